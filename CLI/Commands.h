@@ -1,0 +1,30 @@
+// The `repose` subcommands. Each lives in its own Command<Name>.cpp and returns the exit code;
+// errors are thrown (repose::Error, UsageError) and turned into one line by main.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace repose::cli {
+
+using Args = std::vector<std::string>;
+
+int runInfo(const Args& args);
+int runConvert(const Args& args);
+int runPhantom(const Args& args);
+
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(const Args&);
+};
+
+// In the order `repose --help` lists them.
+inline const Command kCommands[] = {
+    {"info", "describe a volume: geometry, orientation, type, labels", runInfo},
+    {"convert", "convert a volume between NIfTI, NRRD and .seg.nrrd (or from DICOM)", runConvert},
+    {"phantom", "generate the synthetic whole-body mannequin (organs G, parts S, skeleton)",
+     runPhantom},
+};
+
+}  // namespace repose::cli

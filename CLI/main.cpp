@@ -1,0 +1,55 @@
+// `repose`: the command-line face of the module, for scripts and batches. Every subcommand has
+// --help, writes JSON with --json, and fails with one line on stderr and a non-zero exit.
+#include "ArgParser.h"
+#include "Commands.h"
+
+#include "repose/util/Error.h"
+
+#include <cstring>
+#include <iostream>
+#include <new>
+
+namespace {
+
+void printUsage() {
+  std::cout << "usage: repose <command> [options]   (repose <command> --help for details)\n\n"
+               "Re-poses segmented whole-body volumes with a cage.\n\ncommands:\n";
+  for (const auto& c : repose::cli::kCommands)
+    std::cout << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0) {
+    printUsage();
+    return argc < 2 ? 2 : 0;
+  }
+  if (std::strcmp(argv[1], "--version") == 0) {
+    std::cout << "repose " << REPOSE_VERSION << "\n";
+    return 0;
+  }
+  const std::string name = argv[1];
+  const repose::cli::Args args(argv + 2, argv + argc);
+  for (const auto& command : repose::cli::kCommands) {
+    if (name != command.name) continue;
+    try {
+      return command.run(args);
+    } catch (const repose::cli::UsageError& e) {
+      std::cerr << "repose " << name << ": " << e.message << " (see repose " << name
+                << " --help)\n";
+      return 2;
+    } catch (const repose::Cancelled&) {
+      std::cerr << "repose " << name << ": cancelled\n";
+      return 130;
+    } catch (const std::bad_alloc&) {
+      std::cerr << "repose " << name << ": error: out of memory\n";
+      return 1;
+    } catch (const std::exception& e) {
+      std::cerr << "repose " << name << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  std::cerr << "repose: unknown command '" << name << "' (see repose --help)\n";
+  return 2;
+}

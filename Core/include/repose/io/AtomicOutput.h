@@ -1,0 +1,35 @@
+// Safe output files: everything is written inside a hidden temporary folder beside the target
+// and moved into place only on commit(), so a failure or a kill never leaves a partial file.
+#pragma once
+
+#include <string>
+
+namespace repose {
+
+class AtomicOutput {
+ public:
+  // Creates the temporary folder in the target's folder; throws repose::Error naming finalPath
+  // when that folder does not exist or cannot be written.
+  explicit AtomicOutput(const std::string& finalPath);
+  ~AtomicOutput();  // removes the temporary folder and its content unless committed
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+  // Where to write: the final file name inside the temporary folder. Companion files
+  // (a .nhdr's data file) written beside it are moved too.
+  const std::string& tempPath() const { return tempPath_; }
+  const std::string& finalPath() const { return finalPath_; }
+  // Moves every file of the temporary folder into the target folder (rename, same filesystem).
+  void commit();
+
+ private:
+  std::string finalPath_;
+  std::string tempDir_;
+  std::string tempPath_;
+  bool committed_ = false;
+};
+
+// Throws repose::Error if output names the same file as input (an input is never overwritten).
+void refuseOverwritingInput(const std::string& input, const std::string& output);
+
+}  // namespace repose

@@ -1,0 +1,31 @@
+// NIfTI-1 and NIfTI-2 (.nii, .nii.gz) through niftilib. sform (else qform, else pixdim) gives
+// IJK -> RAS; label names come from a Caret/GIFTI XML LabelTable header extension (ecode 0),
+// as TotalSegmentator writes them, and are written back the same way.
+#pragma once
+
+#include "repose/io/VolumeIO.h"
+
+#include <memory>
+
+namespace repose {
+
+Volume readNifti(const std::string& path, const ReadOptions& options = {});
+void writeNifti(const Volume& volume, const std::string& path, const WriteOptions& options = {});
+
+// Writes a single-layer NIfTI slice by slice (k slabs in order) so a volume larger than memory
+// can be produced with bounded memory. Atomic: nothing appears at path until finish().
+class NiftiSlabWriter {
+ public:
+  NiftiSlabWriter(const std::string& path, const VolumeGeometry& geometry, ScalarType type,
+                  const LabelTable& labels, bool labelMap, int niftiVersion = 1);
+  ~NiftiSlabWriter();
+  // `slices` whole k-slices of voxels in file order, starting where the previous call ended.
+  void writeSlices(const void* data, std::int64_t slices);
+  void finish();  // throws unless every slice was written
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace repose

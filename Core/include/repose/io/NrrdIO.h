@@ -1,0 +1,13 @@
+// NRRD (.nrrd, .nhdr with raw or gzip data) through teem, with `space` LPS or RAS and direction
+// vectors, and 3D Slicer .seg.nrrd: the Segment{N}_* fields, including 4D layered segmentations.
+#pragma once
+
+#include "repose/io/VolumeIO.h"
+
+namespace repose {
+
+Volume readNrrd(const std::string& path, const ReadOptions& options = {});
+// A .seg.nrrd path writes the Slicer segmentation fields; otherwise a plain NRRD in LPS.
+void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions& options = {});
+
+}  // namespace repose

@@ -1,0 +1,40 @@
+// Reading and writing volumes by file name: NIfTI-1/2 (.nii, .nii.gz), NRRD (.nrrd, .nhdr),
+// 3D Slicer segmentations (.seg.nrrd) and DICOM series (a folder; read only).
+#pragma once
+
+#include "repose/util/Progress.h"
+#include "repose/volume/Volume.h"
+
+#include <string>
+#include <vector>
+
+namespace repose {
+
+enum class FileFormat { Nifti, Nrrd, SegNrrd, DicomSeries };
+
+struct ReadOptions {
+  ProgressFn progress;
+};
+
+struct WriteOptions {
+  int niftiVersion = 1;   // 1 or 2; NIfTI-1 is switched to 2 when a dimension exceeds 32767
+  bool compress = true;   // gzip for .nhdr data and .nrrd; .nii.gz/.nii decide by their name
+  ProgressFn progress;
+};
+
+// The format a path names: a folder is a DICOM series; otherwise by extension.
+// Throws repose::Error naming the path when the extension is unknown.
+FileFormat formatForPath(const std::string& path);
+const char* formatName(FileFormat f);
+
+// Reads any supported file or DICOM folder. Errors name the file and the problem.
+Volume readVolume(const std::string& path, const ReadOptions& options = {});
+
+// Writes atomically (temporary file in the target folder, renamed on success): a failure
+// leaves no partial output. Label maps keep their label table (names, colours).
+void writeVolume(const Volume& volume, const std::string& path, const WriteOptions& options = {});
+
+// Extensions writeVolume accepts, for help texts.
+std::vector<std::string> writableExtensions();
+
+}  // namespace repose

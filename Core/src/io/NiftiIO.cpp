@@ -1,0 +1,364 @@
+// NIfTI-1/2 reading and writing with niftilib (libnifti2 reads both versions). Geometry: sform
+// if set, else qform, else pixdim (NIfTI "method 1"); all three are RAS, so no flip is needed.
+#include "repose/io/NiftiIO.h"
+
+#include "NiftiLabelExtension.h"
+#include "ReaderCommon.h"
+#include "repose/io/AtomicOutput.h"
+
+#include <nifti2_io.h>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+namespace repose {
+namespace {
+
+struct NiftiImageDeleter {
+  void operator()(nifti_image* nim) const {
+    if (nim) nifti_image_free(nim);
+  }
+};
+using NiftiPtr = std::unique_ptr<nifti_image, NiftiImageDeleter>;
+
+constexpr int kIntentLabel = 1002;  // NIFTI_INTENT_LABEL
+
+// niftilib prints its own diagnostics at debug level >= 1; we report one line ourselves.
+void quietNiftilib() { nifti_set_debug_level(getenv("REPOSE_NIFTI_DEBUG") ? 3 : 0); }
+
+bool diskTypeFromNifti(int datatype, io::DiskType& out) {
+  switch (datatype) {
+    case DT_INT8: out = io::DiskType::Int8; return true;
+    case DT_UINT8: out = io::DiskType::UInt8; return true;
+    case DT_INT16: out = io::DiskType::Int16; return true;
+    case DT_UINT16: out = io::DiskType::UInt16; return true;
+    case DT_INT32: out = io::DiskType::Int32; return true;
+    case DT_UINT32: out = io::DiskType::UInt32; return true;
+    case DT_INT64: out = io::DiskType::Int64; return true;
+    case DT_UINT64: out = io::DiskType::UInt64; return true;
+    case DT_FLOAT32: out = io::DiskType::Float32; return true;
+    case DT_FLOAT64: out = io::DiskType::Float64; return true;
+    default: return false;
+  }
+}
+
+int niftiTypeFor(ScalarType t) {
+  switch (t) {
+    case ScalarType::UInt8: return DT_UINT8;
+    case ScalarType::UInt16: return DT_UINT16;
+    case ScalarType::Int16: return DT_INT16;
+    case ScalarType::Int32: return DT_INT32;
+    case ScalarType::Float32: return DT_FLOAT32;
+  }
+  return DT_UINT8;
+}
+
+Eigen::Matrix4d toEigen(const nifti_dmat44& m) {
+  Eigen::Matrix4d e;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) e(r, c) = m.m[r][c];
+  return e;
+}
+
+nifti_dmat44 toNifti(const Eigen::Matrix4d& e) {
+  nifti_dmat44 m;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) m.m[r][c] = e(r, c);
+  return m;
+}
+
+VolumeGeometry geometryOf(const nifti_image& nim, const std::string& path) {
+  VolumeGeometry g;
+  g.dims = {nim.nx, nim.ny, nim.nz};
+  if (nim.sform_code > 0) {
+    g.ijkToRas = toEigen(nim.sto_xyz);
+  } else if (nim.qform_code > 0) {
+    g.ijkToRas = toEigen(nim.qto_xyz);
+  } else {
+    g.ijkToRas.setIdentity();
+    const double d[3] = {nim.dx, nim.dy, nim.dz};
+    for (int a = 0; a < 3; ++a) g.ijkToRas(a, a) = d[a] > 0 ? d[a] : 1.0;
+  }
+  g.validate(path);
+  return g;
+}
+
+// niftilib looks for "X.nii" before "X.nii.gz" whatever name it is given, so with both present
+// it would read the other file. Then we hand it the file through a private symlink instead.
+class UnambiguousNiftiPath {
+ public:
+  explicit UnambiguousNiftiPath(const std::string& path) : path_(path) {
+    namespace fs = std::filesystem;
+    const std::string lower = fs::path(path).filename().string();
+    if (lower.size() < 7 || lower.compare(lower.size() - 7, 7, ".nii.gz") != 0) return;
+    std::error_code ec;
+    if (!fs::exists(path.substr(0, path.size() - 3), ec)) return;
+    std::string pattern = (fs::temp_directory_path() / "repose-nii-XXXXXX").string();
+    if (!::mkdtemp(pattern.data())) return;
+    dir_ = pattern;
+    const fs::path link = fs::path(dir_) / "volume.nii.gz";
+    fs::create_symlink(fs::absolute(path), link, ec);
+    if (!ec) path_ = link.string();
+  }
+  ~UnambiguousNiftiPath() {
+    std::error_code ec;
+    if (!dir_.empty()) std::filesystem::remove_all(dir_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_, dir_;
+};
+
+// Header, geometry and label table of a NIfTI file, checked before any voxel is read.
+NiftiPtr readHeader(const std::string& path, const std::string& libraryPath) {
+  io::requireReadableFile(path);
+  quietNiftilib();
+  NiftiPtr nim(nifti_image_read(libraryPath.c_str(), 0));
+  if (!nim) throwFileError(path, "not a readable NIfTI file (header missing, truncated or corrupt)");
+  if (nim->nifti_type == NIFTI_FTYPE_ANALYZE)
+    throwFileError(path, "is an ANALYZE 7.5 file without orientation; convert it to NIfTI");
+  for (int d = 4; d <= 7; ++d)
+    if (nim->dim[0] >= d && nim->dim[d] > 1)
+      throwFileError(path, std::to_string(nim->dim[0]) + "D NIfTI (dim" + std::to_string(d) +
+                               " = " + std::to_string(nim->dim[d]) +
+                               ") is not supported: give one 3D volume");
+  return nim;
+}
+
+}  // namespace
+
+Volume readNifti(const std::string& path, const ReadOptions& options) {
+  const UnambiguousNiftiPath alias(path);
+  NiftiPtr nim = readHeader(path, alias.path());
+  io::DiskType diskType;
+  if (!diskTypeFromNifti(nim->datatype, diskType))
+    throwFileError(path, std::string("unsupported voxel type ") +
+                             nifti_datatype_to_string(nim->datatype));
+  if (static_cast<std::size_t>(nim->nbyper) != io::diskTypeSize(diskType))
+    throwFileError(path, "inconsistent bytes per voxel in header");
+  const VolumeGeometry geometry = geometryOf(*nim, path);
+
+  // An uncompressed file must hold all its voxels; say so before reading anything.
+  const std::int64_t dataBytes = nim->nvox * nim->nbyper;
+  if (!nifti_is_gzfile(nim->iname)) {
+    const std::int64_t size = nifti_get_filesize(nim->iname);
+    if (size < nim->iname_offset + dataBytes)
+      throwFileError(path, "file is truncated: header announces " + std::to_string(dataBytes) +
+                               " bytes of voxels after offset " +
+                               std::to_string(nim->iname_offset) + ", the file has " +
+                               std::to_string(size) + " bytes");
+  }
+
+  reportProgress(options.progress, 0.0, "reading");
+  const bool scaled = nim->scl_slope != 0.0 && (nim->scl_slope != 1.0 || nim->scl_inter != 0.0);
+  const ScalarType memType = scaled ? ScalarType::Float32 : io::memoryTypeFor(diskType);
+  Volume volume(geometry, memType);
+  const bool direct = !scaled && scalarSize(memType) == io::diskTypeSize(diskType) &&
+                      io::memoryTypeFor(diskType) == memType &&
+                      diskType != io::DiskType::UInt32 && diskType != io::DiskType::Int8;
+  // niftilib loads into nim->data when it is already allocated: read straight into our buffer.
+  std::vector<std::uint8_t> staging;
+  if (direct) {
+    nim->data = volume.layerData(0);
+  } else {
+    staging.resize(static_cast<std::size_t>(dataBytes));
+    nim->data = staging.data();
+  }
+  const int rc = nifti_image_load(nim.get());
+  nim->data = nullptr;  // never let niftilib free our buffers
+  if (rc != 0) throwFileError(path, "cannot read the voxel data (truncated or corrupt file)");
+  if (!direct) {
+    if (scaled) {
+      std::vector<float> tmp(static_cast<std::size_t>(nim->nvox));
+      io::convertVoxels(diskType, staging.data(), ScalarType::Float32, tmp.data(), nim->nvox, path);
+      float* out = volume.data<float>();
+      for (std::int64_t i = 0; i < nim->nvox; ++i)
+        out[i] = static_cast<float>(tmp[i] * nim->scl_slope + nim->scl_inter);
+    } else {
+      io::convertVoxels(diskType, staging.data(), memType, volume.layerData(0), nim->nvox, path);
+    }
+  }
+
+  for (int e = 0; e < nim->num_ext; ++e) {
+    const nifti1_extension& ext = nim->ext_list[e];
+    if (ext.edata && ext.esize > 8) {
+      const std::string text(ext.edata, strnlen(ext.edata, ext.esize - 8));
+      if (text.find("LabelTable") != std::string::npos) {
+        const LabelTable labels = nifti::parseCaretLabelTable(text);
+        for (const Label& l : labels.labels()) volume.labels().set(l);
+      }
+    }
+  }
+  volume.setLabelMap(nim->intent_code == kIntentLabel || io::looksLikeLabelMap(volume));
+  reportProgress(options.progress, 1.0, "reading");
+  return volume;
+}
+
+namespace {
+
+// A nifti_image describing `geometry` (no data), ready for niftilib's header writer.
+NiftiPtr makeHeader(const std::string& tempPath, const VolumeGeometry& geometry, ScalarType type,
+                    const LabelTable& labels, bool labelMap, int niftiVersion) {
+  quietNiftilib();
+  if (niftiVersion != 1 && niftiVersion != 2)
+    throw Error("NIfTI version must be 1 or 2, not " + std::to_string(niftiVersion));
+  for (auto d : geometry.dims)
+    if (d > 32767) niftiVersion = 2;  // NIfTI-1 stores dims as 16-bit
+  const std::int64_t dims[8] = {3, geometry.dims[0], geometry.dims[1], geometry.dims[2], 1, 1, 1, 1};
+  NiftiPtr nim(nifti_make_new_nim(dims, niftiTypeFor(type), 0));
+  if (!nim) throw Error(tempPath + ": cannot create a NIfTI header");
+  const Eigen::Vector3d spacing = geometry.spacing();
+  nim->dx = nim->pixdim[1] = spacing[0];
+  nim->dy = nim->pixdim[2] = spacing[1];
+  nim->dz = nim->pixdim[3] = spacing[2];
+  nim->xyz_units = NIFTI_UNITS_MM;
+  // Both codes set: sform keeps the exact matrix (shear included), qform its rigid part.
+  nim->sform_code = NIFTI_XFORM_SCANNER_ANAT;
+  nim->qform_code = NIFTI_XFORM_SCANNER_ANAT;
+  nim->sto_xyz = toNifti(geometry.ijkToRas);
+  nim->sto_ijk = nifti_dmat44_inverse(nim->sto_xyz);
+  nifti_dmat44_to_quatern(nim->sto_xyz, &nim->quatern_b, &nim->quatern_c, &nim->quatern_d,
+                          &nim->qoffset_x, &nim->qoffset_y, &nim->qoffset_z, nullptr, nullptr,
+                          nullptr, &nim->qfac);
+  nim->qto_xyz = nifti_quatern_to_dmat44(nim->quatern_b, nim->quatern_c, nim->quatern_d,
+                                         nim->qoffset_x, nim->qoffset_y, nim->qoffset_z,
+                                         nim->dx, nim->dy, nim->dz, nim->qfac);
+  nim->qto_ijk = nifti_dmat44_inverse(nim->qto_xyz);
+  if (labelMap) {
+    nim->intent_code = kIntentLabel;
+    std::strncpy(nim->intent_name, "Label", sizeof(nim->intent_name) - 1);
+    if (!labels.empty()) {
+      const std::string xml = nifti::formatCaretLabelTable(labels);
+      nifti_add_extension(nim.get(), xml.c_str(), static_cast<int>(xml.size() + 1), 0);
+    }
+  }
+  std::strncpy(nim->descrip, "Repose", sizeof(nim->descrip) - 1);
+  if (nifti_set_filenames(nim.get(), tempPath.c_str(), 0, 1) != 0)
+    throw Error(tempPath + ": not a NIfTI file name (.nii or .nii.gz)");
+  // After nifti_set_filenames, which resets the type from the file name.
+  nim->nifti_type = niftiVersion == 2 ? NIFTI_FTYPE_NIFTI2_1 : NIFTI_FTYPE_NIFTI1_1;
+  return nim;
+}
+
+// Header, extender and extensions as bytes, padded to the voxel offset. niftilib fills the header
+// struct; we write the bytes ourselves because libnifti2 3.0.1's single-file NIfTI-2 writer puts
+// the voxels over the header.
+std::vector<char> headerBytes(const nifti_image& nim) {
+  std::int64_t offset = (nim.nifti_type == NIFTI_FTYPE_NIFTI2_1 ? 540 : 348) + 4;
+  for (int e = 0; e < nim.num_ext; ++e) offset += nim.ext_list[e].esize;
+  offset = (offset + 15) / 16 * 16;
+  std::vector<char> bytes;
+  if (nim.nifti_type == NIFTI_FTYPE_NIFTI2_1) {
+    nifti_2_header h;
+    nifti_convert_nim2n2hdr(&nim, &h);
+    h.vox_offset = offset;
+    std::memcpy(h.magic, "n+2\0\r\n\032\n", 8);
+    bytes.assign(reinterpret_cast<const char*>(&h), reinterpret_cast<const char*>(&h) + sizeof(h));
+  } else {
+    nifti_1_header h;
+    nifti_convert_nim2n1hdr(&nim, &h);
+    h.vox_offset = static_cast<float>(offset);
+    std::memcpy(h.magic, "n+1\0", 4);
+    bytes.assign(reinterpret_cast<const char*>(&h), reinterpret_cast<const char*>(&h) + sizeof(h));
+  }
+  const char extender[4] = {static_cast<char>(nim.num_ext > 0 ? 1 : 0), 0, 0, 0};
+  bytes.insert(bytes.end(), extender, extender + 4);
+  for (int e = 0; e < nim.num_ext; ++e) {
+    const nifti1_extension& ext = nim.ext_list[e];
+    const std::int32_t head[2] = {ext.esize, ext.ecode};
+    bytes.insert(bytes.end(), reinterpret_cast<const char*>(head), reinterpret_cast<const char*>(head) + 8);
+    const std::size_t start = bytes.size();
+    bytes.resize(start + ext.esize - 8, 0);
+    std::memcpy(&bytes[start], ext.edata, ext.esize - 8);
+  }
+  bytes.resize(static_cast<std::size_t>(offset), 0);
+  return bytes;
+}
+
+}  // namespace
+
+struct NiftiSlabWriter::Impl {
+  AtomicOutput output;
+  NiftiPtr nim;
+  znzFile file = nullptr;
+  std::int64_t sliceBytes = 0, slicesWritten = 0, slicesTotal = 0;
+  explicit Impl(const std::string& path) : output(path) {}
+  ~Impl() {
+    if (file) znzclose(file);
+  }
+};
+
+NiftiSlabWriter::NiftiSlabWriter(const std::string& path, const VolumeGeometry& geometry,
+                                 ScalarType type, const LabelTable& labels, bool labelMap,
+                                 int niftiVersion)
+    : impl_(std::make_unique<Impl>(path)) {
+  geometry.validate(path);
+  const std::string& temp = impl_->output.tempPath();
+  impl_->nim = makeHeader(temp, geometry, type, labels, labelMap, niftiVersion);
+  impl_->sliceBytes = geometry.dims[0] * geometry.dims[1] * static_cast<std::int64_t>(scalarSize(type));
+  impl_->slicesTotal = geometry.dims[2];
+  const bool gz = temp.size() > 3 && temp.compare(temp.size() - 3, 3, ".gz") == 0;
+  // Level 1: label maps compress nearly as well as at level 6, several times faster.
+  impl_->file = znzopen(temp.c_str(), gz ? "wb1" : "wb", gz ? 1 : 0);
+  if (znz_isnull(impl_->file)) throwFileError(path, "cannot create the output file");
+  const std::vector<char> header = headerBytes(*impl_->nim);
+  if (znzwrite(header.data(), 1, header.size(), impl_->file) != header.size())
+    throwFileError(path, "cannot write the NIfTI header");
+}
+
+NiftiSlabWriter::~NiftiSlabWriter() = default;
+
+void NiftiSlabWriter::writeSlices(const void* data, std::int64_t slices) {
+  if (!impl_->file) throw Error(impl_->output.finalPath() + ": writer already finished");
+  if (impl_->slicesWritten + slices > impl_->slicesTotal)
+    throw Error(impl_->output.finalPath() + ": more slices written than the volume has");
+  // zlib takes 32-bit lengths: write large slabs in pieces.
+  const auto* bytes = static_cast<const char*>(data);
+  for (std::int64_t left = slices * impl_->sliceBytes; left > 0;) {
+    const std::size_t n = static_cast<std::size_t>(std::min<std::int64_t>(left, 1 << 28));
+    if (znzwrite(bytes, 1, n, impl_->file) != n)
+      throwFileError(impl_->output.finalPath(), "write failed (disk full?)");
+    bytes += n;
+    left -= static_cast<std::int64_t>(n);
+  }
+  impl_->slicesWritten += slices;
+}
+
+void NiftiSlabWriter::finish() {
+  if (impl_->slicesWritten != impl_->slicesTotal)
+    throw Error(impl_->output.finalPath() + ": only " + std::to_string(impl_->slicesWritten) +
+                " of " + std::to_string(impl_->slicesTotal) + " slices were written");
+  const int rc = znzclose(impl_->file);
+  impl_->file = nullptr;
+  if (rc != 0) throwFileError(impl_->output.finalPath(), "closing the file failed (disk full?)");
+  impl_->output.commit();
+}
+
+void writeNifti(const Volume& volume, const std::string& path, const WriteOptions& options) {
+  if (volume.layers() != 1)
+    throwFileError(path, "a NIfTI file holds one layer; this segmentation has " +
+                             std::to_string(volume.layers()) +
+                             " overlapping layers: write it as .seg.nrrd");
+  reportProgress(options.progress, 0.0, "writing");
+  NiftiSlabWriter writer(path, volume.geometry(), volume.scalarType(), volume.labels(),
+                         volume.isLabelMap(), options.niftiVersion);
+  const std::int64_t slices = volume.dims()[2];
+  const std::int64_t sliceBytes = volume.dims()[0] * volume.dims()[1] *
+                                  static_cast<std::int64_t>(scalarSize(volume.scalarType()));
+  const auto* bytes = static_cast<const std::uint8_t*>(volume.layerData(0));
+  const std::int64_t step = std::max<std::int64_t>(1, (64 << 20) / std::max<std::int64_t>(1, sliceBytes));
+  for (std::int64_t k = 0; k < slices; k += step) {
+    const std::int64_t n = std::min(step, slices - k);
+    writer.writeSlices(bytes + k * sliceBytes, n);
+    reportProgress(options.progress, double(k + n) / slices, "writing");
+  }
+  writer.finish();
+}
+
+}  // namespace repose

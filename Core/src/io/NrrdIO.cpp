@@ -1,0 +1,276 @@
+// NRRD through teem, as Slicer does. Geometry comes from `space`, `space directions` and
+// `space origin`, converted to RAS; a 4D .seg.nrrd with a leading list axis becomes layers.
+#include "repose/io/NrrdIO.h"
+
+#include "ReaderCommon.h"
+#include "SegNrrdFields.h"
+#include "repose/io/AtomicOutput.h"
+
+#include <teem/nrrd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+
+namespace repose {
+namespace {
+
+struct NrrdDeleter {
+  void operator()(Nrrd* n) const {
+    if (n) nrrdNuke(n);
+  }
+};
+using NrrdPtr = std::unique_ptr<Nrrd, NrrdDeleter>;
+
+// teem reports through biff as a multi-line stack; the deepest line says what went wrong.
+std::string takeBiffMessage() {
+  char* raw = biffGetDone(NRRD);
+  std::string text = raw ? raw : "";
+  std::free(raw);
+  std::string best;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    start = end + 1;
+    // "[nrrd] _nrrdRead: problem" -> "problem"
+    if (auto b = line.find("] "); b != std::string::npos) line = line.substr(b + 2);
+    if (auto c = line.find(": "); c != std::string::npos && c < 40) line = line.substr(c + 2);
+    if (!line.empty()) best = line;
+  }
+  return best.empty() ? "unreadable NRRD file" : best;
+}
+
+bool diskTypeFromNrrd(int type, io::DiskType& out) {
+  switch (type) {
+    case nrrdTypeChar: out = io::DiskType::Int8; return true;
+    case nrrdTypeUChar: out = io::DiskType::UInt8; return true;
+    case nrrdTypeShort: out = io::DiskType::Int16; return true;
+    case nrrdTypeUShort: out = io::DiskType::UInt16; return true;
+    case nrrdTypeInt: out = io::DiskType::Int32; return true;
+    case nrrdTypeUInt: out = io::DiskType::UInt32; return true;
+    case nrrdTypeLLong: out = io::DiskType::Int64; return true;
+    case nrrdTypeULLong: out = io::DiskType::UInt64; return true;
+    case nrrdTypeFloat: out = io::DiskType::Float32; return true;
+    case nrrdTypeDouble: out = io::DiskType::Float64; return true;
+    default: return false;
+  }
+}
+
+int nrrdTypeFor(ScalarType t) {
+  switch (t) {
+    case ScalarType::UInt8: return nrrdTypeUChar;
+    case ScalarType::UInt16: return nrrdTypeUShort;
+    case ScalarType::Int16: return nrrdTypeShort;
+    case ScalarType::Int32: return nrrdTypeInt;
+    case ScalarType::Float32: return nrrdTypeFloat;
+  }
+  return nrrdTypeUChar;
+}
+
+bool hasDirection(const NrrdAxisInfo& axis, unsigned spaceDim) {
+  return spaceDim > 0 && !std::isnan(axis.spaceDirection[0]);
+}
+
+// IJK -> RAS of the three domain axes (given by index), from whatever the header has.
+Eigen::Matrix4d ijkToRasOf(const Nrrd& nrrd, const int axes[3], const std::string& path) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  if (nrrd.spaceDim == 0) {
+    // No space: ITK and Slicer take per-axis spacing in LPS with identity directions.
+    for (int a = 0; a < 3; ++a) {
+      const double s = nrrd.axis[axes[a]].spacing;
+      m(a, a) = std::isfinite(s) && s > 0 ? s : 1.0;
+    }
+    return flipLpsRas(m);
+  }
+  if (nrrd.spaceDim != 3)
+    throwFileError(path, "space dimension " + std::to_string(nrrd.spaceDim) + " is not supported");
+  for (int a = 0; a < 3; ++a)
+    for (int r = 0; r < 3; ++r) m(r, a) = nrrd.axis[axes[a]].spaceDirection[r];
+  for (int r = 0; r < 3; ++r) m(r, 3) = std::isnan(nrrd.spaceOrigin[r]) ? 0.0 : nrrd.spaceOrigin[r];
+  switch (nrrd.space) {
+    case nrrdSpaceRightAnteriorSuperior:
+    case nrrdSpaceRightAnteriorSuperiorTime: return m;
+    case nrrdSpaceLeftAnteriorSuperior:
+    case nrrdSpaceLeftAnteriorSuperiorTime: {
+      Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
+      f(0, 0) = -1;
+      return f * m;
+    }
+    case nrrdSpaceLeftPosteriorSuperior:
+    case nrrdSpaceLeftPosteriorSuperiorTime:
+    case nrrdSpaceScannerXYZ:  // taken as LPS, like ITK
+    case nrrdSpaceUnknown:     // "space dimension: 3" alone: LPS, like ITK
+      return flipLpsRas(m);
+    default:
+      throwFileError(path, std::string("unsupported NRRD space '") +
+                               airEnumStr(nrrdSpace, nrrd.space) + "'");
+  }
+}
+
+std::map<std::string, std::string> keyValues(const Nrrd& nrrd) {
+  std::map<std::string, std::string> kv;
+  for (unsigned i = 0; i < nrrdKeyValueSize(&nrrd); ++i) {
+    char *key = nullptr, *value = nullptr;
+    nrrdKeyValueIndex(&nrrd, &key, &value, i);
+    if (key) kv[key] = value ? value : "";
+    std::free(key);
+    std::free(value);
+  }
+  return kv;
+}
+
+}  // namespace
+
+Volume readNrrd(const std::string& path, const ReadOptions& options) {
+  io::requireReadableFile(path);
+  reportProgress(options.progress, 0.0, "reading");
+  NrrdPtr nrrd(nrrdNew());
+  if (nrrdLoad(nrrd.get(), path.c_str(), nullptr) != 0) {
+    std::string message = takeBiffMessage();
+    if (message.find("fread got only") != std::string::npos ||
+        message.find("but received") != std::string::npos)
+      message = "voxel data is truncated or corrupt (" + message + ")";
+    throwFileError(path, message);
+  }
+
+  io::DiskType diskType;
+  if (!diskTypeFromNrrd(nrrd->type, diskType))
+    throwFileError(path, std::string("unsupported voxel type ") + airEnumStr(nrrdType, nrrd->type));
+  // Domain axes are those with a space direction; a 4D file may have one leading list axis.
+  int axes[3];
+  int layerAxis = -1;
+  if (nrrd->dim == 3) {
+    axes[0] = 0, axes[1] = 1, axes[2] = 2;
+  } else if (nrrd->dim == 4 && !hasDirection(nrrd->axis[0], nrrd->spaceDim) &&
+             nrrd->spaceDim > 0) {
+    layerAxis = 0;
+    axes[0] = 1, axes[1] = 2, axes[2] = 3;
+  } else if (nrrd->dim == 2) {
+    throwFileError(path, "2D NRRD: a volume needs three dimensions");
+  } else {
+    throwFileError(path, std::to_string(nrrd->dim) +
+                             "D NRRD is not supported (only 3D, or 4D segmentation layers)");
+  }
+  for (int a = 0; a < 3; ++a)
+    if (nrrd->spaceDim > 0 && !hasDirection(nrrd->axis[axes[a]], nrrd->spaceDim))
+      throwFileError(path, "axis " + std::to_string(axes[a]) + " has no space direction");
+
+  VolumeGeometry geometry;
+  for (int a = 0; a < 3; ++a) geometry.dims[a] = static_cast<std::int64_t>(nrrd->axis[axes[a]].size);
+  geometry.ijkToRas = ijkToRasOf(*nrrd, axes, path);
+  geometry.validate(path);
+  const int layers = layerAxis < 0 ? 1 : static_cast<int>(nrrd->axis[layerAxis].size);
+  if (layers < 1 || layers > 256)
+    throwFileError(path, "implausible number of layers: " + std::to_string(layers));
+
+  const ScalarType memType = io::memoryTypeFor(diskType);
+  Volume volume(geometry, memType, layers);
+  const std::int64_t n = geometry.numVoxels();
+  const std::size_t inSize = io::diskTypeSize(diskType);
+  if (layers == 1) {
+    io::convertVoxels(diskType, nrrd->data, memType, volume.layerData(0), n, path);
+  } else {
+    // On disk the layer index runs fastest; in memory each layer is one contiguous volume.
+    std::vector<std::uint8_t> planar(n * inSize);
+    const auto* in = static_cast<const std::uint8_t*>(nrrd->data);
+    for (int l = 0; l < layers; ++l) {
+      for (std::int64_t v = 0; v < n; ++v)
+        std::memcpy(&planar[v * inSize], in + (v * layers + l) * inSize, inSize);
+      io::convertVoxels(diskType, planar.data(), memType, volume.layerData(l), n, path);
+    }
+  }
+
+  const auto kv = keyValues(*nrrd);
+  if (segnrrd::hasSegmentFields(kv)) {
+    volume.labels() = segnrrd::parseSegments(kv, path);
+    for (const Label& l : volume.labels().labels())
+      if (l.layer >= layers)
+        throwFileError(path, "segment '" + l.name + "' is on layer " + std::to_string(l.layer) +
+                                 " but the file has " + std::to_string(layers));
+    volume.setLabelMap(true);
+  } else {
+    volume.setLabelMap(layers > 1 || io::looksLikeLabelMap(volume));
+  }
+  reportProgress(options.progress, 1.0, "reading");
+  return volume;
+}
+
+namespace {
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions& options) {
+  const bool segmentation = endsWith(path, ".seg.nrrd");
+  if (segmentation && !isIntegerType(volume.scalarType()))
+    throwFileError(path, "a segmentation needs integer labels, this volume is float32");
+  if (volume.layers() > 1 && !segmentation)
+    throwFileError(path, "a layered segmentation can only be written as .seg.nrrd");
+  reportProgress(options.progress, 0.0, "writing");
+  AtomicOutput output(path);
+
+  const int layers = volume.layers();
+  const std::int64_t n = volume.numVoxels();
+  const std::size_t size = scalarSize(volume.scalarType());
+  // teem wants the on-disk layout: for layers, interleave them (layer index fastest).
+  std::vector<std::uint8_t> interleaved;
+  void* data = const_cast<void*>(volume.layerData(0));
+  if (layers > 1) {
+    interleaved.resize(volume.byteSize());
+    for (int l = 0; l < layers; ++l) {
+      const auto* in = static_cast<const std::uint8_t*>(volume.layerData(l));
+      for (std::int64_t v = 0; v < n; ++v)
+        std::memcpy(&interleaved[(v * layers + l) * size], in + v * size, size);
+    }
+    data = interleaved.data();
+  }
+
+  // nrrdNix, not nrrdNuke: the voxels belong to the volume (or `interleaved`), not to teem.
+  std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), &nrrdNix);
+  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
+                                                                   &nrrdIoStateNix);
+  const auto& d = volume.dims();
+  size_t sizes[4];
+  unsigned dim = 0;
+  if (layers > 1) sizes[dim++] = static_cast<size_t>(layers);
+  for (int a = 0; a < 3; ++a) sizes[dim++] = static_cast<size_t>(d[a]);
+  if (nrrdWrap_nva(nrrd.get(), data, nrrdTypeFor(volume.scalarType()), dim, sizes) != 0)
+    throwFileError(path, takeBiffMessage());
+  nrrdSpaceSet(nrrd.get(), nrrdSpaceLeftPosteriorSuperior);
+  const Eigen::Matrix4d lps = flipLpsRas(volume.geometry().ijkToRas);
+  double dirs[4][NRRD_SPACE_DIM_MAX];
+  int kinds[4];
+  unsigned axis = 0;
+  if (layers > 1) {
+    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[axis][r] = AIR_NAN;
+    kinds[axis++] = nrrdKindList;
+  }
+  for (int a = 0; a < 3; ++a, ++axis) {
+    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[axis][r] = r < 3 ? lps(r, a) : AIR_NAN;
+    kinds[axis] = nrrdKindDomain;
+  }
+  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoSpaceDirection, dirs);
+  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoKind, kinds);
+  const double origin[3] = {lps(0, 3), lps(1, 3), lps(2, 3)};
+  nrrdSpaceOriginSet(nrrd.get(), origin);
+  if (segmentation)
+    for (const auto& [key, value] : segnrrd::formatSegments(volume))
+      nrrdKeyValueAdd(nrrd.get(), key.c_str(), value.c_str());
+
+  nio->encoding = options.compress && nrrdEncodingGzip->available() ? nrrdEncodingGzip
+                                                                     : nrrdEncodingRaw;
+  nio->zlibLevel = 1;  // label maps compress well even at the fastest level
+  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0)
+    throwFileError(path, takeBiffMessage());
+  output.commit();
+  reportProgress(options.progress, 1.0, "writing");
+}
+
+}  // namespace repose

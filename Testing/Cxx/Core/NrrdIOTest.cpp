@@ -1,0 +1,171 @@
+// NRRD and Slicer .seg.nrrd: round trips (attached, detached, raw, gzip), the real Slicer files
+// (LPS geometry, segment fields, a 4D layered segmentation) and bad input.
+#include "TestPaths.h"
+#include "TestVolumes.h"
+
+#include "repose/io/VolumeIO.h"
+#include "repose/volume/LabelStatistics.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <regex>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+std::string headerText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text, line;
+  while (std::getline(in, line) && !line.empty()) text += line + "\n";
+  return text;
+}
+
+}  // namespace
+
+TEST(NrrdIO, RoundTripsEveryTypeAttachedAndDetachedRawAndGzip) {
+  ScratchDir dir;
+  int seed = 10;
+  for (ScalarType t : {ScalarType::UInt8, ScalarType::UInt16, ScalarType::Int16, ScalarType::Int32,
+                       ScalarType::Float32})
+    for (const char* ext : {".nrrd", ".nhdr"})
+      for (bool compress : {true, false}) {
+        const Volume v = randomVolume(t, obliqueGeometry(), 60, seed++);
+        const std::string path = dir.file(std::string("v") + std::to_string(seed) + ext);
+        WriteOptions o;
+        o.compress = compress;
+        writeVolume(v, path, o);
+        const Volume r = readVolume(path);
+        EXPECT_TRUE(sameVoxels(v, r)) << path;
+        EXPECT_LT(matrixDifference(v.geometry().ijkToRas, r.geometry().ijkToRas), 1e-9) << path;
+        EXPECT_NE(headerText(path).find("space: left-posterior-superior"), std::string::npos);
+      }
+  // Detached headers brought their data files along, and nothing temporary is left.
+  for (const auto& e : std::filesystem::directory_iterator(dir.path()))
+    EXPECT_EQ(e.path().filename().string().rfind(".repose-tmp", 0), std::string::npos);
+}
+
+TEST(NrrdIO, ReadsSlicerCtInLpsAsRas) {
+  const Volume ct = readVolume(dataPath("slicer_seg/CTChest4.nrrd"));
+  EXPECT_EQ(ct.dims(), (std::array<std::int64_t, 3>{128, 128, 34}));
+  EXPECT_EQ(ct.scalarType(), ScalarType::Int32);
+  EXPECT_FALSE(ct.isLabelMap());
+  // space directions (-3.05,0,0) (0,-3.05,0) (0,0,10) in LPS are +x, +y in RAS.
+  const Eigen::Matrix4d& m = ct.geometry().ijkToRas;
+  EXPECT_NEAR(m(0, 0), 3.04687595367432, 1e-9);
+  EXPECT_NEAR(m(1, 1), 3.04687595367432, 1e-9);
+  EXPECT_NEAR(m(2, 2), 10.0, 1e-9);
+  EXPECT_NEAR(m(0, 3), -193.09599304199222, 1e-9);
+  EXPECT_NEAR(m(1, 3), -216.39599609374994, 1e-9);
+  EXPECT_NEAR(m(2, 3), -340.24999999999994, 1e-9);
+  EXPECT_EQ(ct.geometry().axisCodes(), "RAS");
+}
+
+TEST(NrrdIO, ReadsSlicerSegmentationFields) {
+  const Volume seg = readVolume(dataPath("slicer_seg/Segmentation.seg.nrrd"));
+  const Volume ct = readVolume(dataPath("slicer_seg/CTChest4.nrrd"));
+  EXPECT_TRUE(seg.isLabelMap());
+  EXPECT_EQ(seg.layers(), 1);
+  EXPECT_EQ(seg.labels().size(), 7u);
+  ASSERT_NE(seg.labels().find(5), nullptr);
+  EXPECT_EQ(seg.labels().find(5)->name, "right lung");
+  EXPECT_EQ(seg.labels().find(1)->id, "Segment_1");
+  EXPECT_NE(seg.labels().find(1)->tags.find("SCT^113197003^Rib"), std::string::npos);
+  EXPECT_NEAR(seg.labels().find(5)->color[1], 0.772549, 1e-6);
+  EXPECT_LT(matrixDifference(seg.geometry().ijkToRas, ct.geometry().ijkToRas), 1e-9);
+  // Orientation sanity on real anatomy: lungs are air (HU < -500), ribs are bone (HU > 150).
+  auto meanHu = [&](int label) {
+    double sum = 0;
+    std::int64_t n = 0;
+    for (std::int64_t i = 0; i < seg.numVoxels(); ++i)
+      if (seg.data<std::uint8_t>()[i] == label) sum += ct.data<std::int32_t>()[i], ++n;
+    return sum / n;
+  };
+  EXPECT_LT(meanHu(5), -500);
+  EXPECT_LT(meanHu(6), -500);
+  EXPECT_GT(meanHu(1), 150);
+}
+
+TEST(NrrdIO, ReadsLayeredSegmentationWithoutMergingSegments) {
+  const Volume seg = readVolume(dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd"));
+  EXPECT_EQ(seg.layers(), 2);
+  EXPECT_EQ(seg.dims(), (std::array<std::int64_t, 3>{128, 128, 34}));
+  ASSERT_NE(seg.labels().find(1, 0), nullptr);
+  ASSERT_NE(seg.labels().find(1, 1), nullptr);
+  EXPECT_EQ(seg.labels().find(1, 0)->name, "ribs");
+  EXPECT_EQ(seg.labels().find(1, 1)->name, "overlapping sphere");
+  // The sphere overlaps other segments: some voxels carry a label on both layers.
+  std::int64_t overlap = 0, sphere = 0;
+  for (std::int64_t i = 0; i < seg.numVoxels(); ++i) {
+    sphere += seg.data<std::uint8_t>(1)[i] == 1;
+    overlap += seg.data<std::uint8_t>(1)[i] == 1 && seg.data<std::uint8_t>(0)[i] != 0;
+  }
+  EXPECT_GT(sphere, 0);
+  EXPECT_GT(overlap, 0);
+  // Layer 0 alone equals the single-layer file's voxels.
+  const Volume flat = readVolume(dataPath("slicer_seg/Segmentation.seg.nrrd"));
+  EXPECT_EQ(std::memcmp(flat.layerData(0), seg.layerData(0), flat.numVoxels()), 0);
+}
+
+TEST(NrrdIO, WrittenSegmentationCarriesSlicerFieldsAndRoundTrips) {
+  ScratchDir dir;
+  for (const char* name : {"Segmentation.seg.nrrd", "SegmentationOverlapping.seg.nrrd"}) {
+    const Volume seg = readVolume(dataPath(std::string("slicer_seg/") + name));
+    const std::string out = dir.file(name);
+    writeVolume(seg, out);
+    const Volume back = readVolume(out);
+    EXPECT_TRUE(sameVoxels(seg, back)) << name;
+    EXPECT_LT(matrixDifference(seg.geometry().ijkToRas, back.geometry().ijkToRas), 1e-9);
+    ASSERT_EQ(back.labels().size(), seg.labels().size());
+    for (const Label& l : seg.labels().labels()) {
+      const Label* b = back.labels().find(l.value, l.layer);
+      ASSERT_NE(b, nullptr);
+      EXPECT_EQ(b->name, l.name);
+      EXPECT_EQ(b->id, l.id);
+      EXPECT_EQ(b->tags, l.tags);
+    }
+    // Every per-segment and per-segmentation field Slicer's own file has, ours has too.
+    const std::string ours = headerText(out), theirs = headerText(dataPath(std::string("slicer_seg/") + name));
+    std::regex key(R"((Segment\d+_\w+|Segmentation_\w+):=)");
+    for (auto it = std::sregex_iterator(theirs.begin(), theirs.end(), key); it != std::sregex_iterator(); ++it)
+      EXPECT_NE(ours.find((*it)[1].str() + ":="), std::string::npos) << (*it)[1] << " in " << name;
+  }
+}
+
+TEST(NrrdIO, SegmentExtentsMatchTheVoxels) {
+  ScratchDir dir;
+  Volume v(obliqueGeometry({20, 10, 8}), ScalarType::UInt8);
+  v.data<std::uint8_t>()[v.index(3, 4, 5)] = 2;
+  v.data<std::uint8_t>()[v.index(7, 1, 6)] = 2;
+  v.setLabelMap(true);
+  writeVolume(v, dir.file("e.seg.nrrd"));
+  EXPECT_NE(headerText(dir.file("e.seg.nrrd")).find("Segment0_Extent:=3 7 1 4 5 6"), std::string::npos);
+}
+
+TEST(NrrdIO, BadInputGivesOneLineErrors) {
+  ScratchDir dir;
+  auto expectError = [&](const std::string& name, const std::string& content, const std::string& fragment) {
+    const std::string path = dir.file(name);
+    std::ofstream(path, std::ios::binary) << content;
+    try {
+      readVolume(path);
+      FAIL() << name;
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+      EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
+      EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
+    }
+  };
+  const std::string head = "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
+                           "sizes: 4 4 4\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nendian: little\n";
+  expectError("short.nrrd", head + "encoding: raw\n\n" + std::string(10, 'x'), "truncated");
+  expectError("garbage.nrrd", "this is not a nrrd file\n", "");
+  expectError("type.nrrd", "NRRD0004\ntype: block\nblock size: 3\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
+                               std::string(24, 'x'), "");
+  expectError("twod.nrrd", "NRRD0004\ntype: short\ndimension: 2\nsizes: 2 2\nendian: little\nencoding: raw\n\n" + std::string(8, 'x'), "2D");
+  expectError("missingdata.nhdr", head + "encoding: raw\ndata file: nowhere.raw\n", "");
+  expectError("badgz.nrrd", head + "encoding: gzip\n\nnot gzip at all", "truncated or corrupt");
+}
