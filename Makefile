@@ -29,3 +29,8 @@ demo: build
 
 clean:
 	rm -rf $(BUILD_DIR)
+
+.PHONY: bench
+# Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).
+bench: build
+	$(BUILD_DIR)/bin/ReposeIOBench --benchmark_min_time=0.2
