@@ -1,0 +1,170 @@
+// Green coordinates for triangle cages, following the closed-form integrals of Lipman et al.
+// 2008 (their Algorithm 1 and GCTriInt), with guards where a point lies in a face's plane or on
+// an edge's line so the coordinates stay finite.
+#include "repose/cage/GreenCoordinates.h"
+
+#include "repose/util/Error.h"
+#include "repose/util/Parallel.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+
+namespace repose {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double sign(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
+
+double clampedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double d = a.norm() * b.norm();
+  if (d <= 0) return 0;
+  return std::acos(std::clamp(a.dot(b) / d, -1.0, 1.0));
+}
+
+// Integral over the triangle (p, v1, v2) of the Green function gradient term, eta at origin.
+double gcTriInt(const Eigen::Vector3d& p, const Eigen::Vector3d& v1, const Eigen::Vector3d& v2) {
+  const double alpha = clampedAngle(v2 - v1, p - v1);
+  const double beta = clampedAngle(v1 - p, v2 - p);
+  const double lambda = (p - v1).squaredNorm() * std::sin(alpha) * std::sin(alpha);
+  const double c = p.squaredNorm();
+  const double sqrtC = std::sqrt(c), sqrtL = std::sqrt(lambda);
+  auto integral = [&](double theta) {
+    const double S = std::sin(theta), C = std::cos(theta);
+    const double denom = (1 - C) * (1 - C);
+    double logTerm = 0;
+    // lambda -> 0 (eta on the edge's line) makes sqrt(lambda)*log(...) -> 0.
+    if (sqrtL > 1e-12 && denom > 1e-300) {
+      const double arg = 2 * sqrtL * S * S / denom *
+                         (1 - 2 * c * C / (c * (1 + C) + lambda + std::sqrt(lambda * lambda + lambda * c * S * S)));
+      if (arg > 0) logTerm = sqrtL * std::log(arg);
+    }
+    const double atanTerm = sqrtC > 0 ? 2 * sqrtC * std::atan(sqrtC * C / std::sqrt(lambda + S * S * c)) : 0;
+    return -sign(S) / 2 * (atanTerm + logTerm);
+  };
+  return -1 / (4 * kPi) * std::fabs(integral(kPi - alpha) - integral(kPi - alpha - beta) - sqrtC * beta);
+}
+
+// Distance from p to triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
+double pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                             const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.norm();
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.norm();
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.norm();
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
+  const double denom = 1 / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+}  // namespace
+
+Eigen::MatrixX3d faceNormals(const Eigen::MatrixX3d& vertices, const Eigen::MatrixX3i& faces) {
+  Eigen::MatrixX3d n(faces.rows(), 3);
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    const Eigen::Vector3d a = vertices.row(faces(f, 0)), b = vertices.row(faces(f, 1)),
+                          c = vertices.row(faces(f, 2));
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    const double len = cross.norm();
+    n.row(f) = len > 0 ? Eigen::Vector3d(cross / len) : Eigen::Vector3d::Zero();
+  }
+  return n;
+}
+
+GreenCoordinates computeGreenCoordinates(const TriangleMesh& cage, const Eigen::MatrixX3d& points,
+                                         int threads) {
+  const Eigen::Index nv = cage.vertices.rows(), nf = cage.faces.rows();
+  if (nv < 4 || nf < 4) throw Error("Green coordinates need a closed cage (at least a tetrahedron)");
+  const Eigen::MatrixX3d normals = faceNormals(cage.vertices, cage.faces);
+  // The closed forms divide tiny by tiny for points within ~1e-6 of a face's plane. Such points
+  // are evaluated a little inside instead, which bounds the error by that offset.
+  const double size = (cage.vertices.colwise().maxCoeff() - cage.vertices.colwise().minCoeff()).norm();
+  const double nearSurface = 1e-5 * size;
+  GreenCoordinates gc;
+  gc.phi.setZero(points.rows(), nv);
+  gc.psi.setZero(points.rows(), nf);
+  parallelFor(points.rows(), threads, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {
+      Eigen::Vector3d eta = points.row(r);
+      // Near an edge or a corner one push leaves the point close to the other faces: repeat.
+      for (int push = 0; push < 8; ++push) {
+        double closest = std::numeric_limits<double>::max();
+        Eigen::Index closestFace = -1;
+        for (Eigen::Index f = 0; f < nf; ++f) {
+          const double d = pointTriangleDistance(eta, cage.vertices.row(cage.faces(f, 0)),
+                                                 cage.vertices.row(cage.faces(f, 1)),
+                                                 cage.vertices.row(cage.faces(f, 2)));
+          if (d < closest) closest = d, closestFace = f;
+        }
+        if (closest >= nearSurface) break;
+        eta -= 2 * nearSurface * normals.row(closestFace).transpose();
+      }
+      for (Eigen::Index f = 0; f < nf; ++f) {
+        const Eigen::Vector3d n = normals.row(f);
+        Eigen::Vector3d v[3];
+        for (int l = 0; l < 3; ++l) v[l] = cage.vertices.row(cage.faces(f, l)).transpose() - eta;
+        const Eigen::Vector3d p = v[0].dot(n) * n;
+        double s[3], I[3], II[3];
+        Eigen::Vector3d N[3];
+        for (int l = 0; l < 3; ++l) {
+          const Eigen::Vector3d& a = v[l];
+          const Eigen::Vector3d& b = v[(l + 1) % 3];
+          s[l] = sign((a - p).cross(b - p).dot(n));
+          I[l] = gcTriInt(p, a, b);
+          II[l] = gcTriInt(Eigen::Vector3d::Zero(), b, a);
+          const Eigen::Vector3d q = b.cross(a);
+          const double qn = q.norm();
+          N[l] = qn > 0 ? Eigen::Vector3d(q / qn) : Eigen::Vector3d::Zero();
+        }
+        const double Itotal = -std::fabs(s[0] * I[0] + s[1] * I[1] + s[2] * I[2]);
+        gc.psi(r, f) = -Itotal;
+        const Eigen::Vector3d w = n * Itotal + N[0] * II[0] + N[1] * II[1] + N[2] * II[2];
+        if (w.norm() > 1e-12) {
+          for (int l = 0; l < 3; ++l) {
+            const Eigen::Vector3d& Nn = N[(l + 1) % 3];
+            const double d = Nn.dot(v[l]);
+            if (std::fabs(d) > 1e-300) gc.phi(r, cage.faces(f, l)) += Nn.dot(w) / d;
+          }
+        }
+      }
+    }
+  }, 16);
+  return gc;
+}
+
+Eigen::VectorXd greenFaceStretch(const TriangleMesh& rest, const Eigen::MatrixX3d& deformed) {
+  Eigen::VectorXd s(rest.faces.rows());
+  for (Eigen::Index f = 0; f < rest.faces.rows(); ++f) {
+    const auto& F = rest.faces;
+    const Eigen::Vector3d u = rest.vertices.row(F(f, 1)) - rest.vertices.row(F(f, 0));
+    const Eigen::Vector3d v = rest.vertices.row(F(f, 2)) - rest.vertices.row(F(f, 0));
+    const Eigen::Vector3d u2 = deformed.row(F(f, 1)) - deformed.row(F(f, 0));
+    const Eigen::Vector3d v2 = deformed.row(F(f, 2)) - deformed.row(F(f, 0));
+    const double area = 0.5 * u.cross(v).norm();
+    const double num = u2.squaredNorm() * v.squaredNorm() - 2 * u2.dot(v2) * u.dot(v) +
+                       v2.squaredNorm() * u.squaredNorm();
+    s[f] = area > 0 ? std::sqrt(std::max(0.0, num)) / (std::sqrt(8.0) * area) : 1.0;
+  }
+  return s;
+}
+
+Eigen::MatrixX3d applyGreenCoordinates(const GreenCoordinates& gc, const TriangleMesh& rest,
+                                       const Eigen::MatrixX3d& deformed) {
+  const Eigen::MatrixX3d normals = faceNormals(deformed, rest.faces);
+  const Eigen::VectorXd stretch = greenFaceStretch(rest, deformed);
+  return gc.phi * deformed + gc.psi * (stretch.asDiagonal() * normals);
+}
+
+}  // namespace repose
