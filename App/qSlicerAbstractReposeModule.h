@@ -1,0 +1,36 @@
+// qSlicerAbstractReposeModule: the interface a loadable module plugin implements, as Slicer's
+// qSlicerAbstractCoreModule; the host finds plugins by module.json and casts them to this.
+#pragma once
+
+#include <QIcon>
+#include <QString>
+#include <QStringList>
+#include <QtPlugin>
+
+class QWidget;
+
+class qSlicerAbstractReposeModule {
+ public:
+  virtual ~qSlicerAbstractReposeModule() = default;
+
+  // Metadata; must agree with the module's module.json (the host checks).
+  virtual QString name() const = 0;
+  virtual QString title() const = 0;
+  virtual QString category() const = 0;
+  virtual QStringList contributors() const = 0;
+  virtual QString helpText() const = 0;
+  virtual QString acknowledgementText() const = 0;
+  virtual QIcon icon() const = 0;
+
+  // Called once after loading, before any other use: create logic and parameter node.
+  virtual void setup() = 0;
+  // The module panel; the caller owns it (through `parent`). May be called more than once.
+  virtual QWidget* createWidgetRepresentation(QWidget* parent) = 0;
+
+  // Files the module opens (File > Open...), as QFileDialog filters, and opening one.
+  virtual QStringList fileFilters() const = 0;
+  virtual bool openFile(const QString& path, QString* errorMessage) = 0;
+};
+
+#define qSlicerAbstractReposeModule_iid "org.repose.qSlicerAbstractReposeModule/1.0"
+Q_DECLARE_INTERFACE(qSlicerAbstractReposeModule, qSlicerAbstractReposeModule_iid)

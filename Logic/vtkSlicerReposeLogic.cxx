@@ -1,0 +1,134 @@
+// vtkSlicerReposeLogic: loading the input volume named by the parameter node, and describing it.
+#include "vtkSlicerReposeLogic.h"
+
+#include "vtkMRMLReposeParametersNode.h"
+#include "vtkSlicerReposeVolumeConversion.h"
+
+#include <repose/io/VolumeIO.h>
+#include <repose/util/Error.h>
+#include <repose/volume/LabelStatistics.h>
+
+#include <vtkCommand.h>
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkLookupTable.h>
+#include <vtkMatrix4x4.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+
+#include <algorithm>
+#include <iomanip>
+#include <new>
+#include <sstream>
+
+vtkStandardNewMacro(vtkSlicerReposeLogic);
+
+vtkSlicerReposeLogic::vtkSlicerReposeLogic() = default;
+
+vtkSlicerReposeLogic::~vtkSlicerReposeLogic() {
+  this->SetParameterNode(nullptr);
+}
+
+void vtkSlicerReposeLogic::SetParameterNode(vtkMRMLReposeParametersNode* node) {
+  if (node == this->ParameterNode) return;
+  if (this->ParameterNode) this->ParameterNode->RemoveObserver(this->ParameterNodeObserverTag);
+  this->ParameterNode = node;
+  if (node) {
+    this->ParameterNodeObserverTag = node->AddObserver(
+        vtkCommand::ModifiedEvent, this, &vtkSlicerReposeLogic::OnParameterNodeModified);
+    this->OnParameterNodeModified();  // bring the volume in line with the new node
+  }
+  this->Modified();
+}
+
+void vtkSlicerReposeLogic::OnParameterNodeModified() {
+  const std::string& path = this->ParameterNode->GetInputSegmentationPath();
+  if (path == this->VolumePath) return;
+  if (path.empty())
+    this->ClearVolume();
+  else
+    this->LoadVolume(path);
+}
+
+namespace {
+// Error texts from the OS or libraries may span lines; an info box and a log want one.
+std::string oneLine(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  std::replace(text.begin(), text.end(), '\r', ' ');
+  return text;
+}
+}  // namespace
+
+bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
+  this->VolumeImageData = nullptr;
+  this->VolumeIJKToRASMatrix = nullptr;
+  this->VolumeLookupTable = nullptr;
+  this->VolumeLabelTable = {};
+  this->VolumeLabelsPresent = -1;
+  this->VolumePath = path;  // before the node is told, so its Modified does not reload
+  this->LastErrorMessage.clear();
+  try {
+    if (path.empty()) throw repose::Error("no input file given");
+    const repose::Volume volume = repose::readVolume(path);
+    this->VolumeImageData = vtkSlicerReposeVolumeConversion::ToImageData(volume);
+    this->VolumeIJKToRASMatrix =
+        vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);
+    this->VolumeLabelTable = volume.labels();
+    if (volume.isLabelMap())
+      this->VolumeLabelsPresent = static_cast<int>(repose::countLabels(volume).size());
+    this->VolumeLookupTable = vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels());
+  } catch (const repose::Error& e) {
+    this->LastErrorMessage = oneLine(e.what());
+  } catch (const std::bad_alloc&) {
+    this->LastErrorMessage = path + ": not enough memory to load the volume";
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = oneLine(path + ": " + e.what());
+  }
+  if (!this->LastErrorMessage.empty()) this->VolumeImageData = nullptr;
+  if (this->ParameterNode) this->ParameterNode->SetInputSegmentationPath(path);
+  this->Modified();
+  return this->LastErrorMessage.empty();
+}
+
+void vtkSlicerReposeLogic::ClearVolume() {
+  this->VolumeImageData = nullptr;
+  this->VolumeIJKToRASMatrix = nullptr;
+  this->VolumeLookupTable = nullptr;
+  this->VolumeLabelTable = {};
+  this->VolumeLabelsPresent = -1;
+  this->VolumePath.clear();
+  this->LastErrorMessage.clear();
+  this->Modified();
+}
+
+std::string vtkSlicerReposeLogic::GetVolumeSummary() const {
+  if (!this->VolumeImageData) return {};
+  const repose::VolumeGeometry geometry =
+      vtkSlicerReposeVolumeConversion::GetGeometry(this->VolumeImageData);
+  vtkDataArray* scalars = this->VolumeImageData->GetPointData()->GetScalars();
+  const repose::ScalarType type =
+      vtkSlicerReposeVolumeConversion::FromVTKScalarType(scalars->GetDataType());
+  const Eigen::Vector3d spacing = geometry.spacing();
+  std::ostringstream out;
+  out << "Dimensions: " << geometry.dims[0] << " x " << geometry.dims[1] << " x "
+      << geometry.dims[2] << "\n";
+  out << "Spacing: " << std::setprecision(6) << spacing[0] << " x " << spacing[1] << " x "
+      << spacing[2] << " mm\n";
+  out << "Orientation: " << geometry.axisCodes() << "\n";
+  out << "Scalar type: " << repose::scalarTypeName(type) << "\n";
+  out << "Layers: " << scalars->GetNumberOfComponents() << "\n";
+  if (this->VolumeLabelsPresent < 0)
+    out << "Labels: none (not a label map)";
+  else
+    out << "Labels: " << this->VolumeLabelsPresent << " present, " << this->VolumeLabelTable.size()
+        << " named";
+  return out.str();
+}
+
+void vtkSlicerReposeLogic::PrintSelf(ostream& os, vtkIndent indent) {
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "ParameterNode: " << this->ParameterNode.GetPointer() << "\n";
+  os << indent << "VolumePath: " << this->VolumePath << "\n";
+  os << indent << "VolumeImageData: " << this->VolumeImageData.GetPointer() << "\n";
+  os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
+}

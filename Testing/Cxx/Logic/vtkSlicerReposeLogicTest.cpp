@@ -1,0 +1,140 @@
+// Tests of vtkSlicerReposeLogic on real files: loaded image data matches the Core volume
+// (geometry, voxels, labels), the logic follows its parameter node, and errors are one line.
+#include "vtkMRMLReposeParametersNode.h"
+#include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeVolumeConversion.h"
+
+#include "TestPaths.h"
+
+#include <repose/io/VolumeIO.h>
+
+#include <gtest/gtest.h>
+
+#include <vtkImageData.h>
+#include <vtkMatrix3x3.h>
+#include <vtkMatrix4x4.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+
+#include <cstring>
+#include <fstream>
+
+namespace {
+
+// The loaded image must put every voxel where Core's IJK->RAS says, and hold the same bytes.
+void expectMatchesCore(vtkSlicerReposeLogic* logic, const std::string& path) {
+  const repose::Volume core = repose::readVolume(path);
+  vtkImageData* image = logic->GetVolumeImageData();
+  ASSERT_NE(image, nullptr);
+  int dims[3];
+  image->GetDimensions(dims);
+  for (int a = 0; a < 3; ++a) EXPECT_EQ(dims[a], core.dims()[a]);
+  const Eigen::Vector3d spacing = core.geometry().spacing(), origin = core.geometry().origin();
+  const Eigen::Matrix3d direction = core.geometry().directions();
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(image->GetSpacing()[a], spacing[a], 1e-12);
+    EXPECT_NEAR(image->GetOrigin()[a], origin[a], 1e-12);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(image->GetDirectionMatrix()->GetElement(a, c), direction(a, c), 1e-12);
+  }
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c)
+      EXPECT_EQ(logic->GetVolumeIJKToRASMatrix()->GetElement(r, c), core.geometry().ijkToRas(r, c));
+  EXPECT_EQ(image->GetNumberOfScalarComponents(), core.layers());
+  EXPECT_EQ(image->GetScalarType(),
+            vtkSlicerReposeVolumeConversion::ToVTKScalarType(core.scalarType()));
+  const repose::Volume back = vtkSlicerReposeVolumeConversion::FromImageData(image);
+  EXPECT_TRUE(back.bytes() == core.bytes());
+  EXPECT_EQ(logic->GetVolumeLabelTable().size(), core.labels().size());
+}
+
+}  // namespace
+
+TEST(vtkSlicerReposeLogic, LoadsTotalSegmentatorNifti) {
+  vtkNew<vtkSlicerReposeLogic> logic;
+  const std::string path = repose::test::dataPath("totalsegmentator/example_seg.nii.gz");
+  ASSERT_TRUE(logic->LoadVolume(path)) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(logic->GetLastErrorMessage().empty());
+  expectMatchesCore(logic, path);
+  int dims[3];
+  logic->GetVolumeImageData()->GetDimensions(dims);
+  EXPECT_EQ(dims[0], 122);
+  EXPECT_EQ(dims[1], 101);
+  EXPECT_EQ(dims[2], 30);
+  EXPECT_NEAR(logic->GetVolumeImageData()->GetSpacing()[0], 3.0, 1e-4);
+  EXPECT_GE(logic->GetVolumeLabelTable().size(), 41u);
+  ASSERT_NE(logic->GetVolumeLookupTable(), nullptr);
+  const std::string summary = logic->GetVolumeSummary();
+  EXPECT_NE(summary.find("Dimensions: 122 x 101 x 30"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("Scalar type: uint8"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("Orientation: RAS"), std::string::npos) << summary;
+  EXPECT_EQ(logic->GetVolumeLabelsPresent(), 41);  // as the data README says
+  EXPECT_NE(summary.find("Labels: 41 present"), std::string::npos) << summary;
+}
+
+TEST(vtkSlicerReposeLogic, LoadsSlicerSegmentationsInLps) {
+  vtkNew<vtkSlicerReposeLogic> logic;
+  const std::string path = repose::test::dataPath("slicer_seg/Segmentation.seg.nrrd");
+  ASSERT_TRUE(logic->LoadVolume(path)) << logic->GetLastErrorMessage();
+  expectMatchesCore(logic, path);
+  EXPECT_EQ(logic->GetVolumeLabelTable().size(), 7u);
+  EXPECT_EQ(logic->GetVolumeLabelsPresent(), 7);
+  // An intensity image has no labels to count.
+  ASSERT_TRUE(logic->LoadVolume(repose::test::dataPath("slicer_seg/CTChest4.nrrd")));
+  EXPECT_EQ(logic->GetVolumeLabelsPresent(), -1);
+  EXPECT_NE(logic->GetVolumeSummary().find("not a label map"), std::string::npos);
+  const std::string overlapping =
+      repose::test::dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd");
+  ASSERT_TRUE(logic->LoadVolume(overlapping)) << logic->GetLastErrorMessage();
+  expectMatchesCore(logic, overlapping);
+  EXPECT_EQ(logic->GetVolumeImageData()->GetNumberOfScalarComponents(), 2);
+  EXPECT_NE(logic->GetVolumeSummary().find("Layers: 2"), std::string::npos);
+}
+
+TEST(vtkSlicerReposeLogic, MissingOrBadFileGivesOneLineError) {
+  vtkNew<vtkSlicerReposeLogic> logic;
+  ASSERT_TRUE(logic->LoadVolume(repose::test::dataPath("totalsegmentator/example_seg.nii.gz")));
+  const std::string missing = repose::test::dataPath("no/such/file.nii.gz");
+  EXPECT_FALSE(logic->LoadVolume(missing));
+  const std::string& error = logic->GetLastErrorMessage();
+  EXPECT_NE(error.find(missing), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_EQ(logic->GetVolumeImageData(), nullptr);  // the previous volume is gone
+  EXPECT_TRUE(logic->GetVolumeSummary().empty());
+
+  repose::test::ScratchDir scratch;
+  const std::string garbage = scratch.file("garbage.nii");
+  std::ofstream(garbage) << "this is not a NIfTI file";
+  EXPECT_FALSE(logic->LoadVolume(garbage));
+  EXPECT_NE(logic->GetLastErrorMessage().find("garbage.nii"), std::string::npos);
+  EXPECT_EQ(logic->GetLastErrorMessage().find('\n'), std::string::npos);
+  EXPECT_FALSE(logic->LoadVolume(""));
+  EXPECT_FALSE(logic->GetLastErrorMessage().empty());
+}
+
+TEST(vtkSlicerReposeLogic, FollowsParameterNode) {
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> node;
+  const std::string path = repose::test::dataPath("slicer_seg/Segmentation.seg.nrrd");
+  node->SetInputSegmentationPath(path);
+  logic->SetParameterNode(node);  // adopts the node's input at once
+  ASSERT_NE(logic->GetVolumeImageData(), nullptr) << logic->GetLastErrorMessage();
+  EXPECT_EQ(logic->GetVolumePath(), path);
+
+  vtkImageData* before = logic->GetVolumeImageData();
+  node->SetCageVertexCount(500);  // unrelated change: no reload
+  EXPECT_EQ(logic->GetVolumeImageData(), before);
+
+  node->SetInputSegmentationPath("");
+  EXPECT_EQ(logic->GetVolumeImageData(), nullptr);
+  EXPECT_TRUE(logic->GetLastErrorMessage().empty());
+
+  // Loading through the logic writes the path back to the node.
+  const std::string nifti = repose::test::dataPath("totalsegmentator/example_seg.nii.gz");
+  ASSERT_TRUE(logic->LoadVolume(nifti));
+  EXPECT_EQ(node->GetInputSegmentationPath(), nifti);
+
+  logic->SetParameterNode(nullptr);
+  node->SetInputSegmentationPath(path);  // no longer observed
+  EXPECT_EQ(logic->GetVolumePath(), nifti);
+}
