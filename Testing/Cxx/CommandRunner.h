@@ -26,7 +26,7 @@ inline std::string shellQuote(const std::string& s) {
 
 // `args` is appended verbatim (quote paths with shellQuote).
 inline CommandResult runCommand(const std::string& exe, const std::string& args) {
-  ScratchDir io;
+  ScratchDir io("run");  // its own folder: the calling test's ScratchDir must survive
   const std::string outFile = io.file("stdout"), errFile = io.file("stderr");
   const std::string cmd = shellQuote(binPath(exe)) + " " + args + " >" + shellQuote(outFile) +
                           " 2>" + shellQuote(errFile) + " </dev/null";

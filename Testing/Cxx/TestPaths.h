@@ -20,13 +20,14 @@ inline std::string binPath(const std::string& name) {
 // A scratch folder unique to the running test, deleted when the object goes away.
 class ScratchDir {
  public:
-  ScratchDir() {
+  // `tag` distinguishes several scratch folders of one test.
+  explicit ScratchDir(const std::string& tag = "") {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "repose";
     for (char& c : name)
       if (c == '/') c = '_';
-    path_ = std::filesystem::temp_directory_path() / ("repose-test-" + name + "-" +
-                                                      std::to_string(::getpid()));
+    path_ = std::filesystem::temp_directory_path() /
+            ("repose-test-" + name + (tag.empty() ? "" : "-" + tag) + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }

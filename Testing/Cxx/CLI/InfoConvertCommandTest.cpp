@@ -53,7 +53,8 @@ TEST(InfoCommand, TextOutputForImagesAndSegmentations) {
   const CommandResult ct =
       runCommand("repose", "info " + shellQuote(dataPath("slicer_seg/CTChest4.nrrd")));
   ASSERT_EQ(ct.exitCode, 0) << ct.err;
-  EXPECT_NE(ct.out.find("LPS"), std::string::npos) << ct.out;  // stored as -x,-y in LPS = RAS... see test below
+  // Stored in LPS with negative x and y steps: the voxel axes point to R, A, S.
+  EXPECT_NE(ct.out.find("orientation  RAS"), std::string::npos) << ct.out;
   EXPECT_NE(ct.out.find("(image)"), std::string::npos);
   const CommandResult seg =
       runCommand("repose", "info " + shellQuote(dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd")));

@@ -13,7 +13,7 @@
 namespace repose {
 
 struct PhantomOptions {
-  double voxelMm = 2.0;       // isotropic voxel size; 1 mm gives ~100M voxels
+  double voxelMm = 2.0;       // isotropic voxel size; 1 mm gives ~160M voxels (1.3 m child)
   bool armsTouching = false;  // hands pressed against the hips (the limb-separation case)
   double marginMm = 10.0;     // empty border around the body
   int threads = 0;            // 0: all cores
@@ -71,6 +71,7 @@ struct PhantomFiles {
 // slab with bounded memory, so a 1G-voxel phantom never needs to fit in memory. ext is ".nii.gz"
 // or ".nii". Outputs are atomic.
 PhantomFiles writePhantom(const Phantom& phantom, const std::string& outDir,
-                          const std::string& ext = ".nii.gz", const ProgressFn& progress = {});
+                          const std::string& ext = ".nii.gz", const ProgressFn& progress = {},
+                          const std::string& prefix = "");
 
 }  // namespace repose

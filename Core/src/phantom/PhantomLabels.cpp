@@ -1,0 +1,72 @@
+// Names and colours of the phantom's organ labels (G) and body parts (S). Names follow
+// TotalSegmentator's snake_case; colours are close to 3D Slicer's GenericAnatomyColors.
+#include "PhantomLabels.h"
+
+#include "repose/phantom/Phantom.h"
+
+namespace repose::phantom {
+
+namespace {
+
+void add(LabelTable& table, int value, const char* name, int r, int g, int b) {
+  Label label;
+  label.value = value;
+  label.name = name;
+  label.color = {r / 255.0, g / 255.0, b / 255.0};
+  table.set(label);
+}
+
+}  // namespace
+
+LabelTable makeOrganLabels() {
+  LabelTable t;
+  add(t, kSkin, "skin", 177, 122, 101);
+  add(t, kFat, "subcutaneous_fat", 235, 225, 60);
+  add(t, kMuscle, "muscle", 192, 104, 88);
+  add(t, kSkull, "skull", 241, 214, 145);
+  add(t, kBrain, "brain", 250, 250, 225);
+  add(t, kEye, "eye", 194, 195, 164);
+  add(t, kVertebrae, "vertebrae", 241, 213, 144);
+  add(t, kRibs, "ribs", 226, 202, 134);
+  add(t, kSternum, "sternum", 244, 217, 154);
+  add(t, kPelvis, "pelvis", 220, 194, 130);
+  add(t, kHumerus, "humerus", 229, 204, 134);
+  add(t, kRadiusUlna, "radius_ulna", 235, 210, 150);
+  add(t, kHandBones, "hand_bones", 246, 222, 160);
+  add(t, kFemur, "femur", 212, 188, 120);
+  add(t, kTibiaFibula, "tibia_fibula", 238, 206, 140);
+  add(t, kFootBones, "foot_bones", 250, 226, 170);
+  add(t, kLungLeft, "lung_left", 197, 165, 145);
+  add(t, kLungRight, "lung_right", 172, 138, 120);
+  add(t, kHeart, "heart", 206, 110, 84);
+  add(t, kLiver, "liver", 221, 130, 101);
+  add(t, kKidneyLeft, "kidney_left", 185, 102, 83);
+  add(t, kKidneyRight, "kidney_right", 160, 85, 70);
+  add(t, kStomach, "stomach", 216, 132, 105);
+  add(t, kSpleen, "spleen", 157, 108, 162);
+  add(t, kBladder, "urinary_bladder", 222, 154, 132);
+  add(t, kSmallBowel, "small_bowel", 205, 167, 142);
+  add(t, kSpinalCord, "spinal_cord", 200, 160, 240);
+  return t;
+}
+
+LabelTable makePartLabels() {
+  LabelTable t;
+  add(t, kPartHead, "head", 250, 210, 160);
+  add(t, kPartTorso, "torso", 128, 174, 128);
+  add(t, kPartUpperArmLeft, "upper_arm_left", 80, 120, 230);
+  add(t, kPartForearmLeft, "forearm_left", 110, 170, 250);
+  add(t, kPartHandLeft, "hand_left", 160, 210, 255);
+  add(t, kPartUpperArmRight, "upper_arm_right", 230, 90, 80);
+  add(t, kPartForearmRight, "forearm_right", 250, 140, 110);
+  add(t, kPartHandRight, "hand_right", 255, 190, 160);
+  add(t, kPartThighLeft, "thigh_left", 60, 160, 150);
+  add(t, kPartShankLeft, "shank_left", 90, 200, 180);
+  add(t, kPartFootLeft, "foot_left", 150, 230, 210);
+  add(t, kPartThighRight, "thigh_right", 200, 150, 40);
+  add(t, kPartShankRight, "shank_right", 230, 190, 70);
+  add(t, kPartFootRight, "foot_right", 250, 225, 130);
+  return t;
+}
+
+}  // namespace repose::phantom
