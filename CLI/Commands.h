@@ -12,6 +12,7 @@ using Args = std::vector<std::string>;
 int runInfo(const Args& args);
 int runConvert(const Args& args);
 int runPhantom(const Args& args);
+int runCage(const Args& args);
 
 struct Command {
   const char* name;
@@ -25,6 +26,7 @@ inline const Command kCommands[] = {
     {"convert", "convert a volume between NIfTI, NRRD and .seg.nrrd (or from DICOM)", runConvert},
     {"phantom", "generate the synthetic whole-body mannequin (organs G, parts S, skeleton)",
      runPhantom},
+    {"cage", "build the control cage around the body (optionally separating two parts)", runCage},
 };
 
 }  // namespace repose::cli
