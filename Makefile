@@ -34,3 +34,4 @@ clean:
 # Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).
 bench: build
 	$(BUILD_DIR)/bin/ReposeIOBench --benchmark_min_time=0.2
+	$(BUILD_DIR)/bin/ReposeCageBench --benchmark_min_time=0.2
