@@ -1,0 +1,55 @@
+// The seed's tetrahedral solver (eq. 1-4): tets inside the cage take their Green-coordinate
+// deformation, every other tet the volume-weighted mean of its neighbours' (step 1), then vertex
+// positions follow those linear maps edge by edge (step 2). Both systems are factorized once.
+#pragma once
+
+#include "repose/mesh/Embedding.h"
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+namespace repose {
+
+class RigiditySolver {
+ public:
+  // Factorizes both least-squares systems (CHOLMOD) for this mesh and these constraints.
+  // Parts of the mesh with no constrained tet (step 1) or vertex (step 2) cannot be driven by the
+  // cage: they keep their rest shape and position, and unconstrainedVertices() counts them.
+  RigiditySolver(const TransferMesh& mesh, const std::vector<int>& constrainedVertices,
+                 const std::vector<int>& constrainedTets);
+  ~RigiditySolver();
+  RigiditySolver(RigiditySolver&&) noexcept;
+  RigiditySolver& operator=(RigiditySolver&&) noexcept;
+
+  // targets: #constrainedVertices by 3 (the Green-coordinate positions, in the order given).
+  // Returns all #V deformed positions; B (optional) receives each tet's 3x3 linear map.
+  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets, std::vector<Eigen::Matrix3d>* B = nullptr) const;
+
+  int unconstrainedVertices() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Linear part B of the affine map taking a rest tet to a deformed one (3x3).
+Eigen::Matrix3d tetLinearMap(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3d& deformed,
+                             const Eigen::RowVector4i& tet);
+
+// One interaction frame: deformed cage -> Green coordinates on V_c -> rigidity solve.
+class CageDeformation {
+ public:
+  CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0);
+  const Embedding& embedding() const { return embedding_; }
+  const RigiditySolver& solver() const { return solver_; }
+  // deformedCage: #cage vertices by 3. Returns #V TM positions (and tet maps if B is given).
+  Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage, std::vector<Eigen::Matrix3d>* B = nullptr) const;
+
+ private:
+  TriangleMesh cage_;
+  Embedding embedding_;
+  RigiditySolver solver_;
+};
+
+}  // namespace repose

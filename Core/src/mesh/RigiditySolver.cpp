@@ -1,0 +1,293 @@
+// Eq. 3 and eq. 4 of the seed with their constraints eliminated: the unknowns are only the tets
+// outside T_c and the vertices outside V_c, so both factorizations and every frame's solves scale
+// with the part of the body the cage misses, not with the whole mesh.
+#include "repose/mesh/RigiditySolver.h"
+
+#include "numerics/SparseCholesky.h"
+#include "repose/util/Error.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <map>
+#include <numeric>
+
+namespace repose {
+namespace {
+
+// Union-find over indices, for the connected parts of the unknowns.
+struct Components {
+  std::vector<int> parent;
+  explicit Components(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void join(int a, int b) { parent[find(a)] = find(b); }
+};
+
+Eigen::Matrix<double, 1, 9> flatten(const Eigen::Matrix3d& B) {
+  return Eigen::Map<const Eigen::Matrix<double, 1, 9>>(B.data());
+}
+Eigen::Matrix3d unflatten(const Eigen::Matrix<double, 1, 9>& row) {
+  return Eigen::Map<const Eigen::Matrix3d>(row.data());
+}
+
+}  // namespace
+
+Eigen::Matrix3d tetLinearMap(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3d& deformed,
+                             const Eigen::RowVector4i& tet) {
+  Eigen::Matrix3d E, D;
+  for (int c = 0; c < 3; ++c) {
+    E.col(c) = (rest.row(tet[c + 1]) - rest.row(tet[0])).transpose();
+    D.col(c) = (deformed.row(tet[c + 1]) - deformed.row(tet[0])).transpose();
+  }
+  return D * E.inverse();
+}
+
+struct RigiditySolver::Impl {
+  const TransferMesh* mesh = nullptr;
+  Eigen::VectorXd volume;                 // |t|
+  std::vector<Eigen::Matrix3d> restInverse;  // E_t^-1 per tet
+  std::vector<int> constrainedVertices, constrainedTets;
+  std::vector<int> vertexSlot;  // vertex -> row among unknown vertices, or -1 if constrained
+  std::vector<int> tetSlot;     // tet -> row among unknown tets, or -1 if in T_c
+  std::vector<int> unknownTets, unknownVertices;
+  std::vector<int> constrainedIndex;  // vertex -> index in constrainedVertices, or -1
+
+  // Step 1: rows  sqrt|t| (B_t - sum_n a_tn B_n) = 0  for t outside T_c; a_tn = |n| / sum |n|.
+  Eigen::SparseMatrix<double> A1u;   // rows x unknown tets
+  Eigen::SparseMatrix<double> A1k;   // rows x constrained tets (their B are known)
+  Eigen::MatrixXd reg1;              // A1^T b from identity rows of unconstrained components
+  SparseCholesky llt1;
+  // Step 2: rows  sqrt(W_e) (v_i - v_j) = g_e / sqrt(W_e)  for edges touching an unknown vertex.
+  std::vector<std::array<int, 2>> edges;
+  std::vector<std::vector<std::pair<int, double>>> edgeTets;  // (tet, |t|) around each edge
+  Eigen::VectorXd edgeWeight;                                 // W_e
+  Eigen::SparseMatrix<double> A2u, A2k;
+  Eigen::MatrixXd reg2;
+  SparseCholesky llt2;
+  int unconstrained = 0;
+};
+
+RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>& constrainedVertices,
+                               const std::vector<int>& constrainedTets)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.mesh = &mesh;
+  const int nv = static_cast<int>(mesh.vertices.rows()), nt = static_cast<int>(mesh.tets.rows());
+  if (constrainedVertices.empty()) throw Error("rigidity solver: no constrained vertex (nothing inside the cage)");
+  m.constrainedVertices = constrainedVertices;
+  m.constrainedTets = constrainedTets;
+  m.volume.resize(nt);
+  m.restInverse.resize(nt);
+  for (int t = 0; t < nt; ++t) {
+    Eigen::Matrix3d E;
+    for (int c = 0; c < 3; ++c) E.col(c) = (mesh.vertices.row(mesh.tets(t, c + 1)) - mesh.vertices.row(mesh.tets(t, 0))).transpose();
+    m.volume[t] = E.determinant() / 6;
+    if (!(m.volume[t] > 0)) throw Error("rigidity solver: tet " + std::to_string(t) + " is degenerate or inverted");
+    m.restInverse[t] = E.inverse();
+  }
+  m.tetSlot.assign(nt, 0);
+  std::vector<int> constrainedTetIndex(nt, -1);
+  for (std::size_t k = 0; k < constrainedTets.size(); ++k) {
+    m.tetSlot.at(constrainedTets[k]) = -1;
+    constrainedTetIndex[constrainedTets[k]] = static_cast<int>(k);
+  }
+  for (int t = 0; t < nt; ++t)
+    if (m.tetSlot[t] == 0) m.tetSlot[t] = static_cast<int>(m.unknownTets.size()), m.unknownTets.push_back(t);
+  m.constrainedIndex.assign(nv, -1);
+  for (std::size_t i = 0; i < constrainedVertices.size(); ++i) m.constrainedIndex.at(constrainedVertices[i]) = static_cast<int>(i);
+  m.vertexSlot.assign(nv, -1);
+  for (int v = 0; v < nv; ++v)
+    if (m.constrainedIndex[v] < 0) m.vertexSlot[v] = static_cast<int>(m.unknownVertices.size()), m.unknownVertices.push_back(v);
+
+  // Face adjacency T1(t), and edges with their tets T1(e).
+  std::map<std::array<int, 3>, std::vector<int>> faces;
+  std::map<std::array<int, 2>, int> edgeIndex;
+  for (int t = 0; t < nt; ++t) {
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<int, 3> f;
+      for (int c = 0, k = 0; c < 4; ++c)
+        if (c != skip) f[k++] = mesh.tets(t, c);
+      std::sort(f.begin(), f.end());
+      faces[f].push_back(t);
+    }
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        std::array<int, 2> e{mesh.tets(t, a), mesh.tets(t, b)};
+        if (e[0] > e[1]) std::swap(e[0], e[1]);
+        auto [it, fresh] = edgeIndex.try_emplace(e, static_cast<int>(m.edges.size()));
+        if (fresh) m.edges.push_back(e), m.edgeTets.emplace_back();
+        m.edgeTets[it->second].emplace_back(t, m.volume[t]);
+      }
+  }
+  std::vector<std::vector<int>> neighbours(nt);
+  for (const auto& [f, ts] : faces)
+    if (ts.size() == 2) neighbours[ts[0]].push_back(ts[1]), neighbours[ts[1]].push_back(ts[0]);
+
+  // Step 1 system. Unknown tets whose face-connected part touches no T_c tet get B = I.
+  const int nu = static_cast<int>(m.unknownTets.size());
+  Components tetParts(nu);
+  std::vector<char> tetDriven(nu, 0);
+  std::vector<Eigen::Triplet<double>> u1, k1;
+  int row = 0;
+  for (int r = 0; r < nu; ++r) {
+    const int t = m.unknownTets[r];
+    double total = 0;
+    for (int n : neighbours[t]) total += m.volume[n];
+    if (neighbours[t].empty()) continue;
+    const double s = std::sqrt(m.volume[t]);
+    u1.emplace_back(row, r, s);
+    for (int n : neighbours[t]) {
+      const double a = -s * m.volume[n] / total;
+      if (m.tetSlot[n] >= 0) {
+        u1.emplace_back(row, m.tetSlot[n], a);
+        tetParts.join(r, m.tetSlot[n]);
+      } else {
+        k1.emplace_back(row, constrainedTetIndex[n], a);
+        tetDriven[r] = 1;
+      }
+    }
+    ++row;
+  }
+  for (int r = 0; r < nu; ++r)
+    if (tetDriven[r]) tetDriven[tetParts.find(r)] = 1;
+  m.reg1 = Eigen::MatrixXd::Zero(nu, 9);
+  const Eigen::Matrix<double, 1, 9> identity = flatten(Eigen::Matrix3d::Identity());
+  for (int r = 0; r < nu; ++r)
+    if (!tetDriven[tetParts.find(r)]) {
+      const double s = std::sqrt(m.volume[m.unknownTets[r]]);
+      u1.emplace_back(row++, r, s);
+      m.reg1.row(r) += s * s * identity;
+    }
+  m.A1u.resize(row, nu);
+  m.A1u.setFromTriplets(u1.begin(), u1.end());
+  m.A1k.resize(row, static_cast<Eigen::Index>(constrainedTets.size()));
+  m.A1k.setFromTriplets(k1.begin(), k1.end());
+  if (nu > 0) m.llt1.factorize(Eigen::SparseMatrix<double>(m.A1u.transpose() * m.A1u), "rigidity solver step 1");
+
+  // Step 2 system over the vertices outside V_c; parts with no edge to V_c stay at rest.
+  const int no = static_cast<int>(m.unknownVertices.size());
+  Components vertexParts(no);
+  std::vector<char> vertexDriven(no, 0);
+  std::vector<Eigen::Triplet<double>> u2, k2;
+  m.edgeWeight.resize(static_cast<Eigen::Index>(m.edges.size()));
+  row = 0;
+  std::vector<int> usedEdges;
+  for (std::size_t e = 0; e < m.edges.size(); ++e) {
+    double W = 0;
+    for (const auto& [t, vol] : m.edgeTets[e]) W += vol;
+    m.edgeWeight[e] = W;
+    const int i = m.edges[e][0], j = m.edges[e][1];
+    const int si = m.vertexSlot[i], sj = m.vertexSlot[j];
+    if (si < 0 && sj < 0) continue;
+    const double s = std::sqrt(W);
+    if (si >= 0) u2.emplace_back(row, si, s); else k2.emplace_back(row, m.constrainedIndex[i], s);
+    if (sj >= 0) u2.emplace_back(row, sj, -s); else k2.emplace_back(row, m.constrainedIndex[j], -s);
+    // An edge to a constrained vertex drives its part; one between unknowns joins their parts.
+    if (si >= 0 && sj >= 0)
+      vertexParts.join(si, sj);
+    else if (si >= 0)
+      vertexDriven[si] = 1;
+    else if (sj >= 0)
+      vertexDriven[sj] = 1;
+    usedEdges.push_back(static_cast<int>(e));
+    ++row;
+  }
+  for (int r = 0; r < no; ++r)
+    if (vertexDriven[r]) vertexDriven[vertexParts.find(r)] = 1;
+  m.reg2 = Eigen::MatrixXd::Zero(no, 3);
+  std::vector<double> vertexWeight(nv, 0);
+  for (int t = 0; t < nt; ++t)
+    for (int c = 0; c < 4; ++c) vertexWeight[mesh.tets(t, c)] += m.volume[t];
+  for (int r = 0; r < no; ++r)
+    if (!vertexDriven[vertexParts.find(r)]) {
+      const int v = m.unknownVertices[r];
+      const double w = std::max(vertexWeight[v], 1e-12);
+      u2.emplace_back(row++, r, std::sqrt(w));
+      m.reg2.row(r) += w * mesh.vertices.row(v);
+      ++m.unconstrained;
+    }
+  // Keep only the edges that have rows, in row order.
+  std::vector<std::array<int, 2>> keptEdges;
+  std::vector<std::vector<std::pair<int, double>>> keptTets;
+  Eigen::VectorXd keptWeight(static_cast<Eigen::Index>(usedEdges.size()));
+  for (std::size_t k = 0; k < usedEdges.size(); ++k) {
+    keptEdges.push_back(m.edges[usedEdges[k]]);
+    keptTets.push_back(std::move(m.edgeTets[usedEdges[k]]));
+    keptWeight[static_cast<Eigen::Index>(k)] = m.edgeWeight[usedEdges[k]];
+  }
+  m.edges = std::move(keptEdges);
+  m.edgeTets = std::move(keptTets);
+  m.edgeWeight = keptWeight;
+  m.A2u.resize(row, no);
+  m.A2u.setFromTriplets(u2.begin(), u2.end());
+  m.A2k.resize(row, static_cast<Eigen::Index>(constrainedVertices.size()));
+  m.A2k.setFromTriplets(k2.begin(), k2.end());
+  if (no > 0) m.llt2.factorize(Eigen::SparseMatrix<double>(m.A2u.transpose() * m.A2u), "rigidity solver step 2");
+}
+
+RigiditySolver::~RigiditySolver() = default;
+RigiditySolver::RigiditySolver(RigiditySolver&&) noexcept = default;
+RigiditySolver& RigiditySolver::operator=(RigiditySolver&&) noexcept = default;
+
+int RigiditySolver::unconstrainedVertices() const { return impl_->unconstrained; }
+
+Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets, std::vector<Eigen::Matrix3d>* Bout) const {
+  const Impl& m = *impl_;
+  const TransferMesh& mesh = *m.mesh;
+  if (targets.rows() != static_cast<Eigen::Index>(m.constrainedVertices.size()))
+    throw Error("rigidity solver: " + std::to_string(targets.rows()) + " targets for " +
+                std::to_string(m.constrainedVertices.size()) + " constrained vertices");
+  if (!targets.allFinite()) throw Error("rigidity solver: target positions are not finite");
+  Eigen::MatrixX3d positions(mesh.vertices.rows(), 3);
+  for (std::size_t i = 0; i < m.constrainedVertices.size(); ++i) positions.row(m.constrainedVertices[i]) = targets.row(i);
+
+  // Step 1: B of T_c from the targets, then the others.
+  std::vector<Eigen::Matrix3d> B(static_cast<std::size_t>(mesh.tets.rows()));
+  Eigen::MatrixXd known(m.constrainedTets.size(), 9);
+  for (std::size_t k = 0; k < m.constrainedTets.size(); ++k) {
+    const int t = m.constrainedTets[k];
+    Eigen::Matrix3d D;
+    for (int c = 0; c < 3; ++c) D.col(c) = (positions.row(mesh.tets(t, c + 1)) - positions.row(mesh.tets(t, 0))).transpose();
+    B[t] = D * m.restInverse[t];
+    known.row(k) = flatten(B[t]);
+  }
+  if (!m.unknownTets.empty()) {
+    const Eigen::MatrixXd rhs = m.reg1 - Eigen::MatrixXd(m.A1u.transpose() * (m.A1k * known));
+    const Eigen::MatrixXd x = m.llt1.solve(rhs);
+    for (std::size_t r = 0; r < m.unknownTets.size(); ++r) B[m.unknownTets[r]] = unflatten(x.row(r));
+  }
+
+  // Step 2: each edge row wants v_i - v_j = (sum |t| B_t e0) / W_e.
+  if (!m.unknownVertices.empty()) {
+    Eigen::MatrixXd b(static_cast<Eigen::Index>(m.edges.size()), 3);
+    for (std::size_t e = 0; e < m.edges.size(); ++e) {
+      const Eigen::Vector3d e0 = (mesh.vertices.row(m.edges[e][0]) - mesh.vertices.row(m.edges[e][1])).transpose();
+      Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+      for (const auto& [t, vol] : m.edgeTets[e]) sum += vol * B[t];
+      b.row(static_cast<Eigen::Index>(e)) = (sum * e0).transpose() / std::sqrt(m.edgeWeight[static_cast<Eigen::Index>(e)]);
+    }
+    // Rows past the edges are the rest-position anchors of undriven parts; their b is in reg2.
+    Eigen::MatrixXd full = Eigen::MatrixXd::Zero(m.A2u.rows(), 3);
+    full.topRows(b.rows()) = b;
+    const Eigen::MatrixXd rhs = Eigen::MatrixXd(m.A2u.transpose() * (full - m.A2k * targets)) + m.reg2;
+    const Eigen::MatrixXd x = m.llt2.solve(rhs);
+    for (std::size_t r = 0; r < m.unknownVertices.size(); ++r) positions.row(m.unknownVertices[r]) = x.row(r);
+  }
+  if (Bout) *Bout = std::move(B);
+  return positions;
+}
+
+CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads)
+    : cage_(cage),
+      embedding_(embedInCage(mesh, cage, threads)),
+      solver_(mesh, embedding_.cageVertices, embedding_.cageTets) {}
+
+Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage, std::vector<Eigen::Matrix3d>* B) const {
+  if (deformedCage.rows() != cage_.vertices.rows()) throw Error("deformed cage has the wrong number of vertices");
+  return solver_.solve(applyGreenCoordinates(embedding_.coordinates, cage_, deformedCage), B);
+}
+
+}  // namespace repose

@@ -1,0 +1,111 @@
+// The tetrahedral solver (seed eq. 1-4): an identity cage leaves the mesh in place, a rigid cage
+// motion moves everything rigidly (also what sticks out of the cage), a bent limb's tip outside
+// the cage follows its neighbours and keeps its edge lengths, and parts the cage cannot reach
+// stay put instead of making the solve fail.
+#include "TestMeshes.h"
+#include "TestTetMeshes.h"
+
+#include "repose/mesh/RigiditySolver.h"
+#include "repose/util/Error.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+// A 300 mm limb along x; the cage covers x in [-15, 215]: the last 85 mm stick out.
+TransferMesh limb() { return tetBox({0, -20, -20}, {300, 20, 20}, {30, 4, 4}); }
+TriangleMesh limbCage() { return boxMesh({-15, -35, -35}, {215, 35, 35}, 4); }
+
+double meshSize(const TransferMesh& m) {
+  return (m.vertices.colwise().maxCoeff() - m.vertices.colwise().minCoeff()).norm();
+}
+
+}  // namespace
+
+TEST(RigiditySolver, IdentityCageLeavesEveryVertexInPlace) {
+  const TransferMesh mesh = limb();
+  const TriangleMesh cage = limbCage();
+  const CageDeformation d(mesh, cage);
+  EXPECT_GT(d.embedding().outliers(), 0);
+  const Eigen::MatrixX3d out = d.deform(cage.vertices);
+  EXPECT_LT((out - mesh.vertices).rowwise().norm().maxCoeff(), 1e-6 * meshSize(mesh));
+}
+
+TEST(RigiditySolver, RigidCageMotionMovesOutsideVerticesRigidly) {
+  const TransferMesh mesh = limb();
+  const TriangleMesh cage = limbCage();
+  const CageDeformation d(mesh, cage);
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.3, -1, 2).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d t(-40, 500, 12);
+  std::vector<Eigen::Matrix3d> B;
+  const Eigen::MatrixX3d out = d.deform((cage.vertices * R.transpose()).rowwise() + t, &B);
+  const Eigen::MatrixX3d expected = (mesh.vertices * R.transpose()).rowwise() + t;
+  EXPECT_LT((out - expected).rowwise().norm().maxCoeff(), 1e-5 * meshSize(mesh));
+  for (const Eigen::Matrix3d& b : B) EXPECT_LT((b - R).norm(), 1e-6);
+}
+
+TEST(RigiditySolver, BentLimbTipOutsideTheCageFollowsAndKeepsItsShape) {
+  const TransferMesh mesh = limb();
+  const TriangleMesh cage = limbCage();
+  const CageDeformation d(mesh, cage);
+  // Bend: cage vertices beyond x = 120 turn 40 degrees about z around (120, 0, 0).
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(40 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d pivot(120, 0, 0);
+  Eigen::MatrixX3d bent = cage.vertices;
+  for (Eigen::Index v = 0; v < bent.rows(); ++v)
+    if (bent(v, 0) > 120) bent.row(v) = (R * (bent.row(v).transpose() - pivot) + pivot).transpose();
+  const Eigen::MatrixX3d out = d.deform(bent);
+  ASSERT_TRUE(out.allFinite());
+  // The tip (outside the cage) turned with the distal cage: its axis points along R * x.
+  Eigen::Vector3d tipStart = Eigen::Vector3d::Zero(), tipEnd = Eigen::Vector3d::Zero();
+  int ns = 0, ne = 0;
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+    if (std::fabs(mesh.vertices(v, 0) - 230) < 1e-9) tipStart += out.row(v).transpose(), ++ns;
+    if (std::fabs(mesh.vertices(v, 0) - 300) < 1e-9) tipEnd += out.row(v).transpose(), ++ne;
+  }
+  const Eigen::Vector3d axis = (tipEnd / ne - tipStart / ns).normalized();
+  EXPECT_GT(axis.dot(R * Eigen::Vector3d::UnitX()), std::cos(10 * M_PI / 180));
+  // Edge lengths of tets wholly outside the cage stay within 5%.
+  double worst = 0;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    bool outside = true;
+    for (int c = 0; c < 4; ++c) outside = outside && d.embedding().inside[mesh.tets(t, c)] == 0;
+    if (!outside) continue;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const double rest = (mesh.vertices.row(mesh.tets(t, a)) - mesh.vertices.row(mesh.tets(t, b))).norm();
+        const double now = (out.row(mesh.tets(t, a)) - out.row(mesh.tets(t, b))).norm();
+        worst = std::max(worst, std::fabs(now / rest - 1));
+      }
+  }
+  EXPECT_LT(worst, 0.05);
+}
+
+TEST(RigiditySolver, PartsTheCageCannotReachStayAtRest) {
+  // A separate block far from the cage: no vertex inside, no edge to one.
+  const TransferMesh mesh = concatenate(limb(), tetBox({500, 0, 0}, {540, 40, 40}, {2, 2, 2}, 2));
+  const TriangleMesh cage = limbCage();
+  const CageDeformation d(mesh, cage);
+  EXPECT_EQ(d.solver().unconstrainedVertices(), 27);
+  const Eigen::MatrixX3d moved = cage.vertices.rowwise() + Eigen::RowVector3d(0, 0, 50);
+  const Eigen::MatrixX3d out = d.deform(moved);
+  ASSERT_TRUE(out.allFinite());
+  for (Eigen::Index v = limb().vertices.rows(); v < mesh.vertices.rows(); ++v)
+    EXPECT_LT((out.row(v) - mesh.vertices.row(v)).norm(), 1e-9);
+  EXPECT_NEAR(out(0, 2) - mesh.vertices(0, 2), 50, 1e-6);  // the limb moved with the cage
+}
+
+TEST(RigiditySolver, RefusesACageAroundNothingAndBadTargets) {
+  const TransferMesh mesh = limb();
+  EXPECT_THROW(CageDeformation(mesh, boxMesh({1000, 1000, 1000}, {1100, 1100, 1100}, 1)), Error);
+  const CageDeformation d(mesh, limbCage());
+  EXPECT_THROW(d.deform(Eigen::MatrixX3d::Zero(3, 3)), Error);
+  Eigen::MatrixX3d nan = limbCage().vertices;
+  nan(0, 0) = std::nan("");
+  EXPECT_THROW(d.deform(nan), Error);
+}
