@@ -3,13 +3,13 @@
 // with the part of the body the cage misses, not with the whole mesh.
 #include "repose/mesh/RigiditySolver.h"
 
+#include "TetAdjacency.h"
 #include "numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
 
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
-#include <map>
 #include <numeric>
 
 namespace repose {
@@ -102,29 +102,12 @@ RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>&
   for (int v = 0; v < nv; ++v)
     if (m.constrainedIndex[v] < 0) m.vertexSlot[v] = static_cast<int>(m.unknownVertices.size()), m.unknownVertices.push_back(v);
 
-  // Face adjacency T1(t), and edges with their tets T1(e).
-  std::map<std::array<int, 3>, std::vector<int>> faces;
-  std::map<std::array<int, 2>, int> edgeIndex;
-  for (int t = 0; t < nt; ++t) {
-    for (int skip = 0; skip < 4; ++skip) {
-      std::array<int, 3> f;
-      for (int c = 0, k = 0; c < 4; ++c)
-        if (c != skip) f[k++] = mesh.tets(t, c);
-      std::sort(f.begin(), f.end());
-      faces[f].push_back(t);
-    }
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
-        std::array<int, 2> e{mesh.tets(t, a), mesh.tets(t, b)};
-        if (e[0] > e[1]) std::swap(e[0], e[1]);
-        auto [it, fresh] = edgeIndex.try_emplace(e, static_cast<int>(m.edges.size()));
-        if (fresh) m.edges.push_back(e), m.edgeTets.emplace_back();
-        m.edgeTets[it->second].emplace_back(t, m.volume[t]);
-      }
-  }
-  std::vector<std::vector<int>> neighbours(nt);
-  for (const auto& [f, ts] : faces)
-    if (ts.size() == 2) neighbours[ts[0]].push_back(ts[1]), neighbours[ts[1]].push_back(ts[0]);
+  const TetAdjacency adjacency = TetAdjacency::build(mesh);
+  const std::vector<std::vector<int>>& neighbours = adjacency.faceNeighbours;
+  m.edges = adjacency.edges;
+  m.edgeTets.resize(m.edges.size());
+  for (std::size_t e = 0; e < m.edges.size(); ++e)
+    for (int t : adjacency.edgeTets[e]) m.edgeTets[e].emplace_back(t, m.volume[t]);
 
   // Step 1 system. Unknown tets whose face-connected part touches no T_c tet get B = I.
   const int nu = static_cast<int>(m.unknownTets.size());
