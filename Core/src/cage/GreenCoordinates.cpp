@@ -17,21 +17,23 @@ constexpr double kPi = 3.14159265358979323846;
 
 double sign(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
 
-double clampedAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+// Cosine of the angle between a and b (1 when either is zero, i.e. the angle is taken as 0).
+double cosAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double d = a.norm() * b.norm();
-  if (d <= 0) return 0;
-  return std::acos(std::clamp(a.dot(b) / d, -1.0, 1.0));
+  return d > 0 ? std::clamp(a.dot(b) / d, -1.0, 1.0) : 1.0;
 }
 
 // Integral over the triangle (p, v1, v2) of the Green function gradient term, eta at origin.
+// The sines and cosines of theta = pi - alpha and pi - alpha - beta come from dot products and
+// the angle-sum identities: only beta itself needs an inverse trigonometric call.
 double gcTriInt(const Eigen::Vector3d& p, const Eigen::Vector3d& v1, const Eigen::Vector3d& v2) {
-  const double alpha = clampedAngle(v2 - v1, p - v1);
-  const double beta = clampedAngle(v1 - p, v2 - p);
-  const double lambda = (p - v1).squaredNorm() * std::sin(alpha) * std::sin(alpha);
+  const double cosA = cosAngle(v2 - v1, p - v1), sinA = std::sqrt(std::max(0.0, 1 - cosA * cosA));
+  const double cosB = cosAngle(v1 - p, v2 - p), sinB = std::sqrt(std::max(0.0, 1 - cosB * cosB));
+  const double beta = std::atan2(sinB, cosB);
+  const double lambda = (p - v1).squaredNorm() * sinA * sinA;
   const double c = p.squaredNorm();
   const double sqrtC = std::sqrt(c), sqrtL = std::sqrt(lambda);
-  auto integral = [&](double theta) {
-    const double S = std::sin(theta), C = std::cos(theta);
+  auto integral = [&](double S, double C) {
     const double denom = (1 - C) * (1 - C);
     double logTerm = 0;
     // lambda -> 0 (eta on the edge's line) makes sqrt(lambda)*log(...) -> 0.
@@ -43,7 +45,10 @@ double gcTriInt(const Eigen::Vector3d& p, const Eigen::Vector3d& v1, const Eigen
     const double atanTerm = sqrtC > 0 ? 2 * sqrtC * std::atan(sqrtC * C / std::sqrt(lambda + S * S * c)) : 0;
     return -sign(S) / 2 * (atanTerm + logTerm);
   };
-  return -1 / (4 * kPi) * std::fabs(integral(kPi - alpha) - integral(kPi - alpha - beta) - sqrtC * beta);
+  // theta1 = pi - alpha; theta2 = pi - (alpha + beta).
+  const double I1 = integral(sinA, -cosA);
+  const double I2 = integral(sinA * cosB + cosA * sinB, -(cosA * cosB - sinA * sinB));
+  return -1 / (4 * kPi) * std::fabs(I1 - I2 - sqrtC * beta);
 }
 
 // Distance from p to triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
@@ -103,6 +108,9 @@ GreenCoordinates computeGreenCoordinates(const TriangleMesh& cage, const Eigen::
         double closest = std::numeric_limits<double>::max();
         Eigen::Index closestFace = -1;
         for (Eigen::Index f = 0; f < nf; ++f) {
+          // The distance to a triangle is at least the distance to its plane: most faces stop here.
+          const double plane = std::fabs(normals.row(f).dot(eta - cage.vertices.row(cage.faces(f, 0)).transpose()));
+          if (plane >= std::min(closest, nearSurface)) continue;
           const double d = pointTriangleDistance(eta, cage.vertices.row(cage.faces(f, 0)),
                                                  cage.vertices.row(cage.faces(f, 1)),
                                                  cage.vertices.row(cage.faces(f, 2)));
