@@ -114,4 +114,16 @@ long ArgParser::getInt(const std::string& name) const {
   return n;
 }
 
+std::pair<int, int> parseLabelPair(const std::string& text, const std::string& option) {
+  const auto colon = text.find(':');
+  const UsageError error{"--" + option + " expects two different positive labels A:B, got '" + text + "'"};
+  if (colon == std::string::npos) throw error;
+  char* end1 = nullptr;
+  char* end2 = nullptr;
+  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
+  const long la = std::strtol(a.c_str(), &end1, 10), lb = std::strtol(b.c_str(), &end2, 10);
+  if (a.empty() || b.empty() || *end1 || *end2 || la <= 0 || lb <= 0 || la == lb || la > 65535 || lb > 65535) throw error;
+  return {static_cast<int>(la), static_cast<int>(lb)};
+}
+
 }  // namespace repose::cli

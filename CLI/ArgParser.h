@@ -41,4 +41,7 @@ struct UsageError {
   std::string message;
 };
 
+// "A:B" with two different positive integers (body-part labels); UsageError naming `option`.
+std::pair<int, int> parseLabelPair(const std::string& text, const std::string& option);
+
 }  // namespace repose::cli

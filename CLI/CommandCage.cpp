@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <tuple>
 #include <iostream>
 
 namespace repose::cli {
@@ -42,15 +43,8 @@ int runCage(const Args& args) {
   o.workingVoxelMm = p.getDouble("working-voxel-mm");
   o.threads = static_cast<int>(p.getInt("threads"));
   if (p.has("separate")) {
-    const std::string s = p.get("separate");
-    const auto colon = s.find(':');
-    char* end1 = nullptr;
-    char* end2 = nullptr;
     LimbSeparation sep;
-    sep.labelA = colon == std::string::npos ? 0 : static_cast<int>(std::strtol(s.substr(0, colon).c_str(), &end1, 10));
-    sep.labelB = colon == std::string::npos ? 0 : static_cast<int>(std::strtol(s.substr(colon + 1).c_str(), &end2, 10));
-    if (colon == std::string::npos || *end1 || *end2 || sep.labelA <= 0 || sep.labelB <= 0 || sep.labelA == sep.labelB)
-      throw UsageError{"--separate expects two different positive labels A:B, got '" + s + "'"};
+    std::tie(sep.labelA, sep.labelB) = parseLabelPair(p.get("separate"), "separate");
     sep.region = Region::parse(p.get("region"));
     o.separations.push_back(sep);
   }
