@@ -1,0 +1,59 @@
+// The transfer mesh (TM): a labelled tetrahedral mesh of the body that carries the cage's
+// deformation to every voxel. Built from S with CGAL Mesh_3 and a sizing field (seed §4.2).
+#pragma once
+
+#include "repose/cage/CageBuilder.h"
+#include "repose/util/Progress.h"
+#include "repose/volume/Volume.h"
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace repose {
+
+struct TransferMesh {
+  Eigen::MatrixX3d vertices;  // #V by 3 rest positions, RAS mm
+  Eigen::MatrixX4i tets;      // #T by 4 vertex indices, positively oriented (volume > 0)
+  Eigen::VectorXi labels;     // #T body-part label (subdomain of S) of each tet
+};
+
+// Signed volume (mm^3) of tet t: det[b-a, c-a, d-a] / 6, positive for the orientation TM uses.
+double tetVolume(const Eigen::MatrixX3d& vertices, const Eigen::RowVector4i& tet);
+
+// Desired tet size (mm) over the volume, stored on a grid (the seed's F). Refinement scales it.
+struct SizingField {
+  VolumeGeometry grid;        // usually S's grid or a coarser one covering it
+  std::vector<float> sizeMm;  // one value per grid voxel (i fastest)
+  static SizingField uniform(const VolumeGeometry& grid, double sizeMm);
+  // Trilinear value at a RAS point, clamped to the grid's border values outside it.
+  double at(const Eigen::Vector3d& ras) const;
+};
+
+struct TransferMeshOptions {
+  double sizeMm = 0;                 // uniform size; 0: 5% of S's diagonal (the seed's default)
+  const SizingField* sizing = nullptr;  // overrides sizeMm when set
+  ProgressFn progress;
+};
+
+struct TransferMeshReport {
+  int vertices = 0, tets = 0;
+  int degenerateTets = 0;  // |volume| below 1e-9 of the mean: removed
+  int invertedTets = 0;    // negative volume after meshing: reoriented
+  std::vector<std::pair<int, int>> tetsPerLabel;  // (label, count)
+};
+
+// Throws repose::Error for an empty S, a non-integer volume or a mesh with no tets.
+TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& options = {},
+                               TransferMeshReport* report = nullptr);
+
+// Inside `region`, duplicates every vertex on a face shared by a tet of label a and a tet of
+// label b, and re-indexes the b-side tets onto the copies, so the two sides can move apart.
+// Returns the number of vertices added. Throws if a or b has no tet.
+int separateLabels(TransferMesh& mesh, int labelA, int labelB, const Region& region);
+
+// VTK XML unstructured grid (.vtu) with a cell array "label"; RAS mm. Atomic write.
+void writeTransferMesh(const TransferMesh& mesh, const std::string& path);
+TransferMesh readTransferMesh(const std::string& path);
+
+}  // namespace repose
