@@ -88,7 +88,9 @@ std::string ArgParser::help() const {
   return out.str();
 }
 
-bool ArgParser::has(const std::string& name) const { return values_.count(name) > 0; }
+bool ArgParser::has(const std::string& name) const {
+  return values_.count(name) > 0;
+}
 
 std::string ArgParser::get(const std::string& name) const {
   if (auto it = values_.find(name); it != values_.end()) return it->second;
@@ -101,7 +103,8 @@ double ArgParser::getDouble(const std::string& name) const {
   const std::string v = get(name);
   char* end = nullptr;
   const double d = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0') throw UsageError{"--" + name + " expects a number, got '" + v + "'"};
+  if (v.empty() || *end != '\0')
+    throw UsageError{"--" + name + " expects a number, got '" + v + "'"};
   return d;
 }
 
@@ -116,13 +119,16 @@ long ArgParser::getInt(const std::string& name) const {
 
 std::pair<int, int> parseLabelPair(const std::string& text, const std::string& option) {
   const auto colon = text.find(':');
-  const UsageError error{"--" + option + " expects two different positive labels A:B, got '" + text + "'"};
+  const UsageError error{"--" + option + " expects two different positive labels A:B, got '" +
+                         text + "'"};
   if (colon == std::string::npos) throw error;
   char* end1 = nullptr;
   char* end2 = nullptr;
   const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
   const long la = std::strtol(a.c_str(), &end1, 10), lb = std::strtol(b.c_str(), &end2, 10);
-  if (a.empty() || b.empty() || *end1 || *end2 || la <= 0 || lb <= 0 || la == lb || la > 65535 || lb > 65535) throw error;
+  if (a.empty() || b.empty() || *end1 || *end2 || la <= 0 || lb <= 0 || la == lb || la > 65535 ||
+      lb > 65535)
+    throw error;
   return {static_cast<int>(la), static_cast<int>(lb)};
 }
 

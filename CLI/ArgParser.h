@@ -21,8 +21,8 @@ class ArgParser {
   bool parse(const std::vector<std::string>& args);
   std::string help() const;
 
-  bool has(const std::string& name) const;  // option given, or flag set
-  std::string get(const std::string& name) const;  // value or default; positionals by name
+  bool has(const std::string& name) const;          // option given, or flag set
+  std::string get(const std::string& name) const;   // value or default; positionals by name
   double getDouble(const std::string& name) const;  // UsageError naming the option if not a number
   long getInt(const std::string& name) const;
 

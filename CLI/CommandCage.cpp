@@ -56,7 +56,8 @@ int runCage(const Args& args) {
   const Volume parts = readVolume(p.get("parts"));
   const Cage cage = buildCage(parts, o);
   writeTriangleMesh(cage.mesh, out);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const CageReport& r = cage.report;
   if (p.has("json")) {
     nlohmann::json j = {{"cage", out},
@@ -67,16 +68,20 @@ int runCage(const Args& args) {
                         {"simplification", r.simplification},
                         {"frozen_dense_vertices", r.frozenVertices},
                         {"dilate_mm", o.dilateMm},
-                        {"checks", {{"closed", r.closed}, {"manifold", r.manifold}, {"outward", r.outward},
-                                    {"self_intersection_free", r.selfIntersectionFree}}},
+                        {"checks",
+                         {{"closed", r.closed},
+                          {"manifold", r.manifold},
+                          {"outward", r.outward},
+                          {"self_intersection_free", r.selfIntersectionFree}}},
                         {"body_voxels", r.bodyVoxels},
                         {"enclosed_voxels", r.enclosedVoxels},
                         {"enclosed_fraction", r.enclosedFraction()},
                         {"seconds", seconds}};
     std::cout << j.dump(2) << "\n";
   } else {
-    std::cout << "wrote " << out << ": " << r.vertices << " vertices, " << r.faces << " faces (from "
-              << r.denseVertices << " on a " << r.workingVoxelMm << " mm grid, " << r.simplification << ")\n"
+    std::cout << "wrote " << out << ": " << r.vertices << " vertices, " << r.faces
+              << " faces (from " << r.denseVertices << " on a " << r.workingVoxelMm << " mm grid, "
+              << r.simplification << ")\n"
               << "checks: closed, manifold, outward, no self-intersection\n"
               << "encloses " << r.enclosedVoxels << " of " << r.bodyVoxels << " body voxels ("
               << 100.0 * r.enclosedFraction() << "%) in " << seconds << " s\n";

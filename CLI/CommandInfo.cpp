@@ -9,10 +9,11 @@
 namespace repose::cli {
 
 int runInfo(const Args& args) {
-  ArgParser p("info", "Describe a volume: dimensions, spacing, orientation (axis codes, the letter\n"
-                      "each voxel axis points to), RAS extent, scalar type, and for label maps every\n"
-                      "label with its name, voxel count and volume. FILE is .nii, .nii.gz, .nrrd,\n"
-                      ".nhdr, .seg.nrrd or a DICOM series folder.");
+  ArgParser p("info",
+              "Describe a volume: dimensions, spacing, orientation (axis codes, the letter\n"
+              "each voxel axis points to), RAS extent, scalar type, and for label maps every\n"
+              "label with its name, voxel count and volume. FILE is .nii, .nii.gz, .nrrd,\n"
+              ".nhdr, .seg.nrrd or a DICOM series folder.");
   p.positional("FILE", "the volume to describe").flag("json", "print JSON instead of text");
   if (!p.parse(args)) return 0;
   ReadOptions options;

@@ -21,12 +21,14 @@ nlohmann::json describeVolume(const Volume& volume, const std::string& path) {
   j["spacing_mm"] = {s.x(), s.y(), s.z()};
   j["orientation"] = g.axisCodes();
   nlohmann::json m = nlohmann::json::array();
-  for (int r = 0; r < 4; ++r) m.push_back({g.ijkToRas(r, 0), g.ijkToRas(r, 1), g.ijkToRas(r, 2), g.ijkToRas(r, 3)});
+  for (int r = 0; r < 4; ++r)
+    m.push_back({g.ijkToRas(r, 0), g.ijkToRas(r, 1), g.ijkToRas(r, 2), g.ijkToRas(r, 3)});
   j["ijk_to_ras"] = m;
   const Eigen::Vector3d o = g.origin();
   j["origin_ras_mm"] = {o.x(), o.y(), o.z()};
   const auto [lo, hi] = g.rasBounds();
-  j["extent_ras_mm"] = {{"min", {lo.x(), lo.y(), lo.z()}}, {"max", {hi.x(), hi.y(), hi.z()}},
+  j["extent_ras_mm"] = {{"min", {lo.x(), lo.y(), lo.z()}},
+                        {"max", {hi.x(), hi.y(), hi.z()}},
                         {"size", {hi.x() - lo.x(), hi.y() - lo.y(), hi.z() - lo.z()}}};
   j["scalar_type"] = scalarTypeName(volume.scalarType());
   j["voxels"] = volume.numVoxels();
@@ -61,7 +63,8 @@ nlohmann::json describeVolume(const Volume& volume, const std::string& path) {
       const double v = volume.valueAsDouble(i);
       lo = std::min(lo, v), hi = std::max(hi, v), sum += v;
     }
-    j["intensity"] = {{"min", lo}, {"max", hi}, {"mean", sum / std::max<std::int64_t>(1, volume.numVoxels())}};
+    j["intensity"] = {
+        {"min", lo}, {"max", hi}, {"mean", sum / std::max<std::int64_t>(1, volume.numVoxels())}};
   }
   return j;
 }
@@ -71,7 +74,8 @@ std::string formatVolumeText(const nlohmann::json& j) {
   out << std::setprecision(6);
   auto triple = [](const nlohmann::json& a, const char* sep) {
     std::ostringstream s;
-    s << std::setprecision(6) << a[0].get<double>() << sep << a[1].get<double>() << sep << a[2].get<double>();
+    s << std::setprecision(6) << a[0].get<double>() << sep << a[1].get<double>() << sep
+      << a[2].get<double>();
     return s.str();
   };
   out << j["file"].get<std::string>() << " (" << j["format"].get<std::string>() << ")\n";
@@ -99,7 +103,8 @@ std::string formatVolumeText(const nlohmann::json& j) {
     }
   } else if (j.contains("intensity")) {
     out << "  intensity    min " << j["intensity"]["min"].get<double>() << ", max "
-        << j["intensity"]["max"].get<double>() << ", mean " << j["intensity"]["mean"].get<double>() << "\n";
+        << j["intensity"]["max"].get<double>() << ", mean " << j["intensity"]["mean"].get<double>()
+        << "\n";
   }
   return out.str();
 }

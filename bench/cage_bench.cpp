@@ -36,7 +36,8 @@ const TriangleMesh& phantomCage(int vertices) {
 }
 
 Eigen::MatrixX3d pointsInBox(const TriangleMesh& cage, int count) {
-  const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(), hi = cage.vertices.colwise().maxCoeff();
+  const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(),
+                        hi = cage.vertices.colwise().maxCoeff();
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(0, 1);
   Eigen::MatrixX3d p(count, 3);
@@ -50,32 +51,37 @@ void BM_GreenCoordinates(benchmark::State& state) {
   const Eigen::MatrixX3d points = pointsInBox(cage, 2000);
   for (auto _ : state) benchmark::DoNotOptimize(computeGreenCoordinates(cage, points));
   state.counters["cage_faces"] = double(cage.faces.rows());
-  state.counters["points*faces/s"] = benchmark::Counter(double(points.rows()) * cage.faces.rows() * state.iterations(),
-                                                        benchmark::Counter::kIsRate);
-  state.counters["points/s"] = benchmark::Counter(double(points.rows()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["points*faces/s"] = benchmark::Counter(
+      double(points.rows()) * cage.faces.rows() * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["points/s"] =
+      benchmark::Counter(double(points.rows()) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
 void BM_WindingNumberPoints(benchmark::State& state) {
   const TriangleMesh& cage = phantomCage(static_cast<int>(state.range(0)));
   const Eigen::MatrixX3d points = pointsInBox(cage, 20000);
   for (auto _ : state) benchmark::DoNotOptimize(windingNumbers(cage, points));
-  state.counters["points/s"] = benchmark::Counter(double(points.rows()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["points/s"] =
+      benchmark::Counter(double(points.rows()) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
 void BM_WindingNumberGrid(benchmark::State& state) {
   const TriangleMesh& cage = phantomCage(static_cast<int>(state.range(0)));
   const double voxel = state.range(1) / 10.0;
-  const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(), hi = cage.vertices.colwise().maxCoeff();
+  const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(),
+                        hi = cage.vertices.colwise().maxCoeff();
   std::array<std::int64_t, 3> dims;
   for (int c = 0; c < 3; ++c) dims[c] = static_cast<std::int64_t>((hi[c] - lo[c]) / voxel) + 1;
   const VolumeGeometry g = VolumeGeometry::make(dims, Eigen::Vector3d::Constant(voxel), lo);
   for (auto _ : state) benchmark::DoNotOptimize(windingNumbersOnGrid(cage, g));
   state.counters["voxels"] = double(g.numVoxels());
-  state.counters["voxels/s"] = benchmark::Counter(double(g.numVoxels()) * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["voxels/s"] =
+      benchmark::Counter(double(g.numVoxels()) * state.iterations(), benchmark::Counter::kIsRate);
 }
 
 // A bend of the right arm's cage vertices about the shoulder: a realistic drag.
-Eigen::MatrixX3d armTargets(const TriangleMesh& cage, const std::vector<int>& handles, double angle) {
+Eigen::MatrixX3d armTargets(const TriangleMesh& cage, const std::vector<int>& handles,
+                            double angle) {
   const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()).toRotationMatrix();
   const Eigen::Vector3d pivot(120, 0, 950);
   Eigen::MatrixX3d t(handles.size(), 3);
@@ -131,7 +137,11 @@ void BM_ArapFactorize(benchmark::State& state) {
 // Multithreaded: rates must come from wall-clock time, not the main thread's CPU time.
 BENCHMARK(BM_GreenCoordinates)->Arg(300)->Arg(500)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_WindingNumberPoints)->Arg(500)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_WindingNumberGrid)->Args({500, 40})->Args({500, 20})->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WindingNumberGrid)
+    ->Args({500, 40})
+    ->Args({500, 20})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ArapIteration)->Arg(500)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ArapSolveFromRest)->Arg(500)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ArapFactorize)->Arg(500)->Unit(benchmark::kMicrosecond);

@@ -34,7 +34,8 @@ const Volume& bodyLikeLabels(std::int64_t n) {
 }
 
 std::string scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("repose-bench-" + std::to_string(getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("repose-bench-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   return (dir / name).string();
 }
@@ -66,12 +67,30 @@ void BM_CountLabels(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_Write, nii_gz, std::string(".nii.gz"))->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Write, nii, std::string(".nii"))->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Write, seg_nrrd, std::string(".seg.nrrd"))->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Read, nii_gz, std::string(".nii.gz"))->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Read, nii, std::string(".nii"))->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Read, seg_nrrd, std::string(".seg.nrrd"))->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Write, nii_gz, std::string(".nii.gz"))
+    ->Arg(128)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Write, nii, std::string(".nii"))
+    ->Arg(128)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Write, seg_nrrd, std::string(".seg.nrrd"))
+    ->Arg(128)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Read, nii_gz, std::string(".nii.gz"))
+    ->Arg(128)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Read, nii, std::string(".nii"))
+    ->Arg(128)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Read, seg_nrrd, std::string(".seg.nrrd"))
+    ->Arg(128)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CountLabels)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
@@ -79,7 +98,7 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   std::error_code ec;
-  std::filesystem::remove_all(std::filesystem::temp_directory_path() /
-                                  ("repose-bench-" + std::to_string(getpid())), ec);
+  std::filesystem::remove_all(
+      std::filesystem::temp_directory_path() / ("repose-bench-" + std::to_string(getpid())), ec);
   return 0;
 }

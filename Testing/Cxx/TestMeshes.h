@@ -16,7 +16,8 @@ inline TriangleMesh boxMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi
   std::vector<Eigen::Vector3i> tris;
   std::map<std::tuple<long, long, long>, int> index;  // dedupe shared edge vertices
   auto vertex = [&](const Eigen::Vector3d& t) {       // t in [0,1]^3
-    const auto key = std::make_tuple(std::lround(t.x() * n), std::lround(t.y() * n), std::lround(t.z() * n));
+    const auto key =
+        std::make_tuple(std::lround(t.x() * n), std::lround(t.y() * n), std::lround(t.z() * n));
     auto it = index.find(key);
     if (it != index.end()) return it->second;
     verts.push_back(lo + (hi - lo).cwiseProduct(t));
@@ -55,7 +56,8 @@ inline TriangleMesh boxMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi
 
 // Unit octahedron subdivided `levels` times and projected on a sphere of `radius` around `centre`.
 inline TriangleMesh sphereMesh(const Eigen::Vector3d& centre, double radius, int levels) {
-  std::vector<Eigen::Vector3d> v = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<Eigen::Vector3d> v = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
   std::vector<Eigen::Vector3i> f = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
                                     {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   for (int level = 0; level < levels; ++level) {
@@ -76,7 +78,8 @@ inline TriangleMesh sphereMesh(const Eigen::Vector3d& centre, double radius, int
   }
   TriangleMesh m;
   m.vertices.resize(v.size(), 3);
-  for (std::size_t i = 0; i < v.size(); ++i) m.vertices.row(i) = centre + radius * v[i].normalized();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    m.vertices.row(i) = centre + radius * v[i].normalized();
   m.faces.resize(f.size(), 3);
   for (std::size_t i = 0; i < f.size(); ++i) m.faces.row(i) = f[i];
   return m;

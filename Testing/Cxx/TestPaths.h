@@ -26,8 +26,9 @@ class ScratchDir {
     std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "repose";
     for (char& c : name)
       if (c == '/') c = '_';
-    path_ = std::filesystem::temp_directory_path() /
-            ("repose-test-" + name + (tag.empty() ? "" : "-" + tag) + "-" + std::to_string(::getpid()));
+    path_ =
+        std::filesystem::temp_directory_path() /
+        ("repose-test-" + name + (tag.empty() ? "" : "-" + tag) + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }

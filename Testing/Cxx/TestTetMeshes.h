@@ -8,7 +8,8 @@
 
 namespace repose::test {
 
-inline TransferMesh tetBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, std::array<int, 3> n, int label = 1) {
+inline TransferMesh tetBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                           std::array<int, 3> n, int label = 1) {
   TransferMesh m;
   const int nx = n[0] + 1, ny = n[1] + 1, nz = n[2] + 1;
   m.vertices.resize(nx * ny * nz, 3);
@@ -16,18 +17,23 @@ inline TransferMesh tetBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
-        m.vertices.row(id(i, j, k)) = lo + (hi - lo).cwiseProduct(Eigen::Vector3d(double(i) / n[0], double(j) / n[1], double(k) / n[2]));
+        m.vertices.row(id(i, j, k)) =
+            lo + (hi - lo).cwiseProduct(
+                     Eigen::Vector3d(double(i) / n[0], double(j) / n[1], double(k) / n[2]));
   std::vector<Eigen::RowVector4i> tets;
   // The six paths from corner 0 to corner 7 through the cube, one tet each.
   const int paths[6][2] = {{1, 2}, {1, 4}, {2, 1}, {2, 4}, {4, 1}, {4, 2}};
   for (int k = 0; k < n[2]; ++k)
     for (int j = 0; j < n[1]; ++j)
       for (int i = 0; i < n[0]; ++i) {
-        auto corner = [&](int bits) { return id(i + (bits & 1), j + ((bits >> 1) & 1), k + ((bits >> 2) & 1)); };
+        auto corner = [&](int bits) {
+          return id(i + (bits & 1), j + ((bits >> 1) & 1), k + ((bits >> 2) & 1));
+        };
         for (const auto& p : paths) {
           Eigen::RowVector4i t(corner(0), corner(p[0]), corner(p[0] | p[1]), corner(7));
           Eigen::Matrix3d E;
-          for (int c = 0; c < 3; ++c) E.col(c) = (m.vertices.row(t[c + 1]) - m.vertices.row(t[0])).transpose();
+          for (int c = 0; c < 3; ++c)
+            E.col(c) = (m.vertices.row(t[c + 1]) - m.vertices.row(t[0])).transpose();
           if (E.determinant() < 0) std::swap(t[2], t[3]);
           tets.push_back(t);
         }

@@ -46,16 +46,17 @@ struct ArapDeformer::Impl {
     double e = 0;
     for (Eigen::Index i = 0; i < rest.rows(); ++i)
       for (const auto& [j, w] : neighbours[i])
-        e += w * ((p.row(i) - p.row(j)).transpose() -
-                  R[i] * (rest.row(i) - rest.row(j)).transpose())
-                     .squaredNorm();
+        e +=
+            w * ((p.row(i) - p.row(j)).transpose() - R[i] * (rest.row(i) - rest.row(j)).transpose())
+                    .squaredNorm();
     return e;
   }
 };
 
 ArapDeformer::ArapDeformer(const TriangleMesh& rest) : impl_(std::make_unique<Impl>()) {
   const Eigen::Index nv = rest.vertices.rows();
-  if (nv < 4 || rest.faces.rows() < 4) throw Error("ARAP needs a closed cage with at least 4 vertices");
+  if (nv < 4 || rest.faces.rows() < 4)
+    throw Error("ARAP needs a closed cage with at least 4 vertices");
   if (rest.faces.minCoeff() < 0 || rest.faces.maxCoeff() >= nv)
     throw Error("ARAP cage has a face index out of range");
   impl_->rest = rest.vertices;
@@ -63,7 +64,8 @@ ArapDeformer::ArapDeformer(const TriangleMesh& rest) : impl_(std::make_unique<Im
   std::map<std::pair<int, int>, double> weights;
   for (Eigen::Index f = 0; f < rest.faces.rows(); ++f)
     for (int c = 0; c < 3; ++c) {
-      const int i = rest.faces(f, (c + 1) % 3), j = rest.faces(f, (c + 2) % 3), k = rest.faces(f, c);
+      const int i = rest.faces(f, (c + 1) % 3), j = rest.faces(f, (c + 2) % 3),
+                k = rest.faces(f, c);
       const Eigen::Vector3d a = rest.vertices.row(i) - rest.vertices.row(k);
       const Eigen::Vector3d b = rest.vertices.row(j) - rest.vertices.row(k);
       const double cross = a.cross(b).norm();
@@ -95,7 +97,8 @@ void ArapDeformer::setHandles(const std::vector<int>& handleVertices) {
     if (h < 0 || h >= nv)
       throw Error("handle vertex " + std::to_string(h) + " is not a cage vertex (0.." +
                   std::to_string(nv - 1) + ")");
-    if (!unique.insert(h).second) throw Error("handle vertex " + std::to_string(h) + " given twice");
+    if (!unique.insert(h).second)
+      throw Error("handle vertex " + std::to_string(h) + " given twice");
   }
   impl_->handles = handleVertices;
   impl_->freeIndex.assign(nv, -1);
@@ -106,7 +109,8 @@ void ArapDeformer::setHandles(const std::vector<int>& handleVertices) {
       impl_->freeVertices.push_back(v);
     }
   std::vector<int> handleIndex(nv, -1);
-  for (std::size_t h = 0; h < handleVertices.size(); ++h) handleIndex[handleVertices[h]] = static_cast<int>(h);
+  for (std::size_t h = 0; h < handleVertices.size(); ++h)
+    handleIndex[handleVertices[h]] = static_cast<int>(h);
   const int nf = static_cast<int>(impl_->freeVertices.size());
   std::vector<Eigen::Triplet<double>> ff, fh;
   for (int r = 0; r < nf; ++r) {
@@ -128,10 +132,12 @@ void ArapDeformer::setHandles(const std::vector<int>& handleVertices) {
   if (nf > 0) impl_->llt.factorize(Lff, "ARAP cage system");
 }
 
-const std::vector<int>& ArapDeformer::handles() const { return impl_->handles; }
+const std::vector<int>& ArapDeformer::handles() const {
+  return impl_->handles;
+}
 
-ArapResult ArapDeformer::solve(const Eigen::MatrixX3d& handleTargets, const Eigen::MatrixX3d* initial,
-                               const ArapOptions& options) const {
+ArapResult ArapDeformer::solve(const Eigen::MatrixX3d& handleTargets,
+                               const Eigen::MatrixX3d* initial, const ArapOptions& options) const {
   const Impl& m = *impl_;
   if (m.handles.empty()) throw Error("ARAP: setHandles must be called before solve");
   if (handleTargets.rows() != static_cast<Eigen::Index>(m.handles.size()))
@@ -140,8 +146,10 @@ ArapResult ArapDeformer::solve(const Eigen::MatrixX3d& handleTargets, const Eige
   if (!handleTargets.allFinite()) throw Error("ARAP: handle targets are not finite");
   ArapResult result;
   result.positions = initial ? *initial : m.rest;
-  if (result.positions.rows() != m.rest.rows()) throw Error("ARAP: initial positions have the wrong size");
-  for (std::size_t h = 0; h < m.handles.size(); ++h) result.positions.row(m.handles[h]) = handleTargets.row(h);
+  if (result.positions.rows() != m.rest.rows())
+    throw Error("ARAP: initial positions have the wrong size");
+  for (std::size_t h = 0; h < m.handles.size(); ++h)
+    result.positions.row(m.handles[h]) = handleTargets.row(h);
   if (m.freeVertices.empty()) return result;
 
   const Eigen::MatrixXd handleTerm = m.Lfh * handleTargets;
@@ -157,7 +165,8 @@ ArapResult ArapDeformer::solve(const Eigen::MatrixX3d& handleTargets, const Eige
       b.row(r) = bi.transpose();
     }
     const Eigen::MatrixXd x = m.llt.solve(b - handleTerm);
-    for (std::size_t r = 0; r < m.freeVertices.size(); ++r) result.positions.row(m.freeVertices[r]) = x.row(r);
+    for (std::size_t r = 0; r < m.freeVertices.size(); ++r)
+      result.positions.row(m.freeVertices[r]) = x.row(r);
     const double e = m.energy(result.positions, m.rotations(result.positions));
     result.energies.push_back(e);
     result.iterations = it + 1;

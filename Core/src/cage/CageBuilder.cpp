@@ -20,7 +20,8 @@ bool Region::contains(const Eigen::Vector3d& p) const {
 
 Region Region::parse(const std::string& text) {
   const auto colon = text.find(':');
-  if (colon == std::string::npos) throw Error("region '" + text + "': expected box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r");
+  if (colon == std::string::npos)
+    throw Error("region '" + text + "': expected box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r");
   const std::string kind = text.substr(0, colon);
   std::vector<double> values;
   std::stringstream in(text.substr(colon + 1));
@@ -28,14 +29,17 @@ Region Region::parse(const std::string& text) {
   while (std::getline(in, item, ',')) {
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) throw Error("region '" + text + "': '" + item + "' is not a number");
+    if (item.empty() || *end != '\0' || !std::isfinite(v))
+      throw Error("region '" + text + "': '" + item + "' is not a number");
     values.push_back(v);
   }
   Region r;
   if (kind == "box" && values.size() == 6) {
     r.shape = Shape::Box;
-    r.a = Eigen::Vector3d(values[0], values[1], values[2]).cwiseMin(Eigen::Vector3d(values[3], values[4], values[5]));
-    r.b = Eigen::Vector3d(values[0], values[1], values[2]).cwiseMax(Eigen::Vector3d(values[3], values[4], values[5]));
+    r.a = Eigen::Vector3d(values[0], values[1], values[2])
+              .cwiseMin(Eigen::Vector3d(values[3], values[4], values[5]));
+    r.b = Eigen::Vector3d(values[0], values[1], values[2])
+              .cwiseMax(Eigen::Vector3d(values[3], values[4], values[5]));
   } else if (kind == "sphere" && values.size() == 4 && values[3] > 0) {
     r.shape = Shape::Sphere;
     r.a = Eigen::Vector3d(values[0], values[1], values[2]);
@@ -48,7 +52,8 @@ Region Region::parse(const std::string& text) {
 
 Cage buildCage(const Volume& parts, const CageOptions& options) {
   if (options.targetVertices < 50 || options.targetVertices > 2000)
-    throw Error("cage vertex count must be between 50 and 2000, not " + std::to_string(options.targetVertices));
+    throw Error("cage vertex count must be between 50 and 2000, not " +
+                std::to_string(options.targetVertices));
   reportProgress(options.progress, 0.0, "cage: working grid");
   Cage cage;
   const cage::CageField field = cage::makeCageField(parts, options, cage.report.bodyVoxels);
@@ -69,12 +74,14 @@ Cage buildCage(const Volume& parts, const CageOptions& options) {
   const double freezeRadius = 3 * w;
   for (int round = 0; round < 6; ++round) {
     std::vector<Eigen::Vector3d> sites;
-    for (cage::Simplification policy : {cage::Simplification::GarlandHeckbert, cage::Simplification::LindstromTurk}) {
+    for (cage::Simplification policy :
+         {cage::Simplification::GarlandHeckbert, cage::Simplification::LindstromTurk}) {
       cage.mesh = cage::simplifyMesh(dense, options.targetVertices, policy, frozen);
       checks = cage::checkAndOrient(cage.mesh);
       cage.report.simplification = cage::simplificationName(policy);
       if (checks.closed && checks.manifold && checks.outward && checks.selfIntersectionFree) break;
-      if (sites.empty() && checks.closed && checks.manifold) sites = cage::selfIntersectionSites(cage.mesh);
+      if (sites.empty() && checks.closed && checks.manifold)
+        sites = cage::selfIntersectionSites(cage.mesh);
     }
     if (checks.selfIntersectionFree || sites.empty()) break;
     for (Eigen::Index v = 0; v < dense.vertices.rows(); ++v)
@@ -98,7 +105,8 @@ Cage buildCage(const Volume& parts, const CageOptions& options) {
   }
 
   reportProgress(options.progress, 0.9, "cage: enclosed body");
-  const std::vector<std::int8_t> wn = windingNumbersOnGrid(cage.mesh, parts.geometry(), options.threads);
+  const std::vector<std::int8_t> wn =
+      windingNumbersOnGrid(cage.mesh, parts.geometry(), options.threads);
   for (std::int64_t n = 0; n < parts.numVoxels(); ++n)
     if (wn[n] >= 1 && parts.valueAsDouble(n) != 0) ++cage.report.enclosedVoxels;
   reportProgress(options.progress, 1.0, "cage");

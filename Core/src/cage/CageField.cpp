@@ -13,7 +13,9 @@
 namespace repose::cage {
 namespace {
 
-int readLabel(const Volume& v, std::int64_t index) { return static_cast<int>(v.valueAsDouble(index)); }
+int readLabel(const Volume& v, std::int64_t index) {
+  return static_cast<int>(v.valueAsDouble(index));
+}
 
 struct Masks {
   std::vector<std::uint8_t> body;
@@ -43,8 +45,10 @@ double CageField::at(const Eigen::Vector3d& gridMm) const {
 }
 
 CageField makeCageField(const Volume& parts, const CageOptions& options, std::int64_t& bodyVoxels) {
-  if (!isIntegerType(parts.scalarType())) throw Error("the cage needs a label map (integer voxels), not float32");
-  if (options.dilateMm < 0 || !std::isfinite(options.dilateMm)) throw Error("dilation must be >= 0 mm");
+  if (!isIntegerType(parts.scalarType()))
+    throw Error("the cage needs a label map (integer voxels), not float32");
+  if (options.dilateMm < 0 || !std::isfinite(options.dilateMm))
+    throw Error("dilation must be >= 0 mm");
   const VolumeGeometry& in = parts.geometry();
   const Eigen::Vector3d inSpacing = in.spacing();
   const auto& dims = in.dims;
@@ -56,18 +60,23 @@ CageField makeCageField(const Volume& parts, const CageOptions& options, std::in
     const int l = readLabel(parts, n);
     if (l != 0) ++bodyVoxels, present.insert(l);
   }
-  if (bodyVoxels == 0) throw Error("the segmentation is empty: no voxel is non-zero, there is no body to cage");
+  if (bodyVoxels == 0)
+    throw Error("the segmentation is empty: no voxel is non-zero, there is no body to cage");
   for (const LimbSeparation& s : options.separations)
     for (int l : {s.labelA, s.labelB})
-      if (!present.count(l)) throw Error("separation label " + std::to_string(l) + " is not present in the segmentation");
+      if (!present.count(l))
+        throw Error("separation label " + std::to_string(l) +
+                    " is not present in the segmentation");
 
   // Working voxel: a coarse cage needs no finer grid than a fraction of the dilation; finer
   // grids make the restricted Delaunay refinement chase the voxel staircase (minutes, GBs).
   const double target = options.workingVoxelMm > 0 ? options.workingVoxelMm
                                                    : std::clamp(options.dilateMm / 2.5, 3.0, 8.0);
   std::array<std::int64_t, 3> factor;
-  for (int c = 0; c < 3; ++c) factor[c] = std::max<std::int64_t>(1, std::llround(std::floor(target / inSpacing[c] + 1e-9)));
-  const Eigen::Vector3d work(inSpacing[0] * factor[0], inSpacing[1] * factor[1], inSpacing[2] * factor[2]);
+  for (int c = 0; c < 3; ++c)
+    factor[c] = std::max<std::int64_t>(1, std::llround(std::floor(target / inSpacing[c] + 1e-9)));
+  const Eigen::Vector3d work(inSpacing[0] * factor[0], inSpacing[1] * factor[1],
+                             inSpacing[2] * factor[2]);
   const double margin = options.dilateMm + 3 * work.maxCoeff();
   std::array<std::int64_t, 3> pad, wd;
   for (int c = 0; c < 3; ++c) {
@@ -79,8 +88,10 @@ CageField makeCageField(const Volume& parts, const CageOptions& options, std::in
   VolumeGeometry g;
   g.dims = wd;
   g.ijkToRas = Eigen::Matrix4d::Identity();
-  g.ijkToRas.block<3, 3>(0, 0) = in.ijkToRas.block<3, 3>(0, 0) * Eigen::Vector3d(factor[0], factor[1], factor[2]).asDiagonal();
-  const Eigen::Vector3d startIndex(-pad[0] * factor[0] + (factor[0] - 1) / 2.0, -pad[1] * factor[1] + (factor[1] - 1) / 2.0,
+  g.ijkToRas.block<3, 3>(0, 0) =
+      in.ijkToRas.block<3, 3>(0, 0) * Eigen::Vector3d(factor[0], factor[1], factor[2]).asDiagonal();
+  const Eigen::Vector3d startIndex(-pad[0] * factor[0] + (factor[0] - 1) / 2.0,
+                                   -pad[1] * factor[1] + (factor[1] - 1) / 2.0,
                                    -pad[2] * factor[2] + (factor[2] - 1) / 2.0);
   g.ijkToRas.block<3, 1>(0, 3) = in.voxelToRas(startIndex.x(), startIndex.y(), startIndex.z());
 
@@ -94,8 +105,9 @@ CageField makeCageField(const Volume& parts, const CageOptions& options, std::in
       for (std::int64_t i = 0; i < dims[0]; ++i) {
         const int l = readLabel(parts, parts.index(i, j, k));
         if (!l) continue;
-        const std::size_t w = static_cast<std::size_t>((i / factor[0] + pad[0]) +
-                                                       wd[0] * ((j / factor[1] + pad[1]) + wd[1] * (k / factor[2] + pad[2])));
+        const std::size_t w = static_cast<std::size_t>(
+            (i / factor[0] + pad[0]) +
+            wd[0] * ((j / factor[1] + pad[1]) + wd[1] * (k / factor[2] + pad[2])));
         m.body[w] = 1;
         for (std::size_t s = 0; s < options.separations.size(); ++s) {
           if (l == options.separations[s].labelA) m.a[s][w] = 1;
@@ -137,16 +149,19 @@ CageField makeCageField(const Volume& parts, const CageOptions& options, std::in
           const double dA = std::sqrt(double(dA2[n])), dB = std::sqrt(double(dB2[n]));
           const double reach = options.dilateMm + 4 * halfGap;
           if (dA > reach || dB > reach) continue;
-          field.value[n] = std::max(field.value[n], static_cast<float>(halfGap - std::fabs(dA - dB) / 2));
+          field.value[n] =
+              std::max(field.value[n], static_cast<float>(halfGap - std::fabs(dA - dB) / 2));
         }
     if (selected == 0) {
       std::ostringstream msg;
-      msg << "separation region for labels " << sep.labelA << ":" << sep.labelB << " selects no voxel of the volume";
+      msg << "separation region for labels " << sep.labelA << ":" << sep.labelB
+          << " selects no voxel of the volume";
       throw Error(msg.str());
     }
   }
   // The mesher starts from a point strictly inside: the lowest value after the inset.
-  deepestAt = static_cast<std::size_t>(std::min_element(field.value.begin(), field.value.end()) - field.value.begin());
+  deepestAt = static_cast<std::size_t>(std::min_element(field.value.begin(), field.value.end()) -
+                                       field.value.begin());
   const std::int64_t di = static_cast<std::int64_t>(deepestAt % wd[0]);
   const std::int64_t dj = static_cast<std::int64_t>((deepestAt / wd[0]) % wd[1]);
   const std::int64_t dk = static_cast<std::int64_t>(deepestAt / (wd[0] * wd[1]));

@@ -38,10 +38,12 @@ Mesh toCgal(const TriangleMesh& m) {
   std::vector<Mesh::Vertex_index> v;
   v.reserve(m.vertices.rows());
   for (Eigen::Index i = 0; i < m.vertices.rows(); ++i)
-    v.push_back(out.add_vertex(Kernel::Point_3(m.vertices(i, 0), m.vertices(i, 1), m.vertices(i, 2))));
+    v.push_back(
+        out.add_vertex(Kernel::Point_3(m.vertices(i, 0), m.vertices(i, 1), m.vertices(i, 2))));
   for (Eigen::Index f = 0; f < m.faces.rows(); ++f)
     if (out.add_face(v[m.faces(f, 0)], v[m.faces(f, 1)], v[m.faces(f, 2)]) == Mesh::null_face())
-      throw Error("cage: the surface is not a manifold triangle mesh (face " + std::to_string(f) + ")");
+      throw Error("cage: the surface is not a manifold triangle mesh (face " + std::to_string(f) +
+                  ")");
   return out;
 }
 
@@ -59,7 +61,8 @@ TriangleMesh fromCgal(const Mesh& m) {
   int f = 0;
   for (Mesh::Face_index face : m.faces()) {
     int c = 0;
-    for (Mesh::Vertex_index v : CGAL::vertices_around_face(m.halfedge(face), m)) out.faces(f, c++) = index[v];
+    for (Mesh::Vertex_index v : CGAL::vertices_around_face(m.halfedge(face), m))
+      out.faces(f, c++) = index[v];
     ++f;
   }
   return out;
@@ -69,12 +72,15 @@ TriangleMesh fromCgal(const Mesh& m) {
 struct FieldFunction {
   using GT = CGAL::Surface_mesh_default_triangulation_3::Geom_traits;
   const CageField* field;
-  GT::FT operator()(const GT::Point_3& p) const { return field->at(Eigen::Vector3d(p.x(), p.y(), p.z())); }
+  GT::FT operator()(const GT::Point_3& p) const {
+    return field->at(Eigen::Vector3d(p.x(), p.y(), p.z()));
+  }
 };
 
 }  // namespace
 
-TriangleMesh meshZeroLevelSet(const CageField& field, double facetRadiusMm, double approximationMm) {
+TriangleMesh meshZeroLevelSet(const CageField& field, double facetRadiusMm,
+                              double approximationMm) {
   using Tr = CGAL::Surface_mesh_default_triangulation_3;
   using C2t3 = CGAL::Complex_2_in_triangulation_3<Tr>;
   using GT = Tr::Geom_traits;
@@ -87,7 +93,8 @@ TriangleMesh meshZeroLevelSet(const CageField& field, double facetRadiusMm, doub
                                  (field.grid.dims[2] - 1) * Eigen::Vector3d(0, 0, s[2]);
   double r2 = 0;
   for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d c((corner & 1) ? extent[0] : 0, (corner & 2) ? extent[1] : 0, (corner & 4) ? extent[2] : 0);
+    const Eigen::Vector3d c((corner & 1) ? extent[0] : 0, (corner & 2) ? extent[1] : 0,
+                            (corner & 4) ? extent[2] : 0);
     r2 = std::max(r2, (c - inside).squaredNorm());
   }
   // The mesher draws its initial points from CGAL's default generator, seeded from the clock:
@@ -95,7 +102,8 @@ TriangleMesh meshZeroLevelSet(const CageField& field, double facetRadiusMm, doub
   CGAL::get_default_random() = CGAL::Random(0);
   Tr tr;
   C2t3 c2t3(tr);
-  Surface surface(FieldFunction{&field}, GT::Sphere_3(GT::Point_3(inside.x(), inside.y(), inside.z()), r2), 1e-6);
+  Surface surface(FieldFunction{&field},
+                  GT::Sphere_3(GT::Point_3(inside.x(), inside.y(), inside.z()), r2), 1e-6);
   CGAL::Surface_mesh_default_criteria_3<Tr> criteria(30.0, facetRadiusMm, approximationMm);
   CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag(), 40);
   Mesh mesh;
@@ -134,11 +142,13 @@ TriangleMesh simplifyMesh(const TriangleMesh& input, int targetVertices, Simplif
                            .filter(SMS::Bounded_normal_change_filter<>())
                            .edge_is_constrained_map(constrained));
   } else {
-    SMS::edge_collapse(mesh, stop,
-                       CGAL::parameters::get_cost(SMS::LindstromTurk_cost<Mesh>())
-                           .get_placement(SMS::Bounded_normal_change_placement<SMS::LindstromTurk_placement<Mesh>>())
-                           .filter(SMS::Bounded_normal_change_filter<>())
-                           .edge_is_constrained_map(constrained));
+    SMS::edge_collapse(
+        mesh, stop,
+        CGAL::parameters::get_cost(SMS::LindstromTurk_cost<Mesh>())
+            .get_placement(
+                SMS::Bounded_normal_change_placement<SMS::LindstromTurk_placement<Mesh>>())
+            .filter(SMS::Bounded_normal_change_filter<>())
+            .edge_is_constrained_map(constrained));
   }
   mesh.collect_garbage();
   return fromCgal(mesh);

@@ -15,7 +15,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double sign(double x) { return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0); }
+double sign(double x) {
+  return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0);
+}
 
 // Cosine of the angle between a and b (1 when either is zero, i.e. the angle is taken as 0).
 double cosAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
@@ -38,11 +40,14 @@ double gcTriInt(const Eigen::Vector3d& p, const Eigen::Vector3d& v1, const Eigen
     double logTerm = 0;
     // lambda -> 0 (eta on the edge's line) makes sqrt(lambda)*log(...) -> 0.
     if (sqrtL > 1e-12 && denom > 1e-300) {
-      const double arg = 2 * sqrtL * S * S / denom *
-                         (1 - 2 * c * C / (c * (1 + C) + lambda + std::sqrt(lambda * lambda + lambda * c * S * S)));
+      const double arg =
+          2 * sqrtL * S * S / denom *
+          (1 -
+           2 * c * C / (c * (1 + C) + lambda + std::sqrt(lambda * lambda + lambda * c * S * S)));
       if (arg > 0) logTerm = sqrtL * std::log(arg);
     }
-    const double atanTerm = sqrtC > 0 ? 2 * sqrtC * std::atan(sqrtC * C / std::sqrt(lambda + S * S * c)) : 0;
+    const double atanTerm =
+        sqrtC > 0 ? 2 * sqrtC * std::atan(sqrtC * C / std::sqrt(lambda + S * S * c)) : 0;
     return -sign(S) / 2 * (atanTerm + logTerm);
   };
   // theta1 = pi - alpha; theta2 = pi - (alpha + beta).
@@ -91,64 +96,72 @@ Eigen::MatrixX3d faceNormals(const Eigen::MatrixX3d& vertices, const Eigen::Matr
 GreenCoordinates computeGreenCoordinates(const TriangleMesh& cage, const Eigen::MatrixX3d& points,
                                          int threads) {
   const Eigen::Index nv = cage.vertices.rows(), nf = cage.faces.rows();
-  if (nv < 4 || nf < 4) throw Error("Green coordinates need a closed cage (at least a tetrahedron)");
+  if (nv < 4 || nf < 4)
+    throw Error("Green coordinates need a closed cage (at least a tetrahedron)");
   const Eigen::MatrixX3d normals = faceNormals(cage.vertices, cage.faces);
   // The closed forms divide tiny by tiny for points within ~1e-6 of a face's plane. Such points
   // are evaluated a little inside instead, which bounds the error by that offset.
-  const double size = (cage.vertices.colwise().maxCoeff() - cage.vertices.colwise().minCoeff()).norm();
+  const double size =
+      (cage.vertices.colwise().maxCoeff() - cage.vertices.colwise().minCoeff()).norm();
   const double nearSurface = 1e-5 * size;
   GreenCoordinates gc;
   gc.phi.setZero(points.rows(), nv);
   gc.psi.setZero(points.rows(), nf);
-  parallelFor(points.rows(), threads, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t r = begin; r < end; ++r) {
-      Eigen::Vector3d eta = points.row(r);
-      // Near an edge or a corner one push leaves the point close to the other faces: repeat.
-      for (int push = 0; push < 8; ++push) {
-        double closest = std::numeric_limits<double>::max();
-        Eigen::Index closestFace = -1;
-        for (Eigen::Index f = 0; f < nf; ++f) {
-          // The distance to a triangle is at least the distance to its plane: most faces stop here.
-          const double plane = std::fabs(normals.row(f).dot(eta - cage.vertices.row(cage.faces(f, 0)).transpose()));
-          if (plane >= std::min(closest, nearSurface)) continue;
-          const double d = pointTriangleDistance(eta, cage.vertices.row(cage.faces(f, 0)),
-                                                 cage.vertices.row(cage.faces(f, 1)),
-                                                 cage.vertices.row(cage.faces(f, 2)));
-          if (d < closest) closest = d, closestFace = f;
-        }
-        if (closest >= nearSurface) break;
-        eta -= 2 * nearSurface * normals.row(closestFace).transpose();
-      }
-      for (Eigen::Index f = 0; f < nf; ++f) {
-        const Eigen::Vector3d n = normals.row(f);
-        Eigen::Vector3d v[3];
-        for (int l = 0; l < 3; ++l) v[l] = cage.vertices.row(cage.faces(f, l)).transpose() - eta;
-        const Eigen::Vector3d p = v[0].dot(n) * n;
-        double s[3], I[3], II[3];
-        Eigen::Vector3d N[3];
-        for (int l = 0; l < 3; ++l) {
-          const Eigen::Vector3d& a = v[l];
-          const Eigen::Vector3d& b = v[(l + 1) % 3];
-          s[l] = sign((a - p).cross(b - p).dot(n));
-          I[l] = gcTriInt(p, a, b);
-          II[l] = gcTriInt(Eigen::Vector3d::Zero(), b, a);
-          const Eigen::Vector3d q = b.cross(a);
-          const double qn = q.norm();
-          N[l] = qn > 0 ? Eigen::Vector3d(q / qn) : Eigen::Vector3d::Zero();
-        }
-        const double Itotal = -std::fabs(s[0] * I[0] + s[1] * I[1] + s[2] * I[2]);
-        gc.psi(r, f) = -Itotal;
-        const Eigen::Vector3d w = n * Itotal + N[0] * II[0] + N[1] * II[1] + N[2] * II[2];
-        if (w.norm() > 1e-12) {
-          for (int l = 0; l < 3; ++l) {
-            const Eigen::Vector3d& Nn = N[(l + 1) % 3];
-            const double d = Nn.dot(v[l]);
-            if (std::fabs(d) > 1e-300) gc.phi(r, cage.faces(f, l)) += Nn.dot(w) / d;
+  parallelFor(
+      points.rows(), threads,
+      [&](std::int64_t begin, std::int64_t end) {
+        for (std::int64_t r = begin; r < end; ++r) {
+          Eigen::Vector3d eta = points.row(r);
+          // Near an edge or a corner one push leaves the point close to the other faces: repeat.
+          for (int push = 0; push < 8; ++push) {
+            double closest = std::numeric_limits<double>::max();
+            Eigen::Index closestFace = -1;
+            for (Eigen::Index f = 0; f < nf; ++f) {
+              // The distance to a triangle is at least the distance to its plane: most faces stop
+              // here.
+              const double plane = std::fabs(
+                  normals.row(f).dot(eta - cage.vertices.row(cage.faces(f, 0)).transpose()));
+              if (plane >= std::min(closest, nearSurface)) continue;
+              const double d = pointTriangleDistance(eta, cage.vertices.row(cage.faces(f, 0)),
+                                                     cage.vertices.row(cage.faces(f, 1)),
+                                                     cage.vertices.row(cage.faces(f, 2)));
+              if (d < closest) closest = d, closestFace = f;
+            }
+            if (closest >= nearSurface) break;
+            eta -= 2 * nearSurface * normals.row(closestFace).transpose();
+          }
+          for (Eigen::Index f = 0; f < nf; ++f) {
+            const Eigen::Vector3d n = normals.row(f);
+            Eigen::Vector3d v[3];
+            for (int l = 0; l < 3; ++l)
+              v[l] = cage.vertices.row(cage.faces(f, l)).transpose() - eta;
+            const Eigen::Vector3d p = v[0].dot(n) * n;
+            double s[3], I[3], II[3];
+            Eigen::Vector3d N[3];
+            for (int l = 0; l < 3; ++l) {
+              const Eigen::Vector3d& a = v[l];
+              const Eigen::Vector3d& b = v[(l + 1) % 3];
+              s[l] = sign((a - p).cross(b - p).dot(n));
+              I[l] = gcTriInt(p, a, b);
+              II[l] = gcTriInt(Eigen::Vector3d::Zero(), b, a);
+              const Eigen::Vector3d q = b.cross(a);
+              const double qn = q.norm();
+              N[l] = qn > 0 ? Eigen::Vector3d(q / qn) : Eigen::Vector3d::Zero();
+            }
+            const double Itotal = -std::fabs(s[0] * I[0] + s[1] * I[1] + s[2] * I[2]);
+            gc.psi(r, f) = -Itotal;
+            const Eigen::Vector3d w = n * Itotal + N[0] * II[0] + N[1] * II[1] + N[2] * II[2];
+            if (w.norm() > 1e-12) {
+              for (int l = 0; l < 3; ++l) {
+                const Eigen::Vector3d& Nn = N[(l + 1) % 3];
+                const double d = Nn.dot(v[l]);
+                if (std::fabs(d) > 1e-300) gc.phi(r, cage.faces(f, l)) += Nn.dot(w) / d;
+              }
+            }
           }
         }
-      }
-    }
-  }, 16);
+      },
+      16);
   return gc;
 }
 

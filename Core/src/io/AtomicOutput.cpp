@@ -27,8 +27,8 @@ AtomicOutput::AtomicOutput(const std::string& finalPath) : finalPath_(finalPath)
   std::vector<char> buf(pattern.begin(), pattern.end());
   buf.push_back('\0');
   if (!::mkdtemp(buf.data()))
-    throwFileError(finalPath, std::string("cannot write in the output folder: ") +
-                                  std::strerror(errno));
+    throwFileError(finalPath,
+                   std::string("cannot write in the output folder: ") + std::strerror(errno));
   tempDir_ = buf.data();
   tempPath_ = (fs::path(tempDir_) / target.filename()).string();
 }

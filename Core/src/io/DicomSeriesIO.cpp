@@ -69,15 +69,32 @@ void readPixels(const std::string& file, std::int64_t columns, std::int64_t rows
     for (std::size_t i = 0; i < n; ++i) out[i] = typed[i] * slope + intercept;
   };
   switch (pf.GetScalarType()) {
-    case gdcm::PixelFormat::UINT8: convert(reinterpret_cast<const std::uint8_t*>(buffer.data())); break;
-    case gdcm::PixelFormat::INT8: convert(reinterpret_cast<const std::int8_t*>(buffer.data())); break;
-    case gdcm::PixelFormat::UINT16: convert(reinterpret_cast<const std::uint16_t*>(buffer.data())); break;
-    case gdcm::PixelFormat::INT16: convert(reinterpret_cast<const std::int16_t*>(buffer.data())); break;
-    case gdcm::PixelFormat::UINT32: convert(reinterpret_cast<const std::uint32_t*>(buffer.data())); break;
-    case gdcm::PixelFormat::INT32: convert(reinterpret_cast<const std::int32_t*>(buffer.data())); break;
-    case gdcm::PixelFormat::FLOAT32: convert(reinterpret_cast<const float*>(buffer.data())); break;
-    case gdcm::PixelFormat::FLOAT64: convert(reinterpret_cast<const double*>(buffer.data())); break;
-    default: throwFileError(file, std::string("unsupported pixel format ") + pf.GetScalarTypeAsString());
+    case gdcm::PixelFormat::UINT8:
+      convert(reinterpret_cast<const std::uint8_t*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::INT8:
+      convert(reinterpret_cast<const std::int8_t*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::UINT16:
+      convert(reinterpret_cast<const std::uint16_t*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::INT16:
+      convert(reinterpret_cast<const std::int16_t*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::UINT32:
+      convert(reinterpret_cast<const std::uint32_t*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::INT32:
+      convert(reinterpret_cast<const std::int32_t*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::FLOAT32:
+      convert(reinterpret_cast<const float*>(buffer.data()));
+      break;
+    case gdcm::PixelFormat::FLOAT64:
+      convert(reinterpret_cast<const double*>(buffer.data()));
+      break;
+    default:
+      throwFileError(file, std::string("unsupported pixel format ") + pf.GetScalarTypeAsString());
   }
 }
 
@@ -129,14 +146,16 @@ Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
     const std::vector<double> p = parseNumbers(scanner.GetValue(f.c_str(), kPosition));
     const std::vector<double> o = parseNumbers(scanner.GetValue(f.c_str(), kOrientation));
     if (p.size() != 3) throwFileError(f, "malformed ImagePositionPatient");
-    if (o.size() != 6 || Eigen::Map<const Eigen::Matrix<double, 6, 1>>(o.data())
-                                 .isApprox(Eigen::Map<const Eigen::Matrix<double, 6, 1>>(iop.data()), 1e-4) == false)
+    if (o.size() != 6 ||
+        Eigen::Map<const Eigen::Matrix<double, 6, 1>>(o.data()).isApprox(
+            Eigen::Map<const Eigen::Matrix<double, 6, 1>>(iop.data()), 1e-4) == false)
       throwFileError(f, "slice orientation differs from the rest of the series");
     Slice s{f, Eigen::Vector3d(p[0], p[1], p[2]), 0};
     s.along = s.position.dot(normal);
     slices.push_back(s);
   }
-  std::sort(slices.begin(), slices.end(), [](const Slice& a, const Slice& b) { return a.along < b.along; });
+  std::sort(slices.begin(), slices.end(),
+            [](const Slice& a, const Slice& b) { return a.along < b.along; });
   for (std::size_t s = 1; s < slices.size(); ++s)
     if (std::fabs(slices[s].along - slices[s - 1].along) < 1e-4)
       throwFileError(slices[s].file, "two slices at the same position (" +

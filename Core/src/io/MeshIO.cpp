@@ -15,7 +15,8 @@ namespace repose {
 namespace {
 
 bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 TriangleMesh assemble(const std::vector<Eigen::Vector3d>& v, const std::vector<Eigen::Vector3i>& f,
@@ -44,17 +45,21 @@ TriangleMesh readObj(const std::string& path, std::istream& in) {
     s >> tag;
     if (tag == "v") {
       Eigen::Vector3d p;
-      if (!(s >> p.x() >> p.y() >> p.z())) throwFileError(path, "line " + std::to_string(number) + ": bad vertex");
+      if (!(s >> p.x() >> p.y() >> p.z()))
+        throwFileError(path, "line " + std::to_string(number) + ": bad vertex");
       v.push_back(p);
     } else if (tag == "f") {
       std::vector<int> idx;
       std::string item;
       while (s >> item) {
         const int i = std::atoi(item.c_str());  // "7", "7/1", "7//3": the vertex index comes first
-        if (i == 0) throwFileError(path, "line " + std::to_string(number) + ": bad face index '" + item + "'");
+        if (i == 0)
+          throwFileError(path,
+                         "line " + std::to_string(number) + ": bad face index '" + item + "'");
         idx.push_back(i > 0 ? i - 1 : static_cast<int>(v.size()) + i);
       }
-      if (idx.size() < 3) throwFileError(path, "line " + std::to_string(number) + ": a face needs 3 vertices");
+      if (idx.size() < 3)
+        throwFileError(path, "line " + std::to_string(number) + ": a face needs 3 vertices");
       for (std::size_t k = 1; k + 1 < idx.size(); ++k) f.emplace_back(idx[0], idx[k], idx[k + 1]);
     }
   }
@@ -68,7 +73,8 @@ TriangleMesh readVtk(const std::string& path, std::istream& in) {
   bool ascii = false;
   while (in >> word) {
     if (word == "ASCII") ascii = true;
-    if (word == "BINARY") throwFileError(path, "binary legacy VTK is not supported; save as ASCII or OBJ");
+    if (word == "BINARY")
+      throwFileError(path, "binary legacy VTK is not supported; save as ASCII or OBJ");
     if (word == "POINTS") {
       std::size_t n;
       std::string type;
@@ -106,17 +112,22 @@ void writeTriangleMesh(const TriangleMesh& mesh, const std::string& path) {
     if (obj) {
       out << "# Repose cage, RAS millimetres, outward faces\n";
       for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i)
-        out << "v " << mesh.vertices(i, 0) << " " << mesh.vertices(i, 1) << " " << mesh.vertices(i, 2) << "\n";
+        out << "v " << mesh.vertices(i, 0) << " " << mesh.vertices(i, 1) << " "
+            << mesh.vertices(i, 2) << "\n";
       for (Eigen::Index i = 0; i < mesh.faces.rows(); ++i)
-        out << "f " << mesh.faces(i, 0) + 1 << " " << mesh.faces(i, 1) + 1 << " " << mesh.faces(i, 2) + 1 << "\n";
+        out << "f " << mesh.faces(i, 0) + 1 << " " << mesh.faces(i, 1) + 1 << " "
+            << mesh.faces(i, 2) + 1 << "\n";
     } else {
-      out << "# vtk DataFile Version 3.0\nRepose cage, SPACE=RAS, millimetres\nASCII\nDATASET POLYDATA\n";
+      out << "# vtk DataFile Version 3.0\nRepose cage, SPACE=RAS, millimetres\nASCII\nDATASET "
+             "POLYDATA\n";
       out << "POINTS " << mesh.vertices.rows() << " double\n";
       for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i)
-        out << mesh.vertices(i, 0) << " " << mesh.vertices(i, 1) << " " << mesh.vertices(i, 2) << "\n";
+        out << mesh.vertices(i, 0) << " " << mesh.vertices(i, 1) << " " << mesh.vertices(i, 2)
+            << "\n";
       out << "POLYGONS " << mesh.faces.rows() << " " << 4 * mesh.faces.rows() << "\n";
       for (Eigen::Index i = 0; i < mesh.faces.rows(); ++i)
-        out << "3 " << mesh.faces(i, 0) << " " << mesh.faces(i, 1) << " " << mesh.faces(i, 2) << "\n";
+        out << "3 " << mesh.faces(i, 0) << " " << mesh.faces(i, 1) << " " << mesh.faces(i, 2)
+            << "\n";
     }
     if (!out.flush()) throwFileError(path, "write failed (disk full?)");
   }

@@ -29,31 +29,59 @@ using NiftiPtr = std::unique_ptr<nifti_image, NiftiImageDeleter>;
 constexpr int kIntentLabel = 1002;  // NIFTI_INTENT_LABEL
 
 // niftilib prints its own diagnostics at debug level >= 1; we report one line ourselves.
-void quietNiftilib() { nifti_set_debug_level(getenv("REPOSE_NIFTI_DEBUG") ? 3 : 0); }
+void quietNiftilib() {
+  nifti_set_debug_level(getenv("REPOSE_NIFTI_DEBUG") ? 3 : 0);
+}
 
 bool diskTypeFromNifti(int datatype, io::DiskType& out) {
   switch (datatype) {
-    case DT_INT8: out = io::DiskType::Int8; return true;
-    case DT_UINT8: out = io::DiskType::UInt8; return true;
-    case DT_INT16: out = io::DiskType::Int16; return true;
-    case DT_UINT16: out = io::DiskType::UInt16; return true;
-    case DT_INT32: out = io::DiskType::Int32; return true;
-    case DT_UINT32: out = io::DiskType::UInt32; return true;
-    case DT_INT64: out = io::DiskType::Int64; return true;
-    case DT_UINT64: out = io::DiskType::UInt64; return true;
-    case DT_FLOAT32: out = io::DiskType::Float32; return true;
-    case DT_FLOAT64: out = io::DiskType::Float64; return true;
-    default: return false;
+    case DT_INT8:
+      out = io::DiskType::Int8;
+      return true;
+    case DT_UINT8:
+      out = io::DiskType::UInt8;
+      return true;
+    case DT_INT16:
+      out = io::DiskType::Int16;
+      return true;
+    case DT_UINT16:
+      out = io::DiskType::UInt16;
+      return true;
+    case DT_INT32:
+      out = io::DiskType::Int32;
+      return true;
+    case DT_UINT32:
+      out = io::DiskType::UInt32;
+      return true;
+    case DT_INT64:
+      out = io::DiskType::Int64;
+      return true;
+    case DT_UINT64:
+      out = io::DiskType::UInt64;
+      return true;
+    case DT_FLOAT32:
+      out = io::DiskType::Float32;
+      return true;
+    case DT_FLOAT64:
+      out = io::DiskType::Float64;
+      return true;
+    default:
+      return false;
   }
 }
 
 int niftiTypeFor(ScalarType t) {
   switch (t) {
-    case ScalarType::UInt8: return DT_UINT8;
-    case ScalarType::UInt16: return DT_UINT16;
-    case ScalarType::Int16: return DT_INT16;
-    case ScalarType::Int32: return DT_INT32;
-    case ScalarType::Float32: return DT_FLOAT32;
+    case ScalarType::UInt8:
+      return DT_UINT8;
+    case ScalarType::UInt16:
+      return DT_UINT16;
+    case ScalarType::Int16:
+      return DT_INT16;
+    case ScalarType::Int32:
+      return DT_INT32;
+    case ScalarType::Float32:
+      return DT_FLOAT32;
   }
   return DT_UINT8;
 }
@@ -120,7 +148,8 @@ NiftiPtr readHeader(const std::string& path, const std::string& libraryPath) {
   io::requireReadableFile(path);
   quietNiftilib();
   NiftiPtr nim(nifti_image_read(libraryPath.c_str(), 0));
-  if (!nim) throwFileError(path, "not a readable NIfTI file (header missing, truncated or corrupt)");
+  if (!nim)
+    throwFileError(path, "not a readable NIfTI file (header missing, truncated or corrupt)");
   if (nim->nifti_type == NIFTI_FTYPE_ANALYZE)
     throwFileError(path, "is an ANALYZE 7.5 file without orientation; convert it to NIfTI");
   for (int d = 4; d <= 7; ++d)
@@ -138,8 +167,8 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
   NiftiPtr nim = readHeader(path, alias.path());
   io::DiskType diskType;
   if (!diskTypeFromNifti(nim->datatype, diskType))
-    throwFileError(path, std::string("unsupported voxel type ") +
-                             nifti_datatype_to_string(nim->datatype));
+    throwFileError(
+        path, std::string("unsupported voxel type ") + nifti_datatype_to_string(nim->datatype));
   if (static_cast<std::size_t>(nim->nbyper) != io::diskTypeSize(diskType))
     throwFileError(path, "inconsistent bytes per voxel in header");
   const VolumeGeometry geometry = geometryOf(*nim, path);
@@ -160,8 +189,8 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
   const ScalarType memType = scaled ? ScalarType::Float32 : io::memoryTypeFor(diskType);
   Volume volume(geometry, memType);
   const bool direct = !scaled && scalarSize(memType) == io::diskTypeSize(diskType) &&
-                      io::memoryTypeFor(diskType) == memType &&
-                      diskType != io::DiskType::UInt32 && diskType != io::DiskType::Int8;
+                      io::memoryTypeFor(diskType) == memType && diskType != io::DiskType::UInt32 &&
+                      diskType != io::DiskType::Int8;
   // niftilib loads into nim->data when it is already allocated: read straight into our buffer.
   std::vector<std::uint8_t> staging;
   if (direct) {
@@ -210,7 +239,8 @@ NiftiPtr makeHeader(const std::string& tempPath, const VolumeGeometry& geometry,
     throw Error("NIfTI version must be 1 or 2, not " + std::to_string(niftiVersion));
   for (auto d : geometry.dims)
     if (d > 32767) niftiVersion = 2;  // NIfTI-1 stores dims as 16-bit
-  const std::int64_t dims[8] = {3, geometry.dims[0], geometry.dims[1], geometry.dims[2], 1, 1, 1, 1};
+  const std::int64_t dims[8] = {3, geometry.dims[0], geometry.dims[1], geometry.dims[2], 1, 1, 1,
+                                1};
   NiftiPtr nim(nifti_make_new_nim(dims, niftiTypeFor(type), 0));
   if (!nim) throw Error(tempPath + ": cannot create a NIfTI header");
   const Eigen::Vector3d spacing = geometry.spacing();
@@ -226,9 +256,9 @@ NiftiPtr makeHeader(const std::string& tempPath, const VolumeGeometry& geometry,
   nifti_dmat44_to_quatern(nim->sto_xyz, &nim->quatern_b, &nim->quatern_c, &nim->quatern_d,
                           &nim->qoffset_x, &nim->qoffset_y, &nim->qoffset_z, nullptr, nullptr,
                           nullptr, &nim->qfac);
-  nim->qto_xyz = nifti_quatern_to_dmat44(nim->quatern_b, nim->quatern_c, nim->quatern_d,
-                                         nim->qoffset_x, nim->qoffset_y, nim->qoffset_z,
-                                         nim->dx, nim->dy, nim->dz, nim->qfac);
+  nim->qto_xyz =
+      nifti_quatern_to_dmat44(nim->quatern_b, nim->quatern_c, nim->quatern_d, nim->qoffset_x,
+                              nim->qoffset_y, nim->qoffset_z, nim->dx, nim->dy, nim->dz, nim->qfac);
   nim->qto_ijk = nifti_dmat44_inverse(nim->qto_xyz);
   if (labelMap) {
     nim->intent_code = kIntentLabel;
@@ -272,7 +302,8 @@ std::vector<char> headerBytes(const nifti_image& nim) {
   for (int e = 0; e < nim.num_ext; ++e) {
     const nifti1_extension& ext = nim.ext_list[e];
     const std::int32_t head[2] = {ext.esize, ext.ecode};
-    bytes.insert(bytes.end(), reinterpret_cast<const char*>(head), reinterpret_cast<const char*>(head) + 8);
+    bytes.insert(bytes.end(), reinterpret_cast<const char*>(head),
+                 reinterpret_cast<const char*>(head) + 8);
     const std::size_t start = bytes.size();
     bytes.resize(start + ext.esize - 8, 0);
     std::memcpy(&bytes[start], ext.edata, ext.esize - 8);
@@ -301,7 +332,8 @@ NiftiSlabWriter::NiftiSlabWriter(const std::string& path, const VolumeGeometry& 
   geometry.validate(path);
   const std::string& temp = impl_->output.tempPath();
   impl_->nim = makeHeader(temp, geometry, type, labels, labelMap, niftiVersion);
-  impl_->sliceBytes = geometry.dims[0] * geometry.dims[1] * static_cast<std::int64_t>(scalarSize(type));
+  impl_->sliceBytes =
+      geometry.dims[0] * geometry.dims[1] * static_cast<std::int64_t>(scalarSize(type));
   impl_->slicesTotal = geometry.dims[2];
   const bool gz = temp.size() > 3 && temp.compare(temp.size() - 3, 3, ".gz") == 0;
   // Level 1: label maps compress nearly as well as at level 6, several times faster.
@@ -352,7 +384,8 @@ void writeNifti(const Volume& volume, const std::string& path, const WriteOption
   const std::int64_t sliceBytes = volume.dims()[0] * volume.dims()[1] *
                                   static_cast<std::int64_t>(scalarSize(volume.scalarType()));
   const auto* bytes = static_cast<const std::uint8_t*>(volume.layerData(0));
-  const std::int64_t step = std::max<std::int64_t>(1, (64 << 20) / std::max<std::int64_t>(1, sliceBytes));
+  const std::int64_t step =
+      std::max<std::int64_t>(1, (64 << 20) / std::max<std::int64_t>(1, sliceBytes));
   for (std::int64_t k = 0; k < slices; k += step) {
     const std::int64_t n = std::min(step, slices - k);
     writer.writeSlices(bytes + k * sliceBytes, n);

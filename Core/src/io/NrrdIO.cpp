@@ -46,27 +46,53 @@ std::string takeBiffMessage() {
 
 bool diskTypeFromNrrd(int type, io::DiskType& out) {
   switch (type) {
-    case nrrdTypeChar: out = io::DiskType::Int8; return true;
-    case nrrdTypeUChar: out = io::DiskType::UInt8; return true;
-    case nrrdTypeShort: out = io::DiskType::Int16; return true;
-    case nrrdTypeUShort: out = io::DiskType::UInt16; return true;
-    case nrrdTypeInt: out = io::DiskType::Int32; return true;
-    case nrrdTypeUInt: out = io::DiskType::UInt32; return true;
-    case nrrdTypeLLong: out = io::DiskType::Int64; return true;
-    case nrrdTypeULLong: out = io::DiskType::UInt64; return true;
-    case nrrdTypeFloat: out = io::DiskType::Float32; return true;
-    case nrrdTypeDouble: out = io::DiskType::Float64; return true;
-    default: return false;
+    case nrrdTypeChar:
+      out = io::DiskType::Int8;
+      return true;
+    case nrrdTypeUChar:
+      out = io::DiskType::UInt8;
+      return true;
+    case nrrdTypeShort:
+      out = io::DiskType::Int16;
+      return true;
+    case nrrdTypeUShort:
+      out = io::DiskType::UInt16;
+      return true;
+    case nrrdTypeInt:
+      out = io::DiskType::Int32;
+      return true;
+    case nrrdTypeUInt:
+      out = io::DiskType::UInt32;
+      return true;
+    case nrrdTypeLLong:
+      out = io::DiskType::Int64;
+      return true;
+    case nrrdTypeULLong:
+      out = io::DiskType::UInt64;
+      return true;
+    case nrrdTypeFloat:
+      out = io::DiskType::Float32;
+      return true;
+    case nrrdTypeDouble:
+      out = io::DiskType::Float64;
+      return true;
+    default:
+      return false;
   }
 }
 
 int nrrdTypeFor(ScalarType t) {
   switch (t) {
-    case ScalarType::UInt8: return nrrdTypeUChar;
-    case ScalarType::UInt16: return nrrdTypeUShort;
-    case ScalarType::Int16: return nrrdTypeShort;
-    case ScalarType::Int32: return nrrdTypeInt;
-    case ScalarType::Float32: return nrrdTypeFloat;
+    case ScalarType::UInt8:
+      return nrrdTypeUChar;
+    case ScalarType::UInt16:
+      return nrrdTypeUShort;
+    case ScalarType::Int16:
+      return nrrdTypeShort;
+    case ScalarType::Int32:
+      return nrrdTypeInt;
+    case ScalarType::Float32:
+      return nrrdTypeFloat;
   }
   return nrrdTypeUChar;
 }
@@ -93,7 +119,8 @@ Eigen::Matrix4d ijkToRasOf(const Nrrd& nrrd, const int axes[3], const std::strin
   for (int r = 0; r < 3; ++r) m(r, 3) = std::isnan(nrrd.spaceOrigin[r]) ? 0.0 : nrrd.spaceOrigin[r];
   switch (nrrd.space) {
     case nrrdSpaceRightAnteriorSuperior:
-    case nrrdSpaceRightAnteriorSuperiorTime: return m;
+    case nrrdSpaceRightAnteriorSuperiorTime:
+      return m;
     case nrrdSpaceLeftAnteriorSuperior:
     case nrrdSpaceLeftAnteriorSuperiorTime: {
       Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
@@ -106,8 +133,8 @@ Eigen::Matrix4d ijkToRasOf(const Nrrd& nrrd, const int axes[3], const std::strin
     case nrrdSpaceUnknown:     // "space dimension: 3" alone: LPS, like ITK
       return flipLpsRas(m);
     default:
-      throwFileError(path, std::string("unsupported NRRD space '") +
-                               airEnumStr(nrrdSpace, nrrd.space) + "'");
+      throwFileError(
+          path, std::string("unsupported NRRD space '") + airEnumStr(nrrdSpace, nrrd.space) + "'");
   }
 }
 
@@ -145,8 +172,7 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
   int layerAxis = -1;
   if (nrrd->dim == 3) {
     axes[0] = 0, axes[1] = 1, axes[2] = 2;
-  } else if (nrrd->dim == 4 && !hasDirection(nrrd->axis[0], nrrd->spaceDim) &&
-             nrrd->spaceDim > 0) {
+  } else if (nrrd->dim == 4 && !hasDirection(nrrd->axis[0], nrrd->spaceDim) && nrrd->spaceDim > 0) {
     layerAxis = 0;
     axes[0] = 1, axes[1] = 2, axes[2] = 3;
   } else if (nrrd->dim == 2) {
@@ -160,7 +186,8 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
       throwFileError(path, "axis " + std::to_string(axes[a]) + " has no space direction");
 
   VolumeGeometry geometry;
-  for (int a = 0; a < 3; ++a) geometry.dims[a] = static_cast<std::int64_t>(nrrd->axis[axes[a]].size);
+  for (int a = 0; a < 3; ++a)
+    geometry.dims[a] = static_cast<std::int64_t>(nrrd->axis[axes[a]].size);
   geometry.ijkToRas = ijkToRasOf(*nrrd, axes, path);
   geometry.validate(path);
   const int layers = layerAxis < 0 ? 1 : static_cast<int>(nrrd->axis[layerAxis].size);
@@ -202,7 +229,8 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
 namespace {
 
 bool endsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace
@@ -264,8 +292,8 @@ void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions
     for (const auto& [key, value] : segnrrd::formatSegments(volume))
       nrrdKeyValueAdd(nrrd.get(), key.c_str(), value.c_str());
 
-  nio->encoding = options.compress && nrrdEncodingGzip->available() ? nrrdEncodingGzip
-                                                                     : nrrdEncodingRaw;
+  nio->encoding =
+      options.compress && nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
   nio->zlibLevel = 1;  // label maps compress well even at the fastest level
   if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0)
     throwFileError(path, takeBiffMessage());

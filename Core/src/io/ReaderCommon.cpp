@@ -11,7 +11,7 @@
 namespace repose::io {
 
 const char* diskTypeName(DiskType t) {
-  static const char* names[] = {"int8",  "uint8",  "int16", "uint16",  "int32",
+  static const char* names[] = {"int8",   "uint8", "int16",  "uint16",  "int32",
                                 "uint32", "int64", "uint64", "float32", "float64"};
   return names[static_cast<int>(t)];
 }
@@ -23,16 +23,21 @@ std::size_t diskTypeSize(DiskType t) {
 
 ScalarType memoryTypeFor(DiskType t) {
   switch (t) {
-    case DiskType::UInt8: return ScalarType::UInt8;
+    case DiskType::UInt8:
+      return ScalarType::UInt8;
     case DiskType::Int8:
-    case DiskType::Int16: return ScalarType::Int16;
-    case DiskType::UInt16: return ScalarType::UInt16;
+    case DiskType::Int16:
+      return ScalarType::Int16;
+    case DiskType::UInt16:
+      return ScalarType::UInt16;
     case DiskType::Int32:
     case DiskType::UInt32:
     case DiskType::Int64:
-    case DiskType::UInt64: return ScalarType::Int32;
+    case DiskType::UInt64:
+      return ScalarType::Int32;
     case DiskType::Float32:
-    case DiskType::Float64: return ScalarType::Float32;
+    case DiskType::Float64:
+      return ScalarType::Float32;
   }
   return ScalarType::Float32;
 }
@@ -60,16 +65,26 @@ void convertTyped(const In* in, Out* out, std::int64_t n, const std::string& pat
 template <class Out>
 void convertFrom(DiskType from, const void* in, Out* out, std::int64_t n, const std::string& p) {
   switch (from) {
-    case DiskType::Int8: return convertTyped(static_cast<const std::int8_t*>(in), out, n, p);
-    case DiskType::UInt8: return convertTyped(static_cast<const std::uint8_t*>(in), out, n, p);
-    case DiskType::Int16: return convertTyped(static_cast<const std::int16_t*>(in), out, n, p);
-    case DiskType::UInt16: return convertTyped(static_cast<const std::uint16_t*>(in), out, n, p);
-    case DiskType::Int32: return convertTyped(static_cast<const std::int32_t*>(in), out, n, p);
-    case DiskType::UInt32: return convertTyped(static_cast<const std::uint32_t*>(in), out, n, p);
-    case DiskType::Int64: return convertTyped(static_cast<const std::int64_t*>(in), out, n, p);
-    case DiskType::UInt64: return convertTyped(static_cast<const std::uint64_t*>(in), out, n, p);
-    case DiskType::Float32: return convertTyped(static_cast<const float*>(in), out, n, p);
-    case DiskType::Float64: return convertTyped(static_cast<const double*>(in), out, n, p);
+    case DiskType::Int8:
+      return convertTyped(static_cast<const std::int8_t*>(in), out, n, p);
+    case DiskType::UInt8:
+      return convertTyped(static_cast<const std::uint8_t*>(in), out, n, p);
+    case DiskType::Int16:
+      return convertTyped(static_cast<const std::int16_t*>(in), out, n, p);
+    case DiskType::UInt16:
+      return convertTyped(static_cast<const std::uint16_t*>(in), out, n, p);
+    case DiskType::Int32:
+      return convertTyped(static_cast<const std::int32_t*>(in), out, n, p);
+    case DiskType::UInt32:
+      return convertTyped(static_cast<const std::uint32_t*>(in), out, n, p);
+    case DiskType::Int64:
+      return convertTyped(static_cast<const std::int64_t*>(in), out, n, p);
+    case DiskType::UInt64:
+      return convertTyped(static_cast<const std::uint64_t*>(in), out, n, p);
+    case DiskType::Float32:
+      return convertTyped(static_cast<const float*>(in), out, n, p);
+    case DiskType::Float64:
+      return convertTyped(static_cast<const double*>(in), out, n, p);
   }
 }
 

@@ -44,9 +44,12 @@ std::map<int, Extent> extentsOf(const Volume& volume, int layer) {
           auto [it, fresh] = out.try_emplace(value, Extent{i, i, j, j, k, k});
           if (!fresh) {
             Extent& e = it->second;
-            e[0] = std::min(e[0], i); e[1] = std::max(e[1], i);
-            e[2] = std::min(e[2], j); e[3] = std::max(e[3], j);
-            e[4] = std::min(e[4], k); e[5] = std::max(e[5], k);
+            e[0] = std::min(e[0], i);
+            e[1] = std::max(e[1], i);
+            e[2] = std::min(e[2], j);
+            e[3] = std::max(e[3], j);
+            e[4] = std::min(e[4], k);
+            e[5] = std::max(e[5], k);
           }
         }
   });

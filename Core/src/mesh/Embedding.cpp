@@ -17,12 +17,16 @@ Embedding embedInCage(const TransferMesh& mesh, const TriangleMesh& cage, int th
       e.cageVertices.push_back(static_cast<int>(v));
     }
   if (e.cageVertices.empty())
-    throw Error("the cage encloses no transfer-mesh vertex: it cannot move anything (is it around the body?)");
+    throw Error(
+        "the cage encloses no transfer-mesh vertex: it cannot move anything (is it around the "
+        "body?)");
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
-    if (e.inside[mesh.tets(t, 0)] && e.inside[mesh.tets(t, 1)] && e.inside[mesh.tets(t, 2)] && e.inside[mesh.tets(t, 3)])
+    if (e.inside[mesh.tets(t, 0)] && e.inside[mesh.tets(t, 1)] && e.inside[mesh.tets(t, 2)] &&
+        e.inside[mesh.tets(t, 3)])
       e.cageTets.push_back(static_cast<int>(t));
   Eigen::MatrixX3d points(e.cageVertices.size(), 3);
-  for (std::size_t i = 0; i < e.cageVertices.size(); ++i) points.row(i) = mesh.vertices.row(e.cageVertices[i]);
+  for (std::size_t i = 0; i < e.cageVertices.size(); ++i)
+    points.row(i) = mesh.vertices.row(e.cageVertices[i]);
   e.coordinates = computeGreenCoordinates(cage, points, threads);
   return e;
 }

@@ -14,14 +14,17 @@ namespace {
 
 double volumeOf(const TransferMesh& mesh, Eigen::Index t) {
   Eigen::Matrix3d E;
-  for (int c = 0; c < 3; ++c) E.col(c) = (mesh.vertices.row(mesh.tets(t, c + 1)) - mesh.vertices.row(mesh.tets(t, 0))).transpose();
+  for (int c = 0; c < 3; ++c)
+    E.col(c) =
+        (mesh.vertices.row(mesh.tets(t, c + 1)) - mesh.vertices.row(mesh.tets(t, 0))).transpose();
   return std::fabs(E.determinant()) / 6;
 }
 
 }  // namespace
 
 Eigen::VectorXd tetErrors(const TransferMesh& mesh, const std::vector<Eigen::Matrix3d>& B) {
-  if (B.size() != static_cast<std::size_t>(mesh.tets.rows())) throw Error("tetErrors: one map per tet is needed");
+  if (B.size() != static_cast<std::size_t>(mesh.tets.rows()))
+    throw Error("tetErrors: one map per tet is needed");
   const TetAdjacency adjacency = TetAdjacency::build(mesh);
   Eigen::VectorXd volume(mesh.tets.rows());
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) volume[t] = volumeOf(mesh, t);
@@ -41,7 +44,8 @@ Eigen::VectorXd vertexErrors(const TransferMesh& mesh, const Eigen::VectorXd& te
   Eigen::VectorXd sum = Eigen::VectorXd::Zero(mesh.vertices.rows()), weight = sum;
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
     const double v = volumeOf(mesh, t);
-    for (int c = 0; c < 4; ++c) sum[mesh.tets(t, c)] += v * tetError[t], weight[mesh.tets(t, c)] += v;
+    for (int c = 0; c < 4; ++c)
+      sum[mesh.tets(t, c)] += v * tetError[t], weight[mesh.tets(t, c)] += v;
   }
   return (weight.array() > 0).select(sum.array() / weight.array().max(1e-300), 0.0).matrix();
 }
@@ -55,7 +59,8 @@ std::vector<float> rasterizeVertexField(const TransferMesh& mesh, const Eigen::V
   const Eigen::Vector3d origin = grid.origin();
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
     Eigen::Vector3d p[4];
-    for (int c = 0; c < 4; ++c) p[c] = toIndex * (mesh.vertices.row(mesh.tets(t, c)).transpose() - origin);
+    for (int c = 0; c < 4; ++c)
+      p[c] = toIndex * (mesh.vertices.row(mesh.tets(t, c)).transpose() - origin);
     Eigen::Matrix3d E;
     for (int c = 0; c < 3; ++c) E.col(c) = p[c + 1] - p[0];
     const double det = E.determinant();
@@ -68,12 +73,13 @@ std::vector<float> rasterizeVertexField(const TransferMesh& mesh, const Eigen::V
       a[c] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(lo[c] - 1e-9)));
       b[c] = std::min<std::int64_t>(d[c] - 1, static_cast<std::int64_t>(std::floor(hi[c] + 1e-9)));
     }
-    const double f0 = values[mesh.tets(t, 0)], f1 = values[mesh.tets(t, 1)], f2 = values[mesh.tets(t, 2)],
-                 f3 = values[mesh.tets(t, 3)];
+    const double f0 = values[mesh.tets(t, 0)], f1 = values[mesh.tets(t, 1)],
+                 f2 = values[mesh.tets(t, 2)], f3 = values[mesh.tets(t, 3)];
     for (std::int64_t k = a[2]; k <= b[2]; ++k)
       for (std::int64_t j = a[1]; j <= b[1]; ++j)
         for (std::int64_t i = a[0]; i <= b[0]; ++i) {
-          const Eigen::Vector3d l = Einv * (Eigen::Vector3d(double(i), double(j), double(k)) - p[0]);
+          const Eigen::Vector3d l =
+              Einv * (Eigen::Vector3d(double(i), double(j), double(k)) - p[0]);
           const double l0 = 1 - l.sum();
           if (l.minCoeff() < -1e-9 || l0 < -1e-9) continue;
           const std::size_t n = static_cast<std::size_t>(i + d[0] * (j + d[1] * k));
@@ -84,7 +90,8 @@ std::vector<float> rasterizeVertexField(const TransferMesh& mesh, const Eigen::V
   return out;
 }
 
-double updateSizingField(SizingField& F, const std::vector<float>& errorGrid, const std::vector<char>& covered) {
+double updateSizingField(SizingField& F, const std::vector<float>& errorGrid,
+                         const std::vector<char>& covered) {
   if (errorGrid.size() != F.sizeMm.size() || covered.size() != F.sizeMm.size())
     throw Error("updateSizingField: the error grid must be the sizing field's grid");
   double sum = 0;
@@ -95,7 +102,9 @@ double updateSizingField(SizingField& F, const std::vector<float>& errorGrid, co
   const double mean = sum / n;
   if (mean <= 0) return 0;  // an exact deformation: nothing to refine
   for (std::size_t v = 0; v < covered.size(); ++v)
-    if (covered[v]) F.sizeMm[v] = static_cast<float>(F.sizeMm[v] * std::cbrt(mean / std::max<double>(errorGrid[v], mean)));
+    if (covered[v])
+      F.sizeMm[v] =
+          static_cast<float>(F.sizeMm[v] * std::cbrt(mean / std::max<double>(errorGrid[v], mean)));
   return mean;
 }
 

@@ -47,7 +47,7 @@ Eigen::Matrix3d tetLinearMap(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3
 
 struct RigiditySolver::Impl {
   const TransferMesh* mesh = nullptr;
-  Eigen::VectorXd volume;                 // |t|
+  Eigen::VectorXd volume;                    // |t|
   std::vector<Eigen::Matrix3d> restInverse;  // E_t^-1 per tet
   std::vector<int> constrainedVertices, constrainedTets;
   std::vector<int> vertexSlot;  // vertex -> row among unknown vertices, or -1 if constrained
@@ -56,9 +56,9 @@ struct RigiditySolver::Impl {
   std::vector<int> constrainedIndex;  // vertex -> index in constrainedVertices, or -1
 
   // Step 1: rows  sqrt|t| (B_t - sum_n a_tn B_n) = 0  for t outside T_c; a_tn = |n| / sum |n|.
-  Eigen::SparseMatrix<double> A1u;   // rows x unknown tets
-  Eigen::SparseMatrix<double> A1k;   // rows x constrained tets (their B are known)
-  Eigen::MatrixXd reg1;              // A1^T b from identity rows of unconstrained components
+  Eigen::SparseMatrix<double> A1u;  // rows x unknown tets
+  Eigen::SparseMatrix<double> A1k;  // rows x constrained tets (their B are known)
+  Eigen::MatrixXd reg1;             // A1^T b from identity rows of unconstrained components
   SparseCholesky llt1;
   // Step 2: rows  sqrt(W_e) (v_i - v_j) = g_e / sqrt(W_e)  for edges touching an unknown vertex.
   std::vector<std::array<int, 2>> edges;
@@ -70,22 +70,27 @@ struct RigiditySolver::Impl {
   int unconstrained = 0;
 };
 
-RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>& constrainedVertices,
+RigiditySolver::RigiditySolver(const TransferMesh& mesh,
+                               const std::vector<int>& constrainedVertices,
                                const std::vector<int>& constrainedTets)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.mesh = &mesh;
   const int nv = static_cast<int>(mesh.vertices.rows()), nt = static_cast<int>(mesh.tets.rows());
-  if (constrainedVertices.empty()) throw Error("rigidity solver: no constrained vertex (nothing inside the cage)");
+  if (constrainedVertices.empty())
+    throw Error("rigidity solver: no constrained vertex (nothing inside the cage)");
   m.constrainedVertices = constrainedVertices;
   m.constrainedTets = constrainedTets;
   m.volume.resize(nt);
   m.restInverse.resize(nt);
   for (int t = 0; t < nt; ++t) {
     Eigen::Matrix3d E;
-    for (int c = 0; c < 3; ++c) E.col(c) = (mesh.vertices.row(mesh.tets(t, c + 1)) - mesh.vertices.row(mesh.tets(t, 0))).transpose();
+    for (int c = 0; c < 3; ++c)
+      E.col(c) =
+          (mesh.vertices.row(mesh.tets(t, c + 1)) - mesh.vertices.row(mesh.tets(t, 0))).transpose();
     m.volume[t] = E.determinant() / 6;
-    if (!(m.volume[t] > 0)) throw Error("rigidity solver: tet " + std::to_string(t) + " is degenerate or inverted");
+    if (!(m.volume[t] > 0))
+      throw Error("rigidity solver: tet " + std::to_string(t) + " is degenerate or inverted");
     m.restInverse[t] = E.inverse();
   }
   m.tetSlot.assign(nt, 0);
@@ -95,12 +100,15 @@ RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>&
     constrainedTetIndex[constrainedTets[k]] = static_cast<int>(k);
   }
   for (int t = 0; t < nt; ++t)
-    if (m.tetSlot[t] == 0) m.tetSlot[t] = static_cast<int>(m.unknownTets.size()), m.unknownTets.push_back(t);
+    if (m.tetSlot[t] == 0)
+      m.tetSlot[t] = static_cast<int>(m.unknownTets.size()), m.unknownTets.push_back(t);
   m.constrainedIndex.assign(nv, -1);
-  for (std::size_t i = 0; i < constrainedVertices.size(); ++i) m.constrainedIndex.at(constrainedVertices[i]) = static_cast<int>(i);
+  for (std::size_t i = 0; i < constrainedVertices.size(); ++i)
+    m.constrainedIndex.at(constrainedVertices[i]) = static_cast<int>(i);
   m.vertexSlot.assign(nv, -1);
   for (int v = 0; v < nv; ++v)
-    if (m.constrainedIndex[v] < 0) m.vertexSlot[v] = static_cast<int>(m.unknownVertices.size()), m.unknownVertices.push_back(v);
+    if (m.constrainedIndex[v] < 0)
+      m.vertexSlot[v] = static_cast<int>(m.unknownVertices.size()), m.unknownVertices.push_back(v);
 
   const TetAdjacency adjacency = TetAdjacency::build(mesh);
   const std::vector<std::vector<int>>& neighbours = adjacency.faceNeighbours;
@@ -148,7 +156,9 @@ RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>&
   m.A1u.setFromTriplets(u1.begin(), u1.end());
   m.A1k.resize(row, static_cast<Eigen::Index>(constrainedTets.size()));
   m.A1k.setFromTriplets(k1.begin(), k1.end());
-  if (nu > 0) m.llt1.factorize(Eigen::SparseMatrix<double>(m.A1u.transpose() * m.A1u), "rigidity solver step 1");
+  if (nu > 0)
+    m.llt1.factorize(Eigen::SparseMatrix<double>(m.A1u.transpose() * m.A1u),
+                     "rigidity solver step 1");
 
   // Step 2 system over the vertices outside V_c; parts with no edge to V_c stay at rest.
   const int no = static_cast<int>(m.unknownVertices.size());
@@ -166,8 +176,14 @@ RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>&
     const int si = m.vertexSlot[i], sj = m.vertexSlot[j];
     if (si < 0 && sj < 0) continue;
     const double s = std::sqrt(W);
-    if (si >= 0) u2.emplace_back(row, si, s); else k2.emplace_back(row, m.constrainedIndex[i], s);
-    if (sj >= 0) u2.emplace_back(row, sj, -s); else k2.emplace_back(row, m.constrainedIndex[j], -s);
+    if (si >= 0)
+      u2.emplace_back(row, si, s);
+    else
+      k2.emplace_back(row, m.constrainedIndex[i], s);
+    if (sj >= 0)
+      u2.emplace_back(row, sj, -s);
+    else
+      k2.emplace_back(row, m.constrainedIndex[j], -s);
     // An edge to a constrained vertex drives its part; one between unknowns joins their parts.
     if (si >= 0 && sj >= 0)
       vertexParts.join(si, sj);
@@ -208,16 +224,21 @@ RigiditySolver::RigiditySolver(const TransferMesh& mesh, const std::vector<int>&
   m.A2u.setFromTriplets(u2.begin(), u2.end());
   m.A2k.resize(row, static_cast<Eigen::Index>(constrainedVertices.size()));
   m.A2k.setFromTriplets(k2.begin(), k2.end());
-  if (no > 0) m.llt2.factorize(Eigen::SparseMatrix<double>(m.A2u.transpose() * m.A2u), "rigidity solver step 2");
+  if (no > 0)
+    m.llt2.factorize(Eigen::SparseMatrix<double>(m.A2u.transpose() * m.A2u),
+                     "rigidity solver step 2");
 }
 
 RigiditySolver::~RigiditySolver() = default;
 RigiditySolver::RigiditySolver(RigiditySolver&&) noexcept = default;
 RigiditySolver& RigiditySolver::operator=(RigiditySolver&&) noexcept = default;
 
-int RigiditySolver::unconstrainedVertices() const { return impl_->unconstrained; }
+int RigiditySolver::unconstrainedVertices() const {
+  return impl_->unconstrained;
+}
 
-Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets, std::vector<Eigen::Matrix3d>* Bout) const {
+Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets,
+                                       std::vector<Eigen::Matrix3d>* Bout) const {
   const Impl& m = *impl_;
   const TransferMesh& mesh = *m.mesh;
   if (targets.rows() != static_cast<Eigen::Index>(m.constrainedVertices.size()))
@@ -225,7 +246,8 @@ Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets, std::vec
                 std::to_string(m.constrainedVertices.size()) + " constrained vertices");
   if (!targets.allFinite()) throw Error("rigidity solver: target positions are not finite");
   Eigen::MatrixX3d positions(mesh.vertices.rows(), 3);
-  for (std::size_t i = 0; i < m.constrainedVertices.size(); ++i) positions.row(m.constrainedVertices[i]) = targets.row(i);
+  for (std::size_t i = 0; i < m.constrainedVertices.size(); ++i)
+    positions.row(m.constrainedVertices[i]) = targets.row(i);
 
   // Step 1: B of T_c from the targets, then the others.
   std::vector<Eigen::Matrix3d> B(static_cast<std::size_t>(mesh.tets.rows()));
@@ -233,31 +255,37 @@ Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets, std::vec
   for (std::size_t k = 0; k < m.constrainedTets.size(); ++k) {
     const int t = m.constrainedTets[k];
     Eigen::Matrix3d D;
-    for (int c = 0; c < 3; ++c) D.col(c) = (positions.row(mesh.tets(t, c + 1)) - positions.row(mesh.tets(t, 0))).transpose();
+    for (int c = 0; c < 3; ++c)
+      D.col(c) = (positions.row(mesh.tets(t, c + 1)) - positions.row(mesh.tets(t, 0))).transpose();
     B[t] = D * m.restInverse[t];
     known.row(k) = flatten(B[t]);
   }
   if (!m.unknownTets.empty()) {
     const Eigen::MatrixXd rhs = m.reg1 - Eigen::MatrixXd(m.A1u.transpose() * (m.A1k * known));
     const Eigen::MatrixXd x = m.llt1.solve(rhs);
-    for (std::size_t r = 0; r < m.unknownTets.size(); ++r) B[m.unknownTets[r]] = unflatten(x.row(r));
+    for (std::size_t r = 0; r < m.unknownTets.size(); ++r)
+      B[m.unknownTets[r]] = unflatten(x.row(r));
   }
 
   // Step 2: each edge row wants v_i - v_j = (sum |t| B_t e0) / W_e.
   if (!m.unknownVertices.empty()) {
     Eigen::MatrixXd b(static_cast<Eigen::Index>(m.edges.size()), 3);
     for (std::size_t e = 0; e < m.edges.size(); ++e) {
-      const Eigen::Vector3d e0 = (mesh.vertices.row(m.edges[e][0]) - mesh.vertices.row(m.edges[e][1])).transpose();
+      const Eigen::Vector3d e0 =
+          (mesh.vertices.row(m.edges[e][0]) - mesh.vertices.row(m.edges[e][1])).transpose();
       Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
       for (const auto& [t, vol] : m.edgeTets[e]) sum += vol * B[t];
-      b.row(static_cast<Eigen::Index>(e)) = (sum * e0).transpose() / std::sqrt(m.edgeWeight[static_cast<Eigen::Index>(e)]);
+      b.row(static_cast<Eigen::Index>(e)) =
+          (sum * e0).transpose() / std::sqrt(m.edgeWeight[static_cast<Eigen::Index>(e)]);
     }
     // Rows past the edges are the rest-position anchors of undriven parts; their b is in reg2.
     Eigen::MatrixXd full = Eigen::MatrixXd::Zero(m.A2u.rows(), 3);
     full.topRows(b.rows()) = b;
-    const Eigen::MatrixXd rhs = Eigen::MatrixXd(m.A2u.transpose() * (full - m.A2k * targets)) + m.reg2;
+    const Eigen::MatrixXd rhs =
+        Eigen::MatrixXd(m.A2u.transpose() * (full - m.A2k * targets)) + m.reg2;
     const Eigen::MatrixXd x = m.llt2.solve(rhs);
-    for (std::size_t r = 0; r < m.unknownVertices.size(); ++r) positions.row(m.unknownVertices[r]) = x.row(r);
+    for (std::size_t r = 0; r < m.unknownVertices.size(); ++r)
+      positions.row(m.unknownVertices[r]) = x.row(r);
   }
   if (Bout) *Bout = std::move(B);
   return positions;
@@ -268,8 +296,10 @@ CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& c
       embedding_(embedInCage(mesh, cage, threads)),
       solver_(mesh, embedding_.cageVertices, embedding_.cageTets) {}
 
-Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage, std::vector<Eigen::Matrix3d>* B) const {
-  if (deformedCage.rows() != cage_.vertices.rows()) throw Error("deformed cage has the wrong number of vertices");
+Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
+                                         std::vector<Eigen::Matrix3d>* B) const {
+  if (deformedCage.rows() != cage_.vertices.rows())
+    throw Error("deformed cage has the wrong number of vertices");
   return solver_.solve(applyGreenCoordinates(embedding_.coordinates, cage_, deformedCage), B);
 }
 

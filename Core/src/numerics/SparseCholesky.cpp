@@ -27,7 +27,9 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& A, const std::
   impl_->ok = true;
 }
 
-bool SparseCholesky::factorized() const { return impl_->ok; }
+bool SparseCholesky::factorized() const {
+  return impl_->ok;
+}
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& B) const {
   if (!impl_->ok) throw Error("SparseCholesky::solve called before a successful factorize");

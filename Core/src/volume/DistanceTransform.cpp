@@ -63,18 +63,21 @@ std::vector<float> squaredDistanceToMask(const std::vector<std::uint8_t>& mask,
     // Lines along `axis`, indexed by the other two coordinates.
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
     const std::int64_t lines = length[a] * length[b];
-    parallelFor(lines, threads, [&](std::int64_t begin, std::int64_t end) {
-      const std::size_t n = static_cast<std::size_t>(length[axis]);
-      std::vector<double> f(n), d(n), z(n + 1);
-      std::vector<int> v(n);
-      for (std::int64_t line = begin; line < end; ++line) {
-        const std::int64_t ia = line % length[a], ib = line / length[a];
-        const std::int64_t base = ia * stride[a] + ib * stride[b];
-        for (std::size_t q = 0; q < n; ++q) f[q] = g[base + q * stride[axis]];
-        transformLine(f, spacing[axis], d, v, z);
-        for (std::size_t q = 0; q < n; ++q) g[base + q * stride[axis]] = f[q];
-      }
-    }, 16);
+    parallelFor(
+        lines, threads,
+        [&](std::int64_t begin, std::int64_t end) {
+          const std::size_t n = static_cast<std::size_t>(length[axis]);
+          std::vector<double> f(n), d(n), z(n + 1);
+          std::vector<int> v(n);
+          for (std::int64_t line = begin; line < end; ++line) {
+            const std::int64_t ia = line % length[a], ib = line / length[a];
+            const std::int64_t base = ia * stride[a] + ib * stride[b];
+            for (std::size_t q = 0; q < n; ++q) f[q] = g[base + q * stride[axis]];
+            transformLine(f, spacing[axis], d, v, z);
+            for (std::size_t q = 0; q < n; ++q) g[base + q * stride[axis]] = f[q];
+          }
+        },
+        16);
   }
   return std::vector<float>(g.begin(), g.end());
 }

@@ -23,7 +23,8 @@ void* Volume::layerData(int layer) {
 }
 
 const void* Volume::layerData(int layer) const {
-  if (layer < 0 || layer >= layers_) throw Error("layer " + std::to_string(layer) + " out of range");
+  if (layer < 0 || layer >= layers_)
+    throw Error("layer " + std::to_string(layer) + " out of range");
   return bytes_.data() + static_cast<std::size_t>(layer) * numVoxels() * scalarSize(type_);
 }
 

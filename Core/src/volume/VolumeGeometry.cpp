@@ -74,8 +74,7 @@ void VolumeGeometry::validate(const std::string& context) const {
 }
 
 VolumeGeometry VolumeGeometry::make(std::array<std::int64_t, 3> dims,
-                                    const Eigen::Vector3d& spacing,
-                                    const Eigen::Vector3d& origin,
+                                    const Eigen::Vector3d& spacing, const Eigen::Vector3d& origin,
                                     const Eigen::Matrix3d& directions) {
   VolumeGeometry g;
   g.dims = dims;

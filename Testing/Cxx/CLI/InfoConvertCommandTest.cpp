@@ -56,8 +56,8 @@ TEST(InfoCommand, TextOutputForImagesAndSegmentations) {
   // Stored in LPS with negative x and y steps: the voxel axes point to R, A, S.
   EXPECT_NE(ct.out.find("orientation  RAS"), std::string::npos) << ct.out;
   EXPECT_NE(ct.out.find("(image)"), std::string::npos);
-  const CommandResult seg =
-      runCommand("repose", "info " + shellQuote(dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd")));
+  const CommandResult seg = runCommand(
+      "repose", "info " + shellQuote(dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd")));
   ASSERT_EQ(seg.exitCode, 0) << seg.err;
   EXPECT_NE(seg.out.find("overlapping sphere"), std::string::npos) << seg.out;
   EXPECT_NE(seg.out.find("2 layers"), std::string::npos) << seg.out;
@@ -69,7 +69,8 @@ TEST(ConvertCommand, NiftiToSegNrrdToNiftiKeepsVoxelsGeometryAndNames) {
   const std::string digest = fileDigest(in);
   const std::string seg = dir.file("seg.seg.nrrd"), back = dir.file("back.nii.gz");
   ASSERT_EQ(runCommand("repose", "convert " + shellQuote(in) + " " + shellQuote(seg)).exitCode, 0);
-  const CommandResult r = runCommand("repose", "convert " + shellQuote(seg) + " " + shellQuote(back) + " --json");
+  const CommandResult r =
+      runCommand("repose", "convert " + shellQuote(seg) + " " + shellQuote(back) + " --json");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["labels_present"], 41);
   const Volume a = readVolume(in), b = readVolume(back), s = readVolume(seg);
@@ -85,8 +86,9 @@ TEST(ConvertCommand, NiftiToSegNrrdToNiftiKeepsVoxelsGeometryAndNames) {
 TEST(ConvertCommand, DicomSeriesToNifti) {
   ScratchDir dir;
   const std::string out = dir.file("ct.nii.gz");
-  const CommandResult r = runCommand(
-      "repose", "convert " + shellQuote(dataPath("dcmqi_ct3slice/ct-3slice")) + " " + shellQuote(out));
+  const CommandResult r =
+      runCommand("repose", "convert " + shellQuote(dataPath("dcmqi_ct3slice/ct-3slice")) + " " +
+                               shellQuote(out));
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const Volume ct = readVolume(out);
   EXPECT_EQ(ct.dims(), (std::array<std::int64_t, 3>{512, 512, 3}));
@@ -96,17 +98,21 @@ TEST(ConvertCommand, DicomSeriesToNifti) {
 TEST(ConvertCommand, BadInputFailsWithOneLineAndNoOutput) {
   ScratchDir dir;
   const std::string out = dir.file("out.nii.gz");
-  expectCleanFailure(runCommand("repose", "convert " + shellQuote(dir.file("missing.nii")) + " " + shellQuote(out)));
+  expectCleanFailure(runCommand(
+      "repose", "convert " + shellQuote(dir.file("missing.nii")) + " " + shellQuote(out)));
   {
     std::ofstream bad(dir.file("bad.nrrd"));
     bad << "NRRD0004\ntype: short\ndimension: 3\nsizes: 100 100 100\nencoding: raw\n\n0123456789";
   }
-  const CommandResult sizeMismatch = runCommand("repose", "convert " + shellQuote(dir.file("bad.nrrd")) + " " + shellQuote(out));
+  const CommandResult sizeMismatch =
+      runCommand("repose", "convert " + shellQuote(dir.file("bad.nrrd")) + " " + shellQuote(out));
   expectCleanFailure(sizeMismatch);
   EXPECT_NE(sizeMismatch.err.find("bad.nrrd"), std::string::npos) << sizeMismatch.err;
   const std::string in = dataPath("slicer_seg/Segmentation.seg.nrrd");
-  expectCleanFailure(runCommand("repose", "convert " + shellQuote(in) + " " + shellQuote(dir.file("x.png"))));
-  expectCleanFailure(runCommand("repose", "convert " + shellQuote(in) + " " + shellQuote(dir.file("no/dir/x.nii"))));
+  expectCleanFailure(
+      runCommand("repose", "convert " + shellQuote(in) + " " + shellQuote(dir.file("x.png"))));
+  expectCleanFailure(runCommand(
+      "repose", "convert " + shellQuote(in) + " " + shellQuote(dir.file("no/dir/x.nii"))));
   expectCleanFailure(runCommand("repose", "convert " + shellQuote(in) + " /dev/null/x.nii"));
   EXPECT_FALSE(std::filesystem::exists(out));
   for (const auto& e : std::filesystem::directory_iterator(dir.path()))
@@ -118,7 +124,8 @@ TEST(ConvertCommand, RefusesToOverwriteItsInput) {
   const std::string copy = dir.file("seg.nii.gz");
   std::filesystem::copy_file(dataPath("totalsegmentator/example_seg.nii.gz"), copy);
   const std::string digest = fileDigest(copy);
-  const CommandResult r = runCommand("repose", "convert " + shellQuote(copy) + " " + shellQuote(copy));
+  const CommandResult r =
+      runCommand("repose", "convert " + shellQuote(copy) + " " + shellQuote(copy));
   expectCleanFailure(r);
   EXPECT_NE(r.err.find("overwrite"), std::string::npos) << r.err;
   EXPECT_EQ(fileDigest(copy), digest);

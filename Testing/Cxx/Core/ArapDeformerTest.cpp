@@ -39,7 +39,8 @@ Eigen::MatrixX3d bendTargets(const TriangleMesh& m, const std::vector<int>& left
   for (std::size_t i = 0; i < left.size(); ++i) t.row(i) = m.vertices.row(left[i]);
   for (std::size_t i = 0; i < right.size(); ++i)
     t.row(left.size() + i) =
-        (R * (m.vertices.row(right[i]).transpose() - pivot) + pivot + Eigen::Vector3d(0, 40, 0)).transpose();
+        (R * (m.vertices.row(right[i]).transpose() - pivot) + pivot + Eigen::Vector3d(0, 40, 0))
+            .transpose();
   return t;
 }
 
@@ -48,13 +49,16 @@ Eigen::MatrixX3d bendTargets(const TriangleMesh& m, const std::vector<int>& left
 TEST(ArapDeformer, RigidMotionOfAllHandlesMovesTheCageRigidly) {
   const TriangleMesh cage = limbCage();
   ArapDeformer arap(cage);
-  const auto handles = verticesWhere(cage, [](const Eigen::Vector3d& p) { return std::fabs(p.x()) > 100; });
+  const auto handles =
+      verticesWhere(cage, [](const Eigen::Vector3d& p) { return std::fabs(p.x()) > 100; });
   ASSERT_GT(handles.size(), 10u);
   arap.setHandles(handles);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
   const Eigen::RowVector3d t(10, -300, 42);
   Eigen::MatrixX3d targets(handles.size(), 3);
-  for (std::size_t h = 0; h < handles.size(); ++h) targets.row(h) = cage.vertices.row(handles[h]) * R.transpose() + t;
+  for (std::size_t h = 0; h < handles.size(); ++h)
+    targets.row(h) = cage.vertices.row(handles[h]) * R.transpose() + t;
   ArapOptions o;
   o.maxIterations = 2000;
   o.tolerance = 1e-15;  // iterate to convergence: the rigid motion is the exact minimum
@@ -101,7 +105,8 @@ TEST(ArapDeformer, RefusesBadHandleSets) {
 TEST(ArapDeformer, AgreesWithCgalSurfaceMeshDeformation) {
   using Kernel = CGAL::Simple_cartesian<double>;
   using Mesh = CGAL::Surface_mesh<Kernel::Point_3>;
-  using Deformation = CGAL::Surface_mesh_deformation<Mesh, CGAL::Default, CGAL::Default, CGAL::ORIGINAL_ARAP>;
+  using Deformation =
+      CGAL::Surface_mesh_deformation<Mesh, CGAL::Default, CGAL::Default, CGAL::ORIGINAL_ARAP>;
   const TriangleMesh cage = limbCage();
   const auto left = verticesWhere(cage, [](const Eigen::Vector3d& p) { return p.x() < -100; });
   const auto right = verticesWhere(cage, [](const Eigen::Vector3d& p) { return p.x() > 100; });
@@ -112,7 +117,8 @@ TEST(ArapDeformer, AgreesWithCgalSurfaceMeshDeformation) {
   Mesh mesh;
   std::vector<Mesh::Vertex_index> vs;
   for (Eigen::Index v = 0; v < cage.vertices.rows(); ++v)
-    vs.push_back(mesh.add_vertex(Kernel::Point_3(cage.vertices(v, 0), cage.vertices(v, 1), cage.vertices(v, 2))));
+    vs.push_back(mesh.add_vertex(
+        Kernel::Point_3(cage.vertices(v, 0), cage.vertices(v, 1), cage.vertices(v, 2))));
   for (Eigen::Index f = 0; f < cage.faces.rows(); ++f)
     mesh.add_face(vs[cage.faces(f, 0)], vs[cage.faces(f, 1)], vs[cage.faces(f, 2)]);
   Deformation cgal(mesh);
@@ -120,7 +126,8 @@ TEST(ArapDeformer, AgreesWithCgalSurfaceMeshDeformation) {
   for (int h : handles) cgal.insert_control_vertex(vs[h]);
   ASSERT_TRUE(cgal.preprocess());
   for (std::size_t h = 0; h < handles.size(); ++h)
-    cgal.set_target_position(vs[handles[h]], Kernel::Point_3(targets(h, 0), targets(h, 1), targets(h, 2)));
+    cgal.set_target_position(vs[handles[h]],
+                             Kernel::Point_3(targets(h, 0), targets(h, 1), targets(h, 2)));
   cgal.deform(500, 1e-10);
 
   ArapDeformer arap(cage);
@@ -132,9 +139,11 @@ TEST(ArapDeformer, AgreesWithCgalSurfaceMeshDeformation) {
   double worst = 0;
   for (Eigen::Index v = 0; v < cage.vertices.rows(); ++v) {
     const auto& p = mesh.point(vs[v]);
-    worst = std::max(worst, (ours.positions.row(v) - Eigen::RowVector3d(p.x(), p.y(), p.z())).norm());
+    worst =
+        std::max(worst, (ours.positions.row(v) - Eigen::RowVector3d(p.x(), p.y(), p.z())).norm());
   }
   // Same energy and weights: the converged cages agree to a small fraction of the 300 mm length.
   EXPECT_LT(worst, 0.5) << "max vertex distance to CGAL's result, mm";
-  std::cout << "max distance to CGAL ARAP: " << worst << " mm after " << ours.iterations << " iterations\n";
+  std::cout << "max distance to CGAL ARAP: " << worst << " mm after " << ours.iterations
+            << " iterations\n";
 }

@@ -37,8 +37,9 @@ Eigen::MatrixX3d interfaceVoxels(const Volume& s, int a, int b, const Region& re
         const int l = v[s.index(i, j, k)];
         if (l != a && l != b) continue;
         const int other = l == a ? b : a;
-        const std::int64_t n[6] = {s.index(i - 1, j, k), s.index(i + 1, j, k), s.index(i, j - 1, k),
-                                   s.index(i, j + 1, k), s.index(i, j, k - 1), s.index(i, j, k + 1)};
+        const std::int64_t n[6] = {s.index(i - 1, j, k), s.index(i + 1, j, k),
+                                   s.index(i, j - 1, k), s.index(i, j + 1, k),
+                                   s.index(i, j, k - 1), s.index(i, j, k + 1)};
         bool touches = false;
         for (std::int64_t x : n) touches = touches || v[x] == other;
         const Eigen::Vector3d p = s.geometry().voxelToRas(i, j, k);
@@ -69,8 +70,14 @@ TEST(CageBuilder, PhantomCageIsValidNearTheTargetSizeAndEnclosesTheBody) {
 
 TEST(CageBuilder, InsetSeparatesAHandGluedToTheHip) {
   const Volume& parts = phantomParts(true);
-  Phantom phantom([] { PhantomOptions o; o.voxelMm = 4; o.armsTouching = true; return o; }());
-  const Eigen::Vector3d hand = (phantom.joint("wrist_left").ras + phantom.joint("hand_tip_left").ras) / 2;
+  Phantom phantom([] {
+    PhantomOptions o;
+    o.voxelMm = 4;
+    o.armsTouching = true;
+    return o;
+  }());
+  const Eigen::Vector3d hand =
+      (phantom.joint("wrist_left").ras + phantom.joint("hand_tip_left").ras) / 2;
   Region region;
   region.shape = Region::Shape::Sphere;
   region.a = hand;
@@ -93,7 +100,6 @@ TEST(CageBuilder, InsetSeparatesAHandGluedToTheHip) {
   EXPECT_GE(inset.report.enclosedFraction(), 0.95);
 }
 
-
 TEST(CageBuilder, RealSegmentationTouchingTheBorderIsPaddedNotRefused) {
   const Volume seg = readVolume(dataPath("totalsegmentator/example_seg.nii.gz"));
   const Cage cage = buildCage(seg, {});
@@ -101,7 +107,8 @@ TEST(CageBuilder, RealSegmentationTouchingTheBorderIsPaddedNotRefused) {
   EXPECT_GE(cage.report.enclosedFraction(), 0.95);
   // Padding: the cage extends beyond the volume where the body touches its border.
   const auto [lo, hi] = seg.geometry().rasBounds();
-  const Eigen::Vector3d cageLo = cage.mesh.vertices.colwise().minCoeff(), cageHi = cage.mesh.vertices.colwise().maxCoeff();
+  const Eigen::Vector3d cageLo = cage.mesh.vertices.colwise().minCoeff(),
+                        cageHi = cage.mesh.vertices.colwise().maxCoeff();
   EXPECT_TRUE((cageLo.array() < lo.array()).any() || (cageHi.array() > hi.array()).any());
 }
 
@@ -122,7 +129,8 @@ TEST(CageBuilder, BadInputsGiveOneLineErrors) {
   absent.separations.push_back({kPartHandLeft, 99, Region::parse("sphere:0,0,0,50")});
   expectError(parts, absent, "label 99 is not present");
   CageOptions nowhere;
-  nowhere.separations.push_back({kPartHandLeft, kPartThighLeft, Region::parse("box:5000,5000,5000,5100,5100,5100")});
+  nowhere.separations.push_back(
+      {kPartHandLeft, kPartThighLeft, Region::parse("box:5000,5000,5000,5100,5100,5100")});
   expectError(parts, nowhere, "selects no voxel");
   CageOptions tooMany;
   tooMany.targetVertices = 5000;
@@ -138,6 +146,7 @@ TEST(Region, ParsesBoxesAndSpheresAndRefusesNonsense) {
   const Region sphere = Region::parse("sphere:1,2,3,4");
   EXPECT_TRUE(sphere.contains({1, 2, 6.9}));
   EXPECT_FALSE(sphere.contains({1, 2, 7.1}));
-  for (const char* bad : {"box:1,2,3", "sphere:0,0,0,-1", "cube:1,2,3,4,5,6", "box:a,b,c,d,e,f", "sphere"})
+  for (const char* bad :
+       {"box:1,2,3", "sphere:0,0,0,-1", "cube:1,2,3,4,5,6", "box:a,b,c,d,e,f", "sphere"})
     EXPECT_THROW(Region::parse(bad), Error) << bad;
 }

@@ -42,7 +42,8 @@ TEST(DicomSeries, GeometryMatchesTheNiftiSegmentationOfTheSeries) {
   ASSERT_GE(kAtBottom, 0);
   for (const Eigen::Vector3d& ijk : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(511, 0, 19),
                                      Eigen::Vector3d(17, 300, 7), Eigen::Vector3d(511, 511, 10)}) {
-    const Eigen::Vector3d niftiIjk = seg.geometry().rasToVoxel(g.voxelToRas(ijk.x(), ijk.y(), ijk.z()));
+    const Eigen::Vector3d niftiIjk =
+        seg.geometry().rasToVoxel(g.voxelToRas(ijk.x(), ijk.y(), ijk.z()));
     EXPECT_NEAR(niftiIjk.x(), ijk.x(), 1e-3);
     EXPECT_NEAR(niftiIjk.y(), 511 - ijk.y(), 1e-3);
     EXPECT_NEAR(std::fabs(niftiIjk.z() - (ijk.z() - kAtBottom)), 0, 1e-3);

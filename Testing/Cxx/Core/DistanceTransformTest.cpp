@@ -26,7 +26,8 @@ TEST(DistanceTransform, EqualsBruteForceOnRandomAnisotropicMasks) {
             for (std::int64_t b = 0; b < dims[1]; ++b)
               for (std::int64_t a = 0; a < dims[0]; ++a)
                 if (mask[a + dims[0] * (b + dims[1] * c)]) {
-                  const Eigen::Vector3d delta((i - a) * spacing[0], (j - b) * spacing[1], (k - c) * spacing[2]);
+                  const Eigen::Vector3d delta((i - a) * spacing[0], (j - b) * spacing[1],
+                                              (k - c) * spacing[2]);
                   best = std::min(best, delta.squaredNorm());
                 }
           const float got = d[i + dims[0] * (j + dims[1] * k)];
@@ -51,6 +52,7 @@ TEST(DistanceTransform, SingleSeedGivesEuclideanBallsInMillimetres) {
 }
 
 TEST(DistanceTransform, EmptyMaskIsInfinitelyFar) {
-  const std::vector<float> d = squaredDistanceToMask(std::vector<std::uint8_t>(27, 0), {3, 3, 3}, {1, 1, 1});
+  const std::vector<float> d =
+      squaredDistanceToMask(std::vector<std::uint8_t>(27, 0), {3, 3, 3}, {1, 1, 1});
   for (float v : d) EXPECT_TRUE(std::isinf(v));
 }

@@ -27,10 +27,14 @@ TEST(ErrorMetric, BendingConcentratesErrorAtTheBend) {
   const TransferMesh mesh = tetBox({0, -20, -20}, {300, 20, 20}, {30, 4, 4});
   const TriangleMesh cage = boxMesh({-15, -35, -35}, {315, 35, 35}, 6);
   const CageDeformation d(mesh, cage);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(M_PI / 3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(M_PI / 3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   Eigen::MatrixX3d bent = cage.vertices;
   for (Eigen::Index v = 0; v < bent.rows(); ++v)
-    if (bent(v, 0) > 150) bent.row(v) = (R * (bent.row(v).transpose() - Eigen::Vector3d(150, 0, 0)) + Eigen::Vector3d(150, 0, 0)).transpose();
+    if (bent(v, 0) > 150)
+      bent.row(v) =
+          (R * (bent.row(v).transpose() - Eigen::Vector3d(150, 0, 0)) + Eigen::Vector3d(150, 0, 0))
+              .transpose();
   std::vector<Eigen::Matrix3d> B;
   d.deform(bent, &B);
   const Eigen::VectorXd ev = vertexErrors(mesh, tetErrors(mesh, B));
@@ -45,7 +49,8 @@ TEST(ErrorMetric, BendingConcentratesErrorAtTheBend) {
 TEST(ErrorMetric, RasterizationInterpolatesLinearFieldsExactly) {
   const TransferMesh mesh = tetBox({2.3, 1.1, -4}, {20.3, 13.1, 8}, {3, 2, 2});
   Eigen::VectorXd f(mesh.vertices.rows());
-  for (Eigen::Index v = 0; v < f.size(); ++v) f[v] = 3 * mesh.vertices(v, 0) - 2 * mesh.vertices(v, 1) + 0.5 * mesh.vertices(v, 2) + 7;
+  for (Eigen::Index v = 0; v < f.size(); ++v)
+    f[v] = 3 * mesh.vertices(v, 0) - 2 * mesh.vertices(v, 1) + 0.5 * mesh.vertices(v, 2) + 7;
   const VolumeGeometry grid = VolumeGeometry::make({26, 18, 16}, {1, 1, 1}, {0, 0, -6});
   std::vector<char> covered;
   const std::vector<float> g = rasterizeVertexField(mesh, f, grid, &covered);
@@ -54,7 +59,8 @@ TEST(ErrorMetric, RasterizationInterpolatesLinearFieldsExactly) {
     for (std::int64_t j = 0; j < 18; ++j)
       for (std::int64_t i = 0; i < 26; ++i) {
         const Eigen::Vector3d p = grid.voxelToRas(i, j, k);
-        const bool in = p.x() >= 2.3 - 1e-9 && p.x() <= 20.3 + 1e-9 && p.y() >= 1.1 - 1e-9 && p.y() <= 13.1 + 1e-9 && p.z() >= -4 && p.z() <= 8;
+        const bool in = p.x() >= 2.3 - 1e-9 && p.x() <= 20.3 + 1e-9 && p.y() >= 1.1 - 1e-9 &&
+                        p.y() <= 13.1 + 1e-9 && p.z() >= -4 && p.z() <= 8;
         const std::size_t n = static_cast<std::size_t>(i + 26 * (j + 18 * k));
         ASSERT_EQ(bool(covered[n]), in) << i << "," << j << "," << k;
         if (in) {

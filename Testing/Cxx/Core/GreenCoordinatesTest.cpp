@@ -27,7 +27,8 @@ std::vector<NamedCage> cages() {
 
 // Random points strictly inside (winding number ~ 1), well away from the surface.
 Eigen::MatrixX3d interiorPoints(const TriangleMesh& cage, int count, unsigned seed) {
-  const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(), hi = cage.vertices.colwise().maxCoeff();
+  const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(),
+                        hi = cage.vertices.colwise().maxCoeff();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(0.05, 0.95);
   Eigen::MatrixX3d candidates(count * 4, 3);
@@ -79,7 +80,8 @@ TEST(GreenCoordinates, SimilarityOfTheCageIsReproducedExactly) {
 
 TEST(GreenCoordinates, StretchIsTheScaleOfASimilarity) {
   const TriangleMesh cage = sphereMesh({0, 0, 0}, 10, 1);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
   const Eigen::VectorXd s = greenFaceStretch(cage, 2.5 * cage.vertices * R.transpose());
   EXPECT_LT((s.array() - 2.5).abs().maxCoeff(), 1e-12);
 }
@@ -89,9 +91,9 @@ TEST(GreenCoordinates, FiniteAndAccurateNearFacesEdgesAndVertices) {
   const double size = std::sqrt(12.0);
   for (double gap : {1e-3, 1e-5, 1e-6, 1e-7, 1e-9, 1e-12, 0.0}) {
     Eigen::MatrixX3d points(4, 3);
-    points << 0.3, 0.2, 1 - gap,  // under a face
-        0.4, 0.4, 1 - gap,        // under a face's diagonal edge
-        0, 1 - gap, 1 - gap,      // next to a cube edge
+    points << 0.3, 0.2, 1 - gap,    // under a face
+        0.4, 0.4, 1 - gap,          // under a face's diagonal edge
+        0, 1 - gap, 1 - gap,        // next to a cube edge
         1 - gap, 1 - gap, 1 - gap;  // next to a corner
     const GreenCoordinates gc = computeGreenCoordinates(cage, points);
     ASSERT_TRUE(gc.phi.allFinite()) << gap;
@@ -104,7 +106,8 @@ TEST(GreenCoordinates, FiniteAndAccurateNearFacesEdgesAndVertices) {
 
 TEST(WindingNumber, OneInsideZeroOutsideForEveryCage) {
   for (const auto& [name, cage] : cages()) {
-    const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(), hi = cage.vertices.colwise().maxCoeff();
+    const Eigen::Vector3d lo = cage.vertices.colwise().minCoeff(),
+                          hi = cage.vertices.colwise().maxCoeff();
     Eigen::MatrixX3d pts(3, 3);
     pts.row(0) = (lo + hi) / 2;
     pts.row(1) = hi + (hi - lo);

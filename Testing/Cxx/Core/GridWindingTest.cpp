@@ -1,5 +1,6 @@
 // Grid winding numbers by ray crossings agree with the solid-angle winding number at every voxel,
-// on axis-aligned and oblique, mirrored grids, including meshes whose vertices sit on voxel centres.
+// on axis-aligned and oblique, mirrored grids, including meshes whose vertices sit on voxel
+// centres.
 #include "TestMeshes.h"
 
 #include "repose/cage/GridWinding.h"
@@ -24,7 +25,8 @@ void expectAgreesWithSolidAngles(const TriangleMesh& mesh, const VolumeGeometry&
   Eigen::MatrixX3d centres(g.numVoxels(), 3);
   for (std::int64_t k = 0, n = 0; k < g.dims[2]; ++k)
     for (std::int64_t j = 0; j < g.dims[1]; ++j)
-      for (std::int64_t i = 0; i < g.dims[0]; ++i) centres.row(n++) = g.voxelToRas(i + tie.x(), j + tie.y(), k + tie.z());
+      for (std::int64_t i = 0; i < g.dims[0]; ++i)
+        centres.row(n++) = g.voxelToRas(i + tie.x(), j + tie.y(), k + tie.z());
   const Eigen::VectorXd exact = windingNumbers(mesh, centres);
   std::int64_t inside = 0, mismatches = 0;
   for (std::int64_t n = 0; n < g.numVoxels(); ++n) {
@@ -39,7 +41,8 @@ void expectAgreesWithSolidAngles(const TriangleMesh& mesh, const VolumeGeometry&
 
 TEST(GridWinding, AgreesWithSolidAnglesOnAxisAlignedGrid) {
   const TriangleMesh sphere = sphereMesh({1.2, -3.4, 5.0}, 9.3, 2);
-  expectAgreesWithSolidAngles(sphere, VolumeGeometry::make({24, 22, 26}, {1, 1, 1}, {-11, -15, -8}));
+  expectAgreesWithSolidAngles(sphere,
+                              VolumeGeometry::make({24, 22, 26}, {1, 1, 1}, {-11, -15, -8}));
 }
 
 TEST(GridWinding, VerticesOnVoxelCentresAreHandled) {
@@ -50,10 +53,13 @@ TEST(GridWinding, VerticesOnVoxelCentresAreHandled) {
 
 TEST(GridWinding, ObliqueAnisotropicAndMirroredGrids) {
   const TriangleMesh sphere = sphereMesh({0, 0, 0}, 20, 2);
-  const Eigen::Matrix3d rot = Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, -1).normalized()).toRotationMatrix();
-  expectAgreesWithSolidAngles(sphere, VolumeGeometry::make({20, 20, 8}, {2.5, 2.5, 6}, {-25, -25, -25}, rot));
+  const Eigen::Matrix3d rot =
+      Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, -1).normalized()).toRotationMatrix();
+  expectAgreesWithSolidAngles(
+      sphere, VolumeGeometry::make({20, 20, 8}, {2.5, 2.5, 6}, {-25, -25, -25}, rot));
   Eigen::Matrix3d mirrored = Eigen::Vector3d(-1, -1, 1).asDiagonal();  // an LPS-like grid
-  expectAgreesWithSolidAngles(sphere, VolumeGeometry::make({22, 22, 22}, {2, 2, 2}, {22, 22, -22}, mirrored));
+  expectAgreesWithSolidAngles(
+      sphere, VolumeGeometry::make({22, 22, 22}, {2, 2, 2}, {22, 22, -22}, mirrored));
 }
 
 TEST(GridWinding, InwardOrientationGivesMinusOne) {

@@ -31,7 +31,8 @@ TEST(MeshIO, QuadsAreTriangulatedAndBadFilesRefused) {
   EXPECT_THROW(readTriangleMesh(dir.file("badindex.obj")), Error);
   std::ofstream(dir.file("empty.obj")) << "# nothing\n";
   EXPECT_THROW(readTriangleMesh(dir.file("empty.obj")), Error);
-  std::ofstream(dir.file("trunc.vtk")) << "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1";
+  std::ofstream(dir.file("trunc.vtk"))
+      << "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1";
   EXPECT_THROW(readTriangleMesh(dir.file("trunc.vtk")), Error);
   EXPECT_THROW(readTriangleMesh(dir.file("missing.obj")), Error);
   EXPECT_THROW(writeTriangleMesh(sphereMesh({0, 0, 0}, 1, 0), dir.file("x.stl")), Error);

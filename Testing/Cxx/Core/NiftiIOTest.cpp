@@ -137,7 +137,8 @@ std::vector<char> gunzip(const std::string& path) {
   gzFile f = gzopen(path.c_str(), "rb");
   std::vector<char> out, buf(1 << 16);
   int n;
-  while ((n = gzread(f, buf.data(), buf.size())) > 0) out.insert(out.end(), buf.begin(), buf.begin() + n);
+  while ((n = gzread(f, buf.data(), buf.size())) > 0)
+    out.insert(out.end(), buf.begin(), buf.begin() + n);
   gzclose(f);
   return out;
 }

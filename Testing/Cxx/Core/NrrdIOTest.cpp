@@ -127,9 +127,11 @@ TEST(NrrdIO, WrittenSegmentationCarriesSlicerFieldsAndRoundTrips) {
       EXPECT_EQ(b->tags, l.tags);
     }
     // Every per-segment and per-segmentation field Slicer's own file has, ours has too.
-    const std::string ours = headerText(out), theirs = headerText(dataPath(std::string("slicer_seg/") + name));
+    const std::string ours = headerText(out),
+                      theirs = headerText(dataPath(std::string("slicer_seg/") + name));
     std::regex key(R"((Segment\d+_\w+|Segmentation_\w+):=)");
-    for (auto it = std::sregex_iterator(theirs.begin(), theirs.end(), key); it != std::sregex_iterator(); ++it)
+    for (auto it = std::sregex_iterator(theirs.begin(), theirs.end(), key);
+         it != std::sregex_iterator(); ++it)
       EXPECT_NE(ours.find((*it)[1].str() + ":="), std::string::npos) << (*it)[1] << " in " << name;
   }
 }
@@ -141,12 +143,14 @@ TEST(NrrdIO, SegmentExtentsMatchTheVoxels) {
   v.data<std::uint8_t>()[v.index(7, 1, 6)] = 2;
   v.setLabelMap(true);
   writeVolume(v, dir.file("e.seg.nrrd"));
-  EXPECT_NE(headerText(dir.file("e.seg.nrrd")).find("Segment0_Extent:=3 7 1 4 5 6"), std::string::npos);
+  EXPECT_NE(headerText(dir.file("e.seg.nrrd")).find("Segment0_Extent:=3 7 1 4 5 6"),
+            std::string::npos);
 }
 
 TEST(NrrdIO, BadInputGivesOneLineErrors) {
   ScratchDir dir;
-  auto expectError = [&](const std::string& name, const std::string& content, const std::string& fragment) {
+  auto expectError = [&](const std::string& name, const std::string& content,
+                         const std::string& fragment) {
     const std::string path = dir.file(name);
     std::ofstream(path, std::ios::binary) << content;
     try {
@@ -159,13 +163,20 @@ TEST(NrrdIO, BadInputGivesOneLineErrors) {
       EXPECT_NE(msg.find(fragment), std::string::npos) << msg;
     }
   };
-  const std::string head = "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
-                           "sizes: 4 4 4\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nendian: little\n";
+  const std::string head =
+      "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
+      "sizes: 4 4 4\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nendian: little\n";
   expectError("short.nrrd", head + "encoding: raw\n\n" + std::string(10, 'x'), "truncated");
   expectError("garbage.nrrd", "this is not a nrrd file\n", "");
-  expectError("type.nrrd", "NRRD0004\ntype: block\nblock size: 3\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
-                               std::string(24, 'x'), "");
-  expectError("twod.nrrd", "NRRD0004\ntype: short\ndimension: 2\nsizes: 2 2\nendian: little\nencoding: raw\n\n" + std::string(8, 'x'), "2D");
+  expectError(
+      "type.nrrd",
+      "NRRD0004\ntype: block\nblock size: 3\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
+          std::string(24, 'x'),
+      "");
+  expectError("twod.nrrd",
+              "NRRD0004\ntype: short\ndimension: 2\nsizes: 2 2\nendian: little\nencoding: raw\n\n" +
+                  std::string(8, 'x'),
+              "2D");
   expectError("missingdata.nhdr", head + "encoding: raw\ndata file: nowhere.raw\n", "");
   expectError("badgz.nrrd", head + "encoding: gzip\n\nnot gzip at all", "truncated or corrupt");
 }

@@ -18,8 +18,12 @@ using namespace repose::test;
 namespace {
 
 // A 300 mm limb along x; the cage covers x in [-15, 215]: the last 85 mm stick out.
-TransferMesh limb() { return tetBox({0, -20, -20}, {300, 20, 20}, {30, 4, 4}); }
-TriangleMesh limbCage() { return boxMesh({-15, -35, -35}, {215, 35, 35}, 4); }
+TransferMesh limb() {
+  return tetBox({0, -20, -20}, {300, 20, 20}, {30, 4, 4});
+}
+TriangleMesh limbCage() {
+  return boxMesh({-15, -35, -35}, {215, 35, 35}, 4);
+}
 
 double meshSize(const TransferMesh& m) {
   return (m.vertices.colwise().maxCoeff() - m.vertices.colwise().minCoeff()).norm();
@@ -40,7 +44,8 @@ TEST(RigiditySolver, RigidCageMotionMovesOutsideVerticesRigidly) {
   const TransferMesh mesh = limb();
   const TriangleMesh cage = limbCage();
   const CageDeformation d(mesh, cage);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.3, -1, 2).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.3, -1, 2).normalized()).toRotationMatrix();
   const Eigen::RowVector3d t(-40, 500, 12);
   std::vector<Eigen::Matrix3d> B;
   const Eigen::MatrixX3d out = d.deform((cage.vertices * R.transpose()).rowwise() + t, &B);
@@ -54,7 +59,8 @@ TEST(RigiditySolver, BentLimbTipOutsideTheCageFollowsAndKeepsItsShape) {
   const TriangleMesh cage = limbCage();
   const CageDeformation d(mesh, cage);
   // Bend: cage vertices beyond x = 120 turn 40 degrees about z around (120, 0, 0).
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(40 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(40 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   const Eigen::Vector3d pivot(120, 0, 0);
   Eigen::MatrixX3d bent = cage.vertices;
   for (Eigen::Index v = 0; v < bent.rows(); ++v)
@@ -78,7 +84,8 @@ TEST(RigiditySolver, BentLimbTipOutsideTheCageFollowsAndKeepsItsShape) {
     if (!outside) continue;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
-        const double rest = (mesh.vertices.row(mesh.tets(t, a)) - mesh.vertices.row(mesh.tets(t, b))).norm();
+        const double rest =
+            (mesh.vertices.row(mesh.tets(t, a)) - mesh.vertices.row(mesh.tets(t, b))).norm();
         const double now = (out.row(mesh.tets(t, a)) - out.row(mesh.tets(t, b))).norm();
         worst = std::max(worst, std::fabs(now / rest - 1));
       }

@@ -12,9 +12,10 @@ TEST(VolumeGeometry, VoxelToRasRoundTripsForObliqueGrids) {
   for (double angle : {0.0, 0.3, 1.2, 3.0}) {
     const Eigen::Matrix3d rot =
         Eigen::AngleAxisd(angle, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-    const VolumeGeometry g = VolumeGeometry::make({10, 20, 30}, {0.5, 1.3, 7.2}, {-100, 20, 3}, rot);
-    for (const Eigen::Vector3d& ijk : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(9, 19, 29),
-                                      Eigen::Vector3d(3.5, -2, 100)}) {
+    const VolumeGeometry g =
+        VolumeGeometry::make({10, 20, 30}, {0.5, 1.3, 7.2}, {-100, 20, 3}, rot);
+    for (const Eigen::Vector3d& ijk :
+         {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(9, 19, 29), Eigen::Vector3d(3.5, -2, 100)}) {
       const Eigen::Vector3d ras = g.voxelToRas(ijk.x(), ijk.y(), ijk.z());
       EXPECT_LT((g.rasToVoxel(ras) - ijk).norm(), 1e-9);
     }

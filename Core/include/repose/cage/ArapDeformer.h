@@ -15,7 +15,7 @@ struct ArapOptions {
 };
 
 struct ArapResult {
-  Eigen::MatrixX3d positions;    // #V by 3, handles exactly at their targets
+  Eigen::MatrixX3d positions;  // #V by 3, handles exactly at their targets
   int iterations = 0;
   std::vector<double> energies;  // ARAP energy after each iteration (non-increasing)
 };

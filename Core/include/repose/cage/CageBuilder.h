@@ -28,9 +28,9 @@ struct LimbSeparation {
 };
 
 struct CageOptions {
-  int targetVertices = 300;    // 50..2000
-  double dilateMm = 10.0;      // exact Euclidean dilation of the body
-  double workingVoxelMm = 0;   // 0: chosen from the dilation and the input spacing
+  int targetVertices = 300;   // 50..2000
+  double dilateMm = 10.0;     // exact Euclidean dilation of the body
+  double workingVoxelMm = 0;  // 0: chosen from the dilation and the input spacing
   std::vector<LimbSeparation> separations;
   int threads = 0;
   ProgressFn progress;
@@ -38,12 +38,13 @@ struct CageOptions {
 
 struct CageReport {
   int vertices = 0, faces = 0;
-  int denseVertices = 0;          // restricted Delaunay surface before simplification
+  int denseVertices = 0;  // restricted Delaunay surface before simplification
   double workingVoxelMm = 0;
-  std::string simplification;     // quadric policy that gave the cage: garland-heckbert or lindstrom-turk
-  int frozenVertices = 0;         // dense vertices kept to undo a self-intersecting simplification
+  std::string
+      simplification;      // quadric policy that gave the cage: garland-heckbert or lindstrom-turk
+  int frozenVertices = 0;  // dense vertices kept to undo a self-intersecting simplification
   bool closed = false, manifold = false, outward = false, selfIntersectionFree = false;
-  std::int64_t bodyVoxels = 0;    // voxels of S != 0
+  std::int64_t bodyVoxels = 0;      // voxels of S != 0
   std::int64_t enclosedVoxels = 0;  // of those, inside the cage
   double enclosedFraction() const { return bodyVoxels ? double(enclosedVoxels) / bodyVoxels : 0; }
   bool valid() const { return closed && manifold && outward && selfIntersectionFree; }

@@ -17,8 +17,8 @@ struct ReadOptions {
 };
 
 struct WriteOptions {
-  int niftiVersion = 1;   // 1 or 2; NIfTI-1 is switched to 2 when a dimension exceeds 32767
-  bool compress = true;   // gzip for .nhdr data and .nrrd; .nii.gz/.nii decide by their name
+  int niftiVersion = 1;  // 1 or 2; NIfTI-1 is switched to 2 when a dimension exceeds 32767
+  bool compress = true;  // gzip for .nhdr data and .nrrd; .nii.gz/.nii decide by their name
   ProgressFn progress;
 };
 

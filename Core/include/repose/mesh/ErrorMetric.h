@@ -20,10 +20,12 @@ Eigen::VectorXd vertexErrors(const TransferMesh& mesh, const Eigen::VectorXd& te
 // Scan-converts every rest tet onto `grid`, interpolating the per-vertex values barycentrically
 // at voxel centres. covered (optional) marks the voxels inside some tet; others get 0.
 std::vector<float> rasterizeVertexField(const TransferMesh& mesh, const Eigen::VectorXd& values,
-                                        const VolumeGeometry& grid, std::vector<char>* covered = nullptr);
+                                        const VolumeGeometry& grid,
+                                        std::vector<char>* covered = nullptr);
 
 // eq. 7: F[v] *= cbrt(e_mean / max(e^G[v], e_mean)) over covered voxels, e_mean their mean
 // error. errorGrid and covered are on F's grid. Returns e_mean.
-double updateSizingField(SizingField& F, const std::vector<float>& errorGrid, const std::vector<char>& covered);
+double updateSizingField(SizingField& F, const std::vector<float>& errorGrid,
+                         const std::vector<char>& covered);
 
 }  // namespace repose

@@ -24,7 +24,8 @@ class RigiditySolver {
 
   // targets: #constrainedVertices by 3 (the Green-coordinate positions, in the order given).
   // Returns all #V deformed positions; B (optional) receives each tet's 3x3 linear map.
-  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets, std::vector<Eigen::Matrix3d>* B = nullptr) const;
+  Eigen::MatrixX3d solve(const Eigen::MatrixX3d& targets,
+                         std::vector<Eigen::Matrix3d>* B = nullptr) const;
 
   int unconstrainedVertices() const;
 
@@ -44,7 +45,8 @@ class CageDeformation {
   const Embedding& embedding() const { return embedding_; }
   const RigiditySolver& solver() const { return solver_; }
   // deformedCage: #cage vertices by 3. Returns #V TM positions (and tet maps if B is given).
-  Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage, std::vector<Eigen::Matrix3d>* B = nullptr) const;
+  Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage,
+                          std::vector<Eigen::Matrix3d>* B = nullptr) const;
 
  private:
   TriangleMesh cage_;

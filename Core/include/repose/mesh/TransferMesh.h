@@ -31,15 +31,15 @@ struct SizingField {
 };
 
 struct TransferMeshOptions {
-  double sizeMm = 0;                 // uniform size; 0: 5% of S's diagonal (the seed's default)
+  double sizeMm = 0;                    // uniform size; 0: 5% of S's diagonal (the seed's default)
   const SizingField* sizing = nullptr;  // overrides sizeMm when set
   ProgressFn progress;
 };
 
 struct TransferMeshReport {
   int vertices = 0, tets = 0;
-  int degenerateTets = 0;  // |volume| below 1e-9 of the mean: removed
-  int invertedTets = 0;    // negative volume after meshing: reoriented
+  int degenerateTets = 0;                         // |volume| below 1e-9 of the mean: removed
+  int invertedTets = 0;                           // negative volume after meshing: reoriented
   std::vector<std::pair<int, int>> tetsPerLabel;  // (label, count)
 };
 

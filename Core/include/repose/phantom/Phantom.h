@@ -28,11 +28,20 @@ struct Joint {
 // Body-part labels of S (stable numbers; tests and pose files rely on them).
 enum PhantomPart : std::uint8_t {
   kPartBackground = 0,
-  kPartHead = 1, kPartTorso = 2,
-  kPartUpperArmLeft = 3, kPartForearmLeft = 4, kPartHandLeft = 5,
-  kPartUpperArmRight = 6, kPartForearmRight = 7, kPartHandRight = 8,
-  kPartThighLeft = 9, kPartShankLeft = 10, kPartFootLeft = 11,
-  kPartThighRight = 12, kPartShankRight = 13, kPartFootRight = 14,
+  kPartHead = 1,
+  kPartTorso = 2,
+  kPartUpperArmLeft = 3,
+  kPartForearmLeft = 4,
+  kPartHandLeft = 5,
+  kPartUpperArmRight = 6,
+  kPartForearmRight = 7,
+  kPartHandRight = 8,
+  kPartThighLeft = 9,
+  kPartShankLeft = 10,
+  kPartFootLeft = 11,
+  kPartThighRight = 12,
+  kPartShankRight = 13,
+  kPartFootRight = 14,
 };
 
 class Phantom {

@@ -10,12 +10,12 @@
 namespace repose {
 
 struct Label {
-  int value = 0;                          // voxel value of this label (in its layer)
-  std::string name;                       // e.g. "liver"
+  int value = 0;                               // voxel value of this label (in its layer)
+  std::string name;                            // e.g. "liver"
   std::array<double, 3> color{0.5, 0.5, 0.5};  // RGB in [0,1]
-  int layer = 0;                          // layer of a multi-layer segmentation, else 0
-  std::string id;                         // Slicer segment ID; empty when the file had none
-  std::string tags;                       // Slicer segment tags (terminology), verbatim
+  int layer = 0;                               // layer of a multi-layer segmentation, else 0
+  std::string id;                              // Slicer segment ID; empty when the file had none
+  std::string tags;                            // Slicer segment tags (terminology), verbatim
 };
 
 class LabelTable {

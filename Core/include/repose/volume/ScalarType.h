@@ -14,22 +14,44 @@ std::size_t scalarSize(ScalarType t);
 const char* scalarTypeName(ScalarType t);
 bool isIntegerType(ScalarType t);
 
-template <class T> constexpr ScalarType scalarTypeOf();
-template <> constexpr ScalarType scalarTypeOf<std::uint8_t>() { return ScalarType::UInt8; }
-template <> constexpr ScalarType scalarTypeOf<std::uint16_t>() { return ScalarType::UInt16; }
-template <> constexpr ScalarType scalarTypeOf<std::int16_t>() { return ScalarType::Int16; }
-template <> constexpr ScalarType scalarTypeOf<std::int32_t>() { return ScalarType::Int32; }
-template <> constexpr ScalarType scalarTypeOf<float>() { return ScalarType::Float32; }
+template <class T>
+constexpr ScalarType scalarTypeOf();
+template <>
+constexpr ScalarType scalarTypeOf<std::uint8_t>() {
+  return ScalarType::UInt8;
+}
+template <>
+constexpr ScalarType scalarTypeOf<std::uint16_t>() {
+  return ScalarType::UInt16;
+}
+template <>
+constexpr ScalarType scalarTypeOf<std::int16_t>() {
+  return ScalarType::Int16;
+}
+template <>
+constexpr ScalarType scalarTypeOf<std::int32_t>() {
+  return ScalarType::Int32;
+}
+template <>
+constexpr ScalarType scalarTypeOf<float>() {
+  return ScalarType::Float32;
+}
 
 // Calls f with a null pointer of the C++ type matching t, so generic code can switch on type once:
 //   dispatchScalar(t, [&](auto* tag) { using T = std::remove_pointer_t<decltype(tag)>; ... });
-template <class F> decltype(auto) dispatchScalar(ScalarType t, F&& f) {
+template <class F>
+decltype(auto) dispatchScalar(ScalarType t, F&& f) {
   switch (t) {
-    case ScalarType::UInt8: return f(static_cast<std::uint8_t*>(nullptr));
-    case ScalarType::UInt16: return f(static_cast<std::uint16_t*>(nullptr));
-    case ScalarType::Int16: return f(static_cast<std::int16_t*>(nullptr));
-    case ScalarType::Int32: return f(static_cast<std::int32_t*>(nullptr));
-    case ScalarType::Float32: break;
+    case ScalarType::UInt8:
+      return f(static_cast<std::uint8_t*>(nullptr));
+    case ScalarType::UInt16:
+      return f(static_cast<std::uint16_t*>(nullptr));
+    case ScalarType::Int16:
+      return f(static_cast<std::int16_t*>(nullptr));
+    case ScalarType::Int32:
+      return f(static_cast<std::int32_t*>(nullptr));
+    case ScalarType::Float32:
+      break;
   }
   return f(static_cast<float*>(nullptr));
 }

@@ -33,8 +33,13 @@ class Volume {
   // Voxel (i,j,k) of a layer is at index i + dims[0]*(j + dims[1]*k) of layerData(layer).
   void* layerData(int layer = 0);
   const void* layerData(int layer = 0) const;
-  template <class T> T* data(int layer = 0) { checkType<T>(); return static_cast<T*>(layerData(layer)); }
-  template <class T> const T* data(int layer = 0) const {
+  template <class T>
+  T* data(int layer = 0) {
+    checkType<T>();
+    return static_cast<T*>(layerData(layer));
+  }
+  template <class T>
+  const T* data(int layer = 0) const {
     checkType<T>();
     return static_cast<const T*>(layerData(layer));
   }
@@ -46,7 +51,8 @@ class Volume {
   const std::vector<std::uint8_t>& bytes() const { return bytes_; }
 
  private:
-  template <class T> void checkType() const;
+  template <class T>
+  void checkType() const;
   VolumeGeometry geometry_;
   ScalarType type_ = ScalarType::UInt8;
   int layers_ = 1;
@@ -60,7 +66,8 @@ class Volume {
 #include "repose/util/Error.h"
 
 namespace repose {
-template <class T> void Volume::checkType() const {
+template <class T>
+void Volume::checkType() const {
   if (scalarTypeOf<T>() != type_)
     throw Error(std::string("volume holds ") + scalarTypeName(type_) + ", not " +
                 scalarTypeName(scalarTypeOf<T>()));
