@@ -13,6 +13,7 @@ int runInfo(const Args& args);
 int runConvert(const Args& args);
 int runPhantom(const Args& args);
 int runCage(const Args& args);
+int runMesh(const Args& args);
 
 struct Command {
   const char* name;
@@ -27,6 +28,7 @@ inline const Command kCommands[] = {
     {"phantom", "generate the synthetic whole-body mannequin (organs G, parts S, skeleton)",
      runPhantom},
     {"cage", "build the control cage around the body (optionally separating two parts)", runCage},
+    {"mesh", "build the transfer mesh and embed it in the cage", runMesh},
 };
 
 }  // namespace repose::cli

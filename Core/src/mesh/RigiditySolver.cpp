@@ -6,6 +6,7 @@
 #include "TetAdjacency.h"
 #include "numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
+#include "repose/util/Parallel.h"
 
 #include <Eigen/LU>
 #include <algorithm>
@@ -294,13 +295,46 @@ Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets,
 CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads)
     : cage_(cage),
       embedding_(embedInCage(mesh, cage, threads)),
-      solver_(mesh, embedding_.cageVertices, embedding_.cageTets) {}
+      solver_(mesh, embedding_.cageVertices, embedding_.cageTets),
+      threads_(threads) {
+  const GreenCoordinates& gc = embedding_.coordinates;
+  coefficients_.resize(gc.phi.rows(), gc.phi.cols() + gc.psi.cols());
+  coefficients_ << gc.phi.cast<float>(), gc.psi.cast<float>();
+  phiSum_ = gc.phi.rowwise().sum();
+  embedding_.coordinates = GreenCoordinates();  // the compact copy is what frames use
+}
+
+Eigen::MatrixX3d CageDeformation::greenPositions(const Eigen::MatrixX3d& deformedCage) const {
+  if (deformedCage.rows() != cage_.vertices.rows())
+    throw Error("deformed cage has the wrong number of vertices");
+  // Coordinates relative to the deformed centroid keep float coefficients accurate for bodies
+  // far from the origin: sum phi_i v_i = sum phi_i (v_i - c) + c sum phi_i.
+  const Eigen::RowVector3d centre = deformedCage.colwise().mean();
+  const Eigen::MatrixX3d normals = faceNormals(deformedCage, cage_.faces);
+  const Eigen::VectorXd stretch = greenFaceStretch(cage_, deformedCage);
+  const Eigen::Index nv = deformedCage.rows(), nf = cage_.faces.rows();
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(nv + nf, 3);
+  x.topRows(nv) = deformedCage.rowwise() - centre;
+  x.bottomRows(nf) = stretch.asDiagonal() * normals;
+  Eigen::MatrixX3d out(coefficients_.rows(), 3);
+  parallelFor(coefficients_.rows(), threads_, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {
+      const float* a = coefficients_.row(r).data();
+      const double* xi = x.data();
+      double y0 = 0, y1 = 0, y2 = 0;
+      for (Eigen::Index i = 0; i < nv + nf; ++i, xi += 3) {
+        const double w = a[i];
+        y0 += w * xi[0], y1 += w * xi[1], y2 += w * xi[2];
+      }
+      out.row(r) = Eigen::RowVector3d(y0, y1, y2) + phiSum_[r] * centre;
+    }
+  });
+  return out;
+}
 
 Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
                                          std::vector<Eigen::Matrix3d>* B) const {
-  if (deformedCage.rows() != cage_.vertices.rows())
-    throw Error("deformed cage has the wrong number of vertices");
-  return solver_.solve(applyGreenCoordinates(embedding_.coordinates, cage_, deformedCage), B);
+  return solver_.solve(greenPositions(deformedCage), B);
 }
 
 }  // namespace repose

@@ -39,11 +39,16 @@ Eigen::Matrix3d tetLinearMap(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3
                              const Eigen::RowVector4i& tet);
 
 // One interaction frame: deformed cage -> Green coordinates on V_c -> rigidity solve.
+// The dense coordinate matrix [phi psi] (V_c rows) is the frame's largest cost and is memory-
+// bound, so it is kept once, compactly: row-major float, read row by row on all cores with
+// double accumulation (the double copy is dropped after construction).
 class CageDeformation {
  public:
   CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0);
   const Embedding& embedding() const { return embedding_; }
   const RigiditySolver& solver() const { return solver_; }
+  // Positions of V_c (rows follow embedding().cageVertices) for a deformed cage.
+  Eigen::MatrixX3d greenPositions(const Eigen::MatrixX3d& deformedCage) const;
   // deformedCage: #cage vertices by 3. Returns #V TM positions (and tet maps if B is given).
   Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage,
                           std::vector<Eigen::Matrix3d>* B = nullptr) const;
@@ -52,6 +57,9 @@ class CageDeformation {
   TriangleMesh cage_;
   Embedding embedding_;
   RigiditySolver solver_;
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> coefficients_;  // [phi psi]
+  Eigen::VectorXd phiSum_;  // row sums of phi in double: the centroid term stays exact
+  int threads_ = 0;
 };
 
 }  // namespace repose

@@ -47,9 +47,10 @@ struct TransferMeshReport {
 TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& options = {},
                                TransferMeshReport* report = nullptr);
 
-// Inside `region`, duplicates every vertex on a face shared by a tet of label a and a tet of
-// label b, and re-indexes the b-side tets onto the copies, so the two sides can move apart.
-// Returns the number of vertices added. Throws if a or b has no tet.
+// Inside `region`, duplicates every vertex shared by a tet of label a and a tet of label b (on a
+// common face, as the seed says, but also along an edge or at a single vertex), and re-indexes
+// the b tets onto the copies, so the two sides can move apart. Returns the number of vertices
+// added. Throws if a or b has no tet.
 int separateLabels(TransferMesh& mesh, int labelA, int labelB, const Region& region);
 
 // VTK XML unstructured grid (.vtu) with a cell array "label"; RAS mm. Atomic write.

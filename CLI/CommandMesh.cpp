@@ -1,0 +1,92 @@
+// `repose mesh --parts S --cage cage.obj --out tm.vtu`: the labelled transfer mesh, optionally
+// split between two body parts, with how much of it the cage holds (V_c) and what it misses.
+#include "ArgParser.h"
+#include "Commands.h"
+#include "TerminalProgress.h"
+
+#include "repose/io/AtomicOutput.h"
+#include "repose/io/MeshIO.h"
+#include "repose/io/VolumeIO.h"
+#include "repose/mesh/Embedding.h"
+#include "repose/mesh/RigiditySolver.h"
+#include "repose/mesh/TransferMesh.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <iostream>
+
+namespace repose::cli {
+
+int runMesh(const Args& args) {
+  ArgParser p(
+      "mesh",
+      "Build the transfer mesh: a tetrahedral mesh of the body parts of PARTS (CGAL Mesh_3,\n"
+      "one label per tet), embed it in the cage (vertices inside it get Green coordinates;\n"
+      "the others, the outliers, follow through the rigidity solver) and write it as a VTK\n"
+      "unstructured grid (.vtu, RAS mm, cell array 'label').");
+  p.option("parts", "FILE", "body-part map S (or any label map)")
+      .option("cage", "FILE", "cage from `repose cage` (.obj or .vtk)")
+      .option("out", "FILE", "output transfer mesh (.vtu)")
+      .option("size-mm", "MM", "tet size (0: 5% of the volume's diagonal)", "0")
+      .option("separate", "A:B", "split the mesh between body-part labels A and B inside --region")
+      .option("region", "SPEC", "box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r in RAS mm")
+      .option("threads", "N", "worker threads (0: all cores)", "0")
+      .flag("json", "print a JSON summary on stdout");
+  if (!p.parse(args)) return 0;
+  for (const char* required : {"parts", "cage", "out"})
+    if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
+  if (p.has("separate") != p.has("region")) throw UsageError{"--separate and --region go together"};
+  const std::string out = p.get("out");
+  refuseOverwritingInput(p.get("parts"), out);
+  AtomicOutput probe(out);  // an unwritable output fails before the work
+  const auto start = std::chrono::steady_clock::now();
+  const Volume parts = readVolume(p.get("parts"));
+  const TriangleMesh cage = readTriangleMesh(p.get("cage"));
+  TransferMeshOptions o;
+  o.sizeMm = p.getDouble("size-mm");
+  if (o.sizeMm < 0) throw UsageError{"--size-mm must be >= 0"};
+  o.progress = terminalProgress();
+  TransferMeshReport report;
+  TransferMesh mesh = buildTransferMesh(parts, o, &report);
+  int added = 0;
+  if (p.has("separate")) {
+    const auto [a, b] = parseLabelPair(p.get("separate"), "separate");
+    added = separateLabels(mesh, a, b, Region::parse(p.get("region")));
+  }
+  const int threads = static_cast<int>(p.getInt("threads"));
+  const Embedding embedding = embedInCage(mesh, cage, threads);
+  const RigiditySolver solver(mesh, embedding.cageVertices, embedding.cageTets);
+  writeTransferMesh(mesh, out);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  nlohmann::json labels = nlohmann::json::object();
+  for (const auto& [label, count] : report.tetsPerLabel) labels[std::to_string(label)] = count;
+  const nlohmann::json j = {{"mesh", out},
+                            {"vertices", mesh.vertices.rows()},
+                            {"tets", mesh.tets.rows()},
+                            {"tets_per_label", labels},
+                            {"degenerate_tets_removed", report.degenerateTets},
+                            {"inverted_tets_reoriented", report.invertedTets},
+                            {"separation_vertices_added", added},
+                            {"vertices_inside_cage", embedding.cageVertices.size()},
+                            {"tets_inside_cage", embedding.cageTets.size()},
+                            {"outliers", embedding.outliers()},
+                            {"unreachable_vertices", solver.unconstrainedVertices()},
+                            {"seconds", seconds}};
+  if (p.has("json")) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "wrote " << out << ": " << mesh.vertices.rows() << " vertices, "
+              << mesh.tets.rows() << " tets\n"
+              << "inside the cage: " << embedding.cageVertices.size() << " vertices, "
+              << embedding.cageTets.size()
+              << " tets; outliers (moved by the rigidity solver): " << embedding.outliers() << "\n";
+    if (solver.unconstrainedVertices() > 0)
+      std::cout << "warning: " << solver.unconstrainedVertices()
+                << " vertices belong to parts with no vertex in the cage; they will not move\n";
+  }
+  return 0;
+}
+
+}  // namespace repose::cli

@@ -1,0 +1,89 @@
+// Small pieces of the transfer mesh: tet volume, the sizing field, and label separation.
+#include "repose/mesh/TransferMesh.h"
+
+#include "repose/util/Error.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <vector>
+
+namespace repose {
+
+double tetVolume(const Eigen::MatrixX3d& vertices, const Eigen::RowVector4i& tet) {
+  Eigen::Matrix3d E;
+  for (int c = 0; c < 3; ++c)
+    E.col(c) = (vertices.row(tet[c + 1]) - vertices.row(tet[0])).transpose();
+  return E.determinant() / 6;
+}
+
+SizingField SizingField::uniform(const VolumeGeometry& grid, double sizeMm) {
+  if (!(sizeMm > 0) || !std::isfinite(sizeMm))
+    throw Error("tet size must be a positive number of mm");
+  SizingField f;
+  f.grid = grid;
+  f.sizeMm.assign(static_cast<std::size_t>(grid.numVoxels()), static_cast<float>(sizeMm));
+  return f;
+}
+
+double SizingField::at(const Eigen::Vector3d& ras) const {
+  const Eigen::Vector3d x = grid.rasToVoxel(ras);
+  std::int64_t i0[3];
+  double f[3];
+  for (int c = 0; c < 3; ++c) {
+    const double clamped = std::clamp(x[c], 0.0, double(grid.dims[c] - 1));
+    i0[c] = std::min<std::int64_t>(static_cast<std::int64_t>(clamped),
+                                   std::max<std::int64_t>(0, grid.dims[c] - 2));
+    f[c] = grid.dims[c] > 1 ? clamped - i0[c] : 0;
+  }
+  auto v = [&](int di, int dj, int dk) {
+    const std::int64_t i = std::min(i0[0] + di, grid.dims[0] - 1),
+                       j = std::min(i0[1] + dj, grid.dims[1] - 1),
+                       k = std::min(i0[2] + dk, grid.dims[2] - 1);
+    return double(sizeMm[static_cast<std::size_t>(i + grid.dims[0] * (j + grid.dims[1] * k))]);
+  };
+  const double c00 = v(0, 0, 0) * (1 - f[0]) + v(1, 0, 0) * f[0],
+               c10 = v(0, 1, 0) * (1 - f[0]) + v(1, 1, 0) * f[0];
+  const double c01 = v(0, 0, 1) * (1 - f[0]) + v(1, 0, 1) * f[0],
+               c11 = v(0, 1, 1) * (1 - f[0]) + v(1, 1, 1) * f[0];
+  return (c00 * (1 - f[1]) + c10 * f[1]) * (1 - f[2]) + (c01 * (1 - f[1]) + c11 * f[1]) * f[2];
+}
+
+int separateLabels(TransferMesh& mesh, int labelA, int labelB, const Region& region) {
+  bool hasA = false, hasB = false;
+  for (Eigen::Index t = 0; t < mesh.labels.size(); ++t)
+    hasA |= mesh.labels[t] == labelA, hasB |= mesh.labels[t] == labelB;
+  if (!hasA || !hasB)
+    throw Error("separation: label " + std::to_string(!hasA ? labelA : labelB) +
+                " has no tetrahedron in the mesh");
+  // The seed duplicates the vertices of faces shared by an a-tet and a b-tet. Tets that touch
+  // only along an edge or at a vertex would still tie the parts together, so every vertex inside
+  // the region used by both an a-tet and a b-tet is split (a superset of the face rule).
+  std::vector<char> usedByA(static_cast<std::size_t>(mesh.vertices.rows()), 0), usedByB(usedByA);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    for (int c = 0; c < 4; ++c) {
+      if (mesh.labels[t] == labelA) usedByA[mesh.tets(t, c)] = 1;
+      if (mesh.labels[t] == labelB) usedByB[mesh.tets(t, c)] = 1;
+    }
+  std::set<int> split;
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+    if (usedByA[v] && usedByB[v] && region.contains(mesh.vertices.row(v).transpose()))
+      split.insert(static_cast<int>(v));
+  // Each split vertex gets one copy; every b-tet using it moves onto the copy.
+  std::map<int, int> copy;
+  const Eigen::Index before = mesh.vertices.rows();
+  for (int v : split) copy[v] = static_cast<int>(before + static_cast<Eigen::Index>(copy.size()));
+  mesh.vertices.conservativeResize(before + static_cast<Eigen::Index>(copy.size()), 3);
+  for (const auto& [v, c] : copy) mesh.vertices.row(c) = mesh.vertices.row(v);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (mesh.labels[t] != labelB) continue;
+    for (int c = 0; c < 4; ++c)
+      if (auto it = copy.find(mesh.tets(t, c)); it != copy.end()) mesh.tets(t, c) = it->second;
+  }
+  return static_cast<int>(copy.size());
+}
+
+}  // namespace repose

@@ -1,0 +1,112 @@
+// The transfer mesh as a VTK XML unstructured grid (ASCII), readable by ParaView, 3D Slicer and
+// VTK's vtkXMLUnstructuredGridReader; the reader here reads this layout back, not every VTU.
+#include "repose/io/AtomicOutput.h"
+#include "repose/mesh/TransferMesh.h"
+#include "repose/util/Error.h"
+
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace repose {
+namespace {
+
+// The whitespace-separated numbers inside the <DataArray ... Name="name"> element.
+std::istringstream dataArray(const std::string& xml, const std::string& name,
+                             const std::string& path) {
+  const std::size_t tag = xml.find("Name=\"" + name + "\"");
+  if (tag == std::string::npos) throwFileError(path, "no DataArray named " + name);
+  const std::size_t open = xml.rfind("<DataArray", tag), start = xml.find('>', tag),
+                    end = xml.find("</DataArray>", tag);
+  if (open == std::string::npos || start == std::string::npos || end == std::string::npos ||
+      start > end)
+    throwFileError(path, "malformed DataArray " + name);
+  const std::string header = xml.substr(open, start - open);
+  if (header.find("format=\"ascii\"") == std::string::npos)
+    throwFileError(
+        path, "DataArray " + name + " is not ASCII (binary and appended VTU are not supported)");
+  return std::istringstream(xml.substr(start + 1, end - start - 1));
+}
+
+long attribute(const std::string& xml, const std::string& name, const std::string& path) {
+  const std::size_t at = xml.find(name + "=\"");
+  if (at == std::string::npos) throwFileError(path, "missing " + name);
+  return std::strtol(xml.c_str() + at + name.size() + 2, nullptr, 10);
+}
+
+}  // namespace
+
+void writeTransferMesh(const TransferMesh& mesh, const std::string& path) {
+  AtomicOutput output(path);
+  {
+    std::ofstream out(output.tempPath());
+    if (!out) throwFileError(path, "cannot create the file");
+    out << std::setprecision(17);
+    out << "<?xml version=\"1.0\"?>\n<!-- Repose transfer mesh: RAS millimetres, cell array "
+           "'label' -->\n"
+        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+           "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
+        << "<Piece NumberOfPoints=\"" << mesh.vertices.rows() << "\" NumberOfCells=\""
+        << mesh.tets.rows() << "\">\n"
+        << "<Points>\n<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" "
+           "format=\"ascii\">\n";
+    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+      out << mesh.vertices(v, 0) << " " << mesh.vertices(v, 1) << " " << mesh.vertices(v, 2)
+          << "\n";
+    out << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
+           "format=\"ascii\">\n";
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+      out << mesh.tets(t, 0) << " " << mesh.tets(t, 1) << " " << mesh.tets(t, 2) << " "
+          << mesh.tets(t, 3) << "\n";
+    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) out << 4 * (t + 1) << "\n";
+    out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) out << "10\n";  // VTK_TETRA
+    out << "</DataArray>\n</Cells>\n<CellData Scalars=\"label\">\n<DataArray type=\"Int32\" "
+           "Name=\"label\" format=\"ascii\">\n";
+    for (Eigen::Index t = 0; t < mesh.labels.size(); ++t) out << mesh.labels[t] << "\n";
+    out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    if (!out.flush()) throwFileError(path, "write failed (disk full?)");
+  }
+  output.commit();
+}
+
+TransferMesh readTransferMesh(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throwFileError(path, "file not found or unreadable");
+  const std::string xml((std::istreambuf_iterator<char>(in)), {});
+  if (xml.find("<VTKFile") == std::string::npos ||
+      xml.find("UnstructuredGrid") == std::string::npos)
+    throwFileError(path, "not a VTK XML unstructured grid (.vtu)");
+  const long points = attribute(xml, "NumberOfPoints", path),
+             cells = attribute(xml, "NumberOfCells", path);
+  if (points <= 0 || cells <= 0) throwFileError(path, "no points or no cells");
+  TransferMesh mesh;
+  mesh.vertices.resize(points, 3);
+  auto p = dataArray(xml, "Points", path);
+  for (long v = 0; v < points; ++v)
+    if (!(p >> mesh.vertices(v, 0) >> mesh.vertices(v, 1) >> mesh.vertices(v, 2)))
+      throwFileError(path, "truncated Points");
+  mesh.tets.resize(cells, 4);
+  auto c = dataArray(xml, "connectivity", path);
+  for (long t = 0; t < cells; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (!(c >> mesh.tets(t, k)))
+        throwFileError(path, "truncated connectivity (only tetrahedra are supported)");
+  auto types = dataArray(xml, "types", path);
+  for (long t = 0; t < cells; ++t) {
+    int type = 0;
+    if (!(types >> type) || type != 10)
+      throwFileError(path, "cell " + std::to_string(t) + " is not a tetrahedron");
+  }
+  mesh.labels.resize(cells);
+  auto l = dataArray(xml, "label", path);
+  for (long t = 0; t < cells; ++t)
+    if (!(l >> mesh.labels[t])) throwFileError(path, "truncated label array");
+  if (mesh.tets.minCoeff() < 0 || mesh.tets.maxCoeff() >= points)
+    throwFileError(path, "a cell uses a point that does not exist");
+  if (!mesh.vertices.allFinite()) throwFileError(path, "point coordinates are not finite");
+  return mesh;
+}
+
+}  // namespace repose

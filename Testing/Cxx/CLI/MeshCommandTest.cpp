@@ -1,0 +1,49 @@
+// `repose mesh` as a user runs it: phantom -> cage -> transfer mesh with its JSON summary, and a
+// separation; bad requests fail with one line and write nothing.
+#include "CommandRunner.h"
+#include "TestPaths.h"
+
+#include "repose/mesh/TransferMesh.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+using namespace repose;
+using namespace repose::test;
+
+TEST(MeshCommand, BuildsEmbedsAndWritesTheTransferMesh) {
+  ScratchDir dir;
+  const std::string d = shellQuote(dir.path().string());
+  ASSERT_EQ(runCommand("repose", "phantom --voxel 4 --arms-touching --out " + d).exitCode, 0);
+  const std::string parts = shellQuote(dir.file("S.nii.gz")),
+                    cage = shellQuote(dir.file("cage.obj"));
+  ASSERT_EQ(runCommand("repose", "cage --parts " + parts + " --out " + cage).exitCode, 0);
+  const CommandResult r =
+      runCommand("repose", "mesh --parts " + parts + " --cage " + cage + " --out " +
+                               shellQuote(dir.file("tm.vtu")) + " --size-mm 30 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const TransferMesh tm = readTransferMesh(dir.file("tm.vtu"));
+  EXPECT_EQ(j["vertices"].get<long>(), tm.vertices.rows());
+  EXPECT_EQ(j["tets"].get<long>(), tm.tets.rows());
+  EXPECT_EQ(j["vertices_inside_cage"].get<long>() + j["outliers"].get<long>(), tm.vertices.rows());
+  EXPECT_EQ(j["inverted_tets_reoriented"], 0);
+  const CommandResult sep = runCommand(
+      "repose", "mesh --parts " + parts + " --cage " + cage + " --out " +
+                    shellQuote(dir.file("sep.vtu")) +
+                    " --size-mm 30 --separate 9:5 --region sphere:-136,9,526,110 --json");
+  ASSERT_EQ(sep.exitCode, 0) << sep.err;
+  EXPECT_GT(nlohmann::json::parse(sep.out)["separation_vertices_added"].get<int>(), 0);
+  for (const std::string extra : {"--separate 5", "--size-mm -3", ""}) {
+    const std::string out = dir.file("bad.vtu");
+    const std::string cmd = extra.empty() ? "mesh --parts " + parts + " --out " + shellQuote(out)
+                                          : "mesh --parts " + parts + " --cage " + cage +
+                                                " --out " + shellQuote(out) + " " + extra;
+    const CommandResult bad = runCommand("repose", cmd);
+    EXPECT_NE(bad.exitCode, 0) << extra;
+    EXPECT_EQ(lineCount(bad.err), 1) << bad.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+}

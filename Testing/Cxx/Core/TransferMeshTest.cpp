@@ -1,0 +1,144 @@
+// The transfer mesh from CGAL Mesh_3: positive tets whose labels follow S, the body's volume,
+// the sizing field's effect; label separation that lets a hand leave the hip; .vtu round trips.
+#include "TestPaths.h"
+
+#include "repose/io/VolumeIO.h"
+#include "repose/mesh/TransferMesh.h"
+#include "repose/phantom/Phantom.h"
+#include "repose/util/Error.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <set>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+const Volume& phantomParts(bool armsTouching) {
+  static std::map<bool, Volume> cache;
+  if (auto it = cache.find(armsTouching); it != cache.end()) return it->second;
+  PhantomOptions o;
+  o.voxelMm = 4;
+  o.armsTouching = armsTouching;
+  return cache.emplace(armsTouching, Phantom(o).makeVolumes().second).first->second;
+}
+
+TransferMesh phantomMesh(bool armsTouching, double size, TransferMeshReport* report = nullptr) {
+  TransferMeshOptions o;
+  o.sizeMm = size;
+  return buildTransferMesh(phantomParts(armsTouching), o, report);
+}
+
+}  // namespace
+
+TEST(TransferMesh, PositiveTetsWhoseLabelsFollowTheSegmentation) {
+  TransferMeshReport report;
+  const TransferMesh mesh = phantomMesh(false, 30, &report);
+  const Volume& s = phantomParts(false);
+  EXPECT_EQ(report.vertices, mesh.vertices.rows());
+  EXPECT_EQ(report.tets, mesh.tets.rows());
+  double volume = 0;
+  int agree = 0;
+  std::set<int> labels;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    const double v = tetVolume(mesh.vertices, mesh.tets.row(t));
+    ASSERT_GT(v, 0) << "tet " << t;
+    volume += v;
+    labels.insert(mesh.labels[t]);
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += mesh.vertices.row(mesh.tets(t, k)).transpose() / 4;
+    const Eigen::Vector3d ijk = s.geometry().rasToVoxel(c);
+    const std::int64_t i = std::lround(ijk.x()), j = std::lround(ijk.y()), k = std::lround(ijk.z());
+    if (i >= 0 && j >= 0 && k >= 0 && i < s.dims()[0] && j < s.dims()[1] && k < s.dims()[2])
+      agree += s.data<std::uint8_t>()[s.index(i, j, k)] == mesh.labels[t];
+  }
+  EXPECT_EQ(labels.size(), 14u);
+  EXPECT_GE(agree, 0.95 * mesh.tets.rows());
+  std::int64_t bodyVoxels = 0;
+  for (std::int64_t n = 0; n < s.numVoxels(); ++n) bodyVoxels += s.data<std::uint8_t>()[n] != 0;
+  EXPECT_NEAR(volume, bodyVoxels * 64.0, 0.05 * bodyVoxels * 64.0);
+}
+
+TEST(TransferMesh, SmallerSizeGivesMoreVertices) {
+  // Surface vertices are set by the one-voxel facet distance, so the growth is less than cubic.
+  EXPECT_GT(phantomMesh(false, 15).vertices.rows(), phantomMesh(false, 50).vertices.rows());
+}
+
+TEST(SizingField, TrilinearInsideAndClampedOutside) {
+  SizingField f = SizingField::uniform(VolumeGeometry::make({2, 2, 2}, {10, 10, 10}, {0, 0, 0}), 5);
+  f.sizeMm = {0, 10, 0, 10, 0, 10, 0, 10};  // grows with x
+  EXPECT_DOUBLE_EQ(f.at({5, 3, 7}), 5);
+  EXPECT_DOUBLE_EQ(f.at({-50, 0, 0}), 0);
+  EXPECT_DOUBLE_EQ(f.at({50, 0, 0}), 10);
+  EXPECT_THROW(SizingField::uniform(f.grid, -1), Error);
+}
+
+TEST(TransferMesh, RealSegmentationTouchingTheBorderMeshesCleanly) {
+  const Volume seg = readVolume(dataPath("totalsegmentator/example_seg.nii.gz"));
+  TransferMeshOptions o;
+  o.sizeMm = 20;
+  TransferMeshReport report;
+  const TransferMesh mesh = buildTransferMesh(seg, o, &report);
+  EXPECT_GT(report.tets, 100);
+  EXPECT_EQ(report.invertedTets, 0);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) ASSERT_GT(tetVolume(mesh.vertices, mesh.tets.row(t)), 0);
+}
+
+TEST(TransferMesh, SeparationLetsTheHandLeaveTheHip) {
+  TransferMesh mesh = phantomMesh(true, 20);
+  Phantom phantom([] {
+    PhantomOptions o;
+    o.voxelMm = 4;
+    o.armsTouching = true;
+    return o;
+  }());
+  Region region;
+  region.shape = Region::Shape::Sphere;
+  region.a = (phantom.joint("wrist_left").ras + phantom.joint("hand_tip_left").ras) / 2;
+  region.b = Eigen::Vector3d(110, 0, 0);
+  const TransferMesh before = mesh;
+  auto usedBy = [](const TransferMesh& m, int label) {
+    std::set<int> v;
+    for (Eigen::Index t = 0; t < m.tets.rows(); ++t)
+      if (m.labels[t] == label)
+        for (int k = 0; k < 4; ++k) v.insert(m.tets(t, k));
+    return v;
+  };
+  const std::set<int> handBefore = usedBy(before, kPartHandLeft), thighBefore = usedBy(before, kPartThighLeft);
+  int shared = 0;
+  for (int v : handBefore) shared += thighBefore.count(v);
+  ASSERT_GT(shared, 0) << "the arms-touching phantom's hand mesh must touch the thigh mesh";
+  const int added = separateLabels(mesh, kPartThighLeft, kPartHandLeft, region);
+  EXPECT_GT(added, 0);
+  const std::set<int> hand = usedBy(mesh, kPartHandLeft), thigh = usedBy(mesh, kPartThighLeft);
+  for (int v : hand) EXPECT_EQ(thigh.count(v), 0u) << "vertex " << v << " still shared";
+  // Moving the hand's vertices leaves every thigh vertex where it was.
+  Eigen::MatrixX3d moved = mesh.vertices;
+  for (int v : hand) moved.row(v) += Eigen::RowVector3d(-100, 0, 0);
+  for (int v : thigh) EXPECT_EQ(moved.row(v), mesh.vertices.row(v));
+  // Outside the separation nothing changed: the other tets keep their vertices.
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (mesh.labels[t] != kPartHandLeft) {
+      EXPECT_EQ(mesh.tets.row(t), before.tets.row(t));
+    }
+  }
+  EXPECT_THROW(separateLabels(mesh, kPartThighLeft, 99, region), Error);
+}
+
+TEST(TransferMesh, VtuRoundTripAndBadFiles) {
+  ScratchDir dir;
+  const TransferMesh mesh = phantomMesh(false, 50);
+  writeTransferMesh(mesh, dir.file("tm.vtu"));
+  const TransferMesh back = readTransferMesh(dir.file("tm.vtu"));
+  EXPECT_EQ(back.tets, mesh.tets);
+  EXPECT_EQ(back.labels, mesh.labels);
+  EXPECT_LT((back.vertices - mesh.vertices).cwiseAbs().maxCoeff(), 1e-9);
+  std::ofstream(dir.file("bad.vtu")) << "<VTKFile type=\"UnstructuredGrid\"><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\">"
+                                        "<DataArray Name=\"Points\" format=\"binary\">AAAA</DataArray>";
+  EXPECT_THROW(readTransferMesh(dir.file("bad.vtu")), Error);
+  EXPECT_THROW(readTransferMesh(dir.file("missing.vtu")), Error);
+  EXPECT_THROW(buildTransferMesh(Volume(VolumeGeometry::make({8, 8, 8}, {1, 1, 1}, {0, 0, 0}), ScalarType::UInt8)), Error);
+}

@@ -1,0 +1,97 @@
+// One interaction frame at the seed's sizes: deformed cage -> Green coordinates of V_c -> both
+// rigidity solves, on the 2 mm phantom with a ~500-vertex cage and a transfer mesh of ~36K
+// vertices (--benchmark_filter to pick parts). Prints where the time goes.
+#include "repose/cage/ArapDeformer.h"
+#include "repose/cage/CageBuilder.h"
+#include "repose/mesh/RigiditySolver.h"
+#include "repose/mesh/TransferMesh.h"
+#include "repose/phantom/Phantom.h"
+
+#include <benchmark/benchmark.h>
+
+#include <Eigen/Geometry>
+#include <cstdlib>
+#include <iostream>
+
+namespace {
+
+using namespace repose;
+
+struct Scene {
+  TriangleMesh cage;
+  TransferMesh mesh;
+  std::unique_ptr<CageDeformation> deformation;
+  Eigen::MatrixX3d deformedCage;
+};
+
+// TM size in mm giving about 36K vertices on the 2 mm phantom (REPOSE_FRAME_TM_MM overrides).
+double tmSize() {
+  const char* env = std::getenv("REPOSE_FRAME_TM_MM");
+  return env ? std::atof(env) : 9.0;
+}
+
+const Scene& scene() {
+  static const Scene s = [] {
+    Scene s;
+    PhantomOptions po;
+    po.voxelMm = 2;
+    const Volume parts = Phantom(po).makeVolumes().second;
+    CageOptions co;
+    co.targetVertices = 500;
+    s.cage = buildCage(parts, co).mesh;
+    TransferMeshOptions to;
+    to.sizeMm = tmSize();
+    s.mesh = buildTransferMesh(parts, to);
+    s.deformation = std::make_unique<CageDeformation>(s.mesh, s.cage);
+    // Raise the right arm 60 degrees about the shoulder with ARAP: a realistic drag.
+    std::vector<int> handles;
+    for (Eigen::Index v = 0; v < s.cage.vertices.rows(); ++v)
+      if (s.cage.vertices(v, 0) > 150 || s.cage.vertices(v, 2) < 100)
+        handles.push_back(static_cast<int>(v));
+    ArapDeformer arap(s.cage);
+    arap.setHandles(handles);
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(-60 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Vector3d pivot(110, 0, 1000);
+    Eigen::MatrixX3d targets(handles.size(), 3);
+    for (std::size_t h = 0; h < handles.size(); ++h) {
+      const Eigen::Vector3d p = s.cage.vertices.row(handles[h]);
+      targets.row(h) = (p.x() > 150 ? Eigen::Vector3d(R * (p - pivot) + pivot) : p).transpose();
+    }
+    s.deformedCage = arap.solve(targets).positions;
+    std::cout << "frame scene: cage " << s.cage.vertices.rows() << " vertices / "
+              << s.cage.faces.rows() << " faces, TM " << s.mesh.vertices.rows() << " vertices / "
+              << s.mesh.tets.rows() << " tets, V_c "
+              << s.deformation->embedding().cageVertices.size() << ", outliers "
+              << s.deformation->embedding().outliers() << " (TM size " << tmSize() << " mm)\n";
+    return s;
+  }();
+  return s;
+}
+
+void BM_Frame(benchmark::State& state) {
+  const Scene& s = scene();
+  for (auto _ : state) benchmark::DoNotOptimize(s.deformation->deform(s.deformedCage));
+  state.counters["TM_vertices"] = double(s.mesh.vertices.rows());
+  state.counters["FPS"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_FrameGreenProduct(benchmark::State& state) {
+  const Scene& s = scene();
+  for (auto _ : state) benchmark::DoNotOptimize(s.deformation->greenPositions(s.deformedCage));
+}
+
+void BM_FrameRigiditySolves(benchmark::State& state) {
+  const Scene& s = scene();
+  const Eigen::MatrixX3d targets = s.deformation->greenPositions(s.deformedCage);
+  for (auto _ : state) benchmark::DoNotOptimize(s.deformation->solver().solve(targets));
+  state.counters["outliers"] = double(s.deformation->embedding().outliers());
+}
+
+}  // namespace
+
+BENCHMARK(BM_Frame)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameGreenProduct)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_FrameRigiditySolves)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
