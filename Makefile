@@ -35,3 +35,4 @@ clean:
 bench: build
 	$(BUILD_DIR)/bin/ReposeIOBench --benchmark_min_time=0.2
 	$(BUILD_DIR)/bin/ReposeCageBench --benchmark_min_time=0.2
+	$(BUILD_DIR)/bin/ReposeFrameBench --benchmark_min_time=0.5
