@@ -84,7 +84,8 @@ TEST(TransferMesh, RealSegmentationTouchingTheBorderMeshesCleanly) {
   const TransferMesh mesh = buildTransferMesh(seg, o, &report);
   EXPECT_GT(report.tets, 100);
   EXPECT_EQ(report.invertedTets, 0);
-  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) ASSERT_GT(tetVolume(mesh.vertices, mesh.tets.row(t)), 0);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    ASSERT_GT(tetVolume(mesh.vertices, mesh.tets.row(t)), 0);
 }
 
 TEST(TransferMesh, SeparationLetsTheHandLeaveTheHip) {
@@ -107,7 +108,8 @@ TEST(TransferMesh, SeparationLetsTheHandLeaveTheHip) {
         for (int k = 0; k < 4; ++k) v.insert(m.tets(t, k));
     return v;
   };
-  const std::set<int> handBefore = usedBy(before, kPartHandLeft), thighBefore = usedBy(before, kPartThighLeft);
+  const std::set<int> handBefore = usedBy(before, kPartHandLeft),
+                      thighBefore = usedBy(before, kPartThighLeft);
   int shared = 0;
   for (int v : handBefore) shared += thighBefore.count(v);
   ASSERT_GT(shared, 0) << "the arms-touching phantom's hand mesh must touch the thigh mesh";
@@ -136,9 +138,12 @@ TEST(TransferMesh, VtuRoundTripAndBadFiles) {
   EXPECT_EQ(back.tets, mesh.tets);
   EXPECT_EQ(back.labels, mesh.labels);
   EXPECT_LT((back.vertices - mesh.vertices).cwiseAbs().maxCoeff(), 1e-9);
-  std::ofstream(dir.file("bad.vtu")) << "<VTKFile type=\"UnstructuredGrid\"><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\">"
-                                        "<DataArray Name=\"Points\" format=\"binary\">AAAA</DataArray>";
+  std::ofstream(dir.file("bad.vtu"))
+      << "<VTKFile type=\"UnstructuredGrid\"><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\">"
+         "<DataArray Name=\"Points\" format=\"binary\">AAAA</DataArray>";
   EXPECT_THROW(readTransferMesh(dir.file("bad.vtu")), Error);
   EXPECT_THROW(readTransferMesh(dir.file("missing.vtu")), Error);
-  EXPECT_THROW(buildTransferMesh(Volume(VolumeGeometry::make({8, 8, 8}, {1, 1, 1}, {0, 0, 0}), ScalarType::UInt8)), Error);
+  EXPECT_THROW(buildTransferMesh(Volume(VolumeGeometry::make({8, 8, 8}, {1, 1, 1}, {0, 0, 0}),
+                                        ScalarType::UInt8)),
+               Error);
 }
