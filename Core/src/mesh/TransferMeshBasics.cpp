@@ -72,18 +72,43 @@ int separateLabels(TransferMesh& mesh, int labelA, int labelB, const Region& reg
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
     if (usedByA[v] && usedByB[v] && region.contains(mesh.vertices.row(v).transpose()))
       split.insert(static_cast<int>(v));
-  // Each split vertex gets one copy; every b-tet using it moves onto the copy.
-  std::map<int, int> copy;
-  const Eigen::Index before = mesh.vertices.rows();
-  for (int v : split) copy[v] = static_cast<int>(before + static_cast<Eigen::Index>(copy.size()));
-  mesh.vertices.conservativeResize(before + static_cast<Eigen::Index>(copy.size()), 3);
-  for (const auto& [v, c] : copy) mesh.vertices.row(c) = mesh.vertices.row(v);
-  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
-    if (mesh.labels[t] != labelB) continue;
+  // Each split vertex gets one copy. Around it, the copy goes to the b tets and to every tet
+  // reachable from them through faces that contain the vertex without crossing an a tet: a hand
+  // leaving the hip takes its forearm along instead of tearing away from it.
+  std::map<int, std::vector<int>> around;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
     for (int c = 0; c < 4; ++c)
-      if (auto it = copy.find(mesh.tets(t, c)); it != copy.end()) mesh.tets(t, c) = it->second;
+      if (split.count(mesh.tets(t, c))) around[mesh.tets(t, c)].push_back(static_cast<int>(t));
+  const Eigen::Index before = mesh.vertices.rows();
+  mesh.vertices.conservativeResize(before + static_cast<Eigen::Index>(split.size()), 3);
+  int added = 0;
+  for (int v : split) {
+    const int copy = static_cast<int>(before) + added++;
+    mesh.vertices.row(copy) = mesh.vertices.row(v);
+    const std::vector<int>& tets = around[v];
+    auto shareFace = [&](int t, int u) {  // v plus two more common vertices
+      int common = 0;
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) common += mesh.tets(t, a) == mesh.tets(u, b);
+      return common == 3;
+    };
+    std::vector<char> reached(tets.size(), 0);
+    std::vector<std::size_t> queue;
+    for (std::size_t i = 0; i < tets.size(); ++i)
+      if (mesh.labels[tets[i]] == labelB) reached[i] = 1, queue.push_back(i);
+    while (!queue.empty()) {
+      const std::size_t i = queue.back();
+      queue.pop_back();
+      for (std::size_t j = 0; j < tets.size(); ++j)
+        if (!reached[j] && mesh.labels[tets[j]] != labelA && shareFace(tets[i], tets[j]))
+          reached[j] = 1, queue.push_back(j);
+    }
+    for (std::size_t i = 0; i < tets.size(); ++i)
+      if (reached[i])
+        for (int c = 0; c < 4; ++c)
+          if (mesh.tets(tets[i], c) == v) mesh.tets(tets[i], c) = copy;
   }
-  return static_cast<int>(copy.size());
+  return added;
 }
 
 }  // namespace repose

@@ -109,8 +109,13 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
   namespace p = CGAL::parameters;
   const Criteria criteria(p::facet_angle = 25, p::facet_size = facetSize, p::facet_distance = voxel,
                           p::cell_radius_edge_ratio = 3, p::cell_size = cellSize);
-  const C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, CGAL::parameters::no_perturb(),
-                                            CGAL::parameters::no_exude());
+  // Exudation removes slivers (without it dihedral angles go down to 0.1 degree, which makes the
+  // tets' linear maps ill-conditioned); no time limit, since a limit makes the result depend on
+  // the machine's speed. Perturbation costs seconds for little more.
+  const C3t3 c3t3 =
+      CGAL::make_mesh_3<C3t3>(domain, criteria, CGAL::parameters::no_perturb(),
+                              CGAL::parameters::exude(CGAL::parameters::time_limit = 0,
+                                                      CGAL::parameters::sliver_bound = 10));
   reportProgress(options.progress, 0.9, "transfer mesh");
 
   TransferMesh mesh;

@@ -9,8 +9,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
+#include <sstream>
 
 using namespace repose;
 using namespace repose::test;
@@ -121,12 +125,19 @@ TEST(TransferMesh, SeparationLetsTheHandLeaveTheHip) {
   Eigen::MatrixX3d moved = mesh.vertices;
   for (int v : hand) moved.row(v) += Eigen::RowVector3d(-100, 0, 0);
   for (int v : thigh) EXPECT_EQ(moved.row(v), mesh.vertices.row(v));
-  // Outside the separation nothing changed: the other tets keep their vertices.
+  // The thigh side keeps its vertices; the hand stays attached to its forearm: wherever a hand
+  // tet and a forearm tet shared a vertex before, they still share one (the copy or the original).
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
-    if (mesh.labels[t] != kPartHandLeft) {
+    if (mesh.labels[t] == kPartThighLeft) {
       EXPECT_EQ(mesh.tets.row(t), before.tets.row(t));
     }
   }
+  const std::set<int> forearmBefore = usedBy(before, kPartForearmLeft),
+                      forearm = usedBy(mesh, kPartForearmLeft);
+  int attachedBefore = 0, attached = 0;
+  for (int v : handBefore) attachedBefore += forearmBefore.count(v);
+  for (int v : hand) attached += forearm.count(v);
+  EXPECT_EQ(attached, attachedBefore);
   EXPECT_THROW(separateLabels(mesh, kPartThighLeft, 99, region), Error);
 }
 
@@ -146,4 +157,102 @@ TEST(TransferMesh, VtuRoundTripAndBadFiles) {
   EXPECT_THROW(buildTransferMesh(Volume(VolumeGeometry::make({8, 8, 8}, {1, 1, 1}, {0, 0, 0}),
                                         ScalarType::UInt8)),
                Error);
+}
+
+TEST(TransferMesh, ReportCountsAndBoundsAgreeWithTheMesh) {
+  TransferMeshReport report;
+  const TransferMesh mesh = phantomMesh(false, 30, &report);
+  // CGAL's cells are positive and the phantom's grid is not mirrored: nothing to fix or drop.
+  EXPECT_EQ(report.degenerateTets, 0);
+  EXPECT_EQ(report.invertedTets, 0);
+  std::map<int, int> perLabel;
+  for (Eigen::Index t = 0; t < mesh.labels.size(); ++t) ++perLabel[mesh.labels[t]];
+  using Counts = std::vector<std::pair<int, int>>;
+  EXPECT_EQ(report.tetsPerLabel, Counts(perLabel.begin(), perLabel.end()));
+  std::vector<char> used(static_cast<std::size_t>(mesh.vertices.rows()), 0);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    for (int k = 0; k < 4; ++k) used[mesh.tets(t, k)] = 1;
+  EXPECT_EQ(std::count(used.begin(), used.end(), 0), 0) << "unreferenced vertices";
+  // Surface vertices are found by bisection, so they may pass the voxel boundary by a hair.
+  const auto [lo, hi] = phantomParts(false).geometry().rasBounds();
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_GE(mesh.vertices(v, c), lo[c] - 1e-3) << "vertex " << v;
+      ASSERT_LE(mesh.vertices(v, c), hi[c] + 1e-3) << "vertex " << v;
+    }
+}
+
+// Determinism is checked across two fresh processes (this test re-runs itself), because within
+// one process CGAL's containers may hand out different addresses and so a different order.
+TEST(TransferMesh, SameMeshInAFreshProcess) {
+  if (const char* out = std::getenv("REPOSE_TM_DETERMINISM_OUT")) {
+    writeTransferMesh(phantomMesh(false, 30), out);
+    return;
+  }
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) GTEST_SKIP() << "cannot re-run the test executable on this system";
+  ScratchDir dir;
+  std::string text[2];
+  for (int run = 0; run < 2; ++run) {
+    const std::string file = dir.file("run" + std::to_string(run) + ".vtu");
+    const std::string command = "REPOSE_TM_DETERMINISM_OUT='" + file + "' '" + self.string() +
+                                "' --gtest_filter=TransferMesh.SameMeshInAFreshProcess >/dev/null";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    std::ifstream in(file);
+    std::stringstream all;
+    all << in.rdbuf();
+    text[run] = all.str();
+  }
+  EXPECT_GT(text[0].size(), 1000u);
+  EXPECT_TRUE(text[0] == text[1]) << "two fresh processes built different meshes";
+}
+
+TEST(TransferMesh, RefusesFloatVolumes) {
+  Volume f(VolumeGeometry::make({8, 8, 8}, {1, 1, 1}, {0, 0, 0}), ScalarType::Float32);
+  EXPECT_THROW(buildTransferMesh(f), Error);
+}
+
+TEST(TransferMesh, VtuReaderRefusesMalformedFilesNamingThem) {
+  ScratchDir dir;
+  const std::string head =
+      "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"4\" "
+      "NumberOfCells=\"1\"><DataArray type=\"Float64\" Name=\"Points\" format=\"ascii\">"
+      "0 0 0 1 0 0 0 1 0 0 0 1</DataArray>";
+  auto cells = [](const std::string& connectivity, const std::string& type) {
+    return "<DataArray Name=\"connectivity\" format=\"ascii\">" + connectivity +
+           "</DataArray><DataArray Name=\"offsets\" format=\"ascii\">4</DataArray>"
+           "<DataArray Name=\"types\" format=\"ascii\">" +
+           type + "</DataArray>";
+  };
+  const std::string label = "<DataArray Name=\"label\" format=\"ascii\">3</DataArray>";
+  const std::string tail = "</Piece></UnstructuredGrid></VTKFile>";
+  const std::map<std::string, std::string> files = {
+      {"good.vtu", head + cells("0 1 2 3", "10") + label + tail},
+      {"appended.vtu",
+       "<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece "
+       "NumberOfPoints=\"4\" NumberOfCells=\"1\"><DataArray Name=\"Points\" "
+       "format=\"appended\" offset=\"0\"/>" +
+           tail},
+      {"index.vtu", head + cells("0 1 2 4", "10") + label + tail},
+      {"triangle.vtu", head + cells("0 1 2 3", "5") + label + tail},
+      {"nolabel.vtu", head + cells("0 1 2 3", "10") + tail},
+      {"truncated.vtu", head + cells("0 1 2", "10") + label + tail},
+      {"notvtk.vtu", "solid x\nendsolid x\n"},
+  };
+  for (const auto& [name, content] : files) std::ofstream(dir.file(name)) << content;
+  const TransferMesh good = readTransferMesh(dir.file("good.vtu"));
+  EXPECT_EQ(good.tets.rows(), 1);
+  EXPECT_EQ(good.labels[0], 3);
+  for (const auto& [name, content] : files) {
+    if (name == "good.vtu") continue;
+    try {
+      readTransferMesh(dir.file(name));
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(name), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+  }
 }

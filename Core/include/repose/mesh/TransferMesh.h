@@ -48,9 +48,10 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
                                TransferMeshReport* report = nullptr);
 
 // Inside `region`, duplicates every vertex shared by a tet of label a and a tet of label b (on a
-// common face, as the seed says, but also along an edge or at a single vertex), and re-indexes
-// the b tets onto the copies, so the two sides can move apart. Returns the number of vertices
-// added. Throws if a or b has no tet.
+// common face, as the seed says, but also along an edge or at a single vertex). Around each such
+// vertex the copy goes to the b tets and to the tets face-connected to them without crossing an a
+// tet (so b keeps its other neighbours), and the two sides can move apart. Returns the number of
+// vertices added. Throws if a or b has no tet.
 int separateLabels(TransferMesh& mesh, int labelA, int labelB, const Region& region);
 
 // VTK XML unstructured grid (.vtu) with a cell array "label"; RAS mm. Atomic write.
