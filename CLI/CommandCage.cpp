@@ -1,6 +1,7 @@
 // `repose cage --parts S --out cage.obj|.vtk`: the control cage around the body, with optional
 // limb separation, and the checks and enclosed fraction that say whether it can be trusted.
 #include "ArgParser.h"
+#include "SeparationOptions.h"
 #include "Commands.h"
 #include "TerminalProgress.h"
 
@@ -13,7 +14,6 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
-#include <tuple>
 #include <iostream>
 
 namespace repose::cli {
@@ -29,25 +29,18 @@ int runCage(const Args& args) {
       .option("vertices", "N", "target number of cage vertices (50..2000)", "300")
       .option("dilate-mm", "MM", "dilation of the body before meshing", "10")
       .option("working-voxel-mm", "MM", "voxel size of the working grid (0: automatic)", "0")
-      .option("separate", "A:B", "separate body-part labels A and B inside --region")
-      .option("region", "SPEC", "box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r in RAS mm")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("json", "print a JSON report on stdout");
+  declareSeparationOptions(p, "the cage passes between");
   if (!p.parse(args)) return 0;
   if (!p.has("parts")) throw UsageError{"--parts is required"};
   if (!p.has("out")) throw UsageError{"--out is required"};
-  if (p.has("separate") != p.has("region")) throw UsageError{"--separate and --region go together"};
   CageOptions o;
   o.targetVertices = static_cast<int>(p.getInt("vertices"));
   o.dilateMm = p.getDouble("dilate-mm");
   o.workingVoxelMm = p.getDouble("working-voxel-mm");
   o.threads = static_cast<int>(p.getInt("threads"));
-  if (p.has("separate")) {
-    LimbSeparation sep;
-    std::tie(sep.labelA, sep.labelB) = parseLabelPair(p.get("separate"), "separate");
-    sep.region = Region::parse(p.get("region"));
-    o.separations.push_back(sep);
-  }
+  if (const auto separation = parseSeparationOptions(p)) o.separations.push_back(*separation);
   const std::string out = p.get("out");
   refuseOverwritingInput(p.get("parts"), out);
   AtomicOutput probe(out);  // an unwritable output fails now, not after the work

@@ -1,6 +1,7 @@
 // `repose mesh --parts S --cage cage.obj --out tm.vtu`: the labelled transfer mesh, optionally
 // split between two body parts, with how much of it the cage holds (V_c) and what it misses.
 #include "ArgParser.h"
+#include "SeparationOptions.h"
 #include "Commands.h"
 #include "TerminalProgress.h"
 
@@ -15,6 +16,7 @@
 
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 namespace repose::cli {
 
@@ -29,14 +31,13 @@ int runMesh(const Args& args) {
       .option("cage", "FILE", "cage from `repose cage` (.obj or .vtk)")
       .option("out", "FILE", "output transfer mesh (.vtu)")
       .option("size-mm", "MM", "tet size (0: 5% of the volume's diagonal)", "0")
-      .option("separate", "A:B", "split the mesh between body-part labels A and B inside --region")
-      .option("region", "SPEC", "box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r in RAS mm")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("json", "print a JSON summary on stdout");
+  declareSeparationOptions(p, "split the mesh between");
   if (!p.parse(args)) return 0;
   for (const char* required : {"parts", "cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
-  if (p.has("separate") != p.has("region")) throw UsageError{"--separate and --region go together"};
+  const std::optional<LimbSeparation> separation = parseSeparationOptions(p);
   const std::string out = p.get("out");
   refuseOverwritingInput(p.get("parts"), out);
   AtomicOutput probe(out);  // an unwritable output fails before the work
@@ -50,10 +51,8 @@ int runMesh(const Args& args) {
   TransferMeshReport report;
   TransferMesh mesh = buildTransferMesh(parts, o, &report);
   int added = 0;
-  if (p.has("separate")) {
-    const auto [a, b] = parseLabelPair(p.get("separate"), "separate");
-    added = separateLabels(mesh, a, b, Region::parse(p.get("region")));
-  }
+  if (separation)
+    added = separateLabels(mesh, separation->labelA, separation->labelB, separation->region);
   const int threads = static_cast<int>(p.getInt("threads"));
   const Embedding embedding = embedInCage(mesh, cage, threads);
   const RigiditySolver solver(mesh, embedding.cageVertices, embedding.cageTets);
