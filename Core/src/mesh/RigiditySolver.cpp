@@ -3,6 +3,7 @@
 // with the part of the body the cage misses, not with the whole mesh.
 #include "repose/mesh/RigiditySolver.h"
 
+#include "CompactGreenMatrix.h"
 #include "TetAdjacency.h"
 #include "numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
@@ -292,49 +293,53 @@ Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets,
   return positions;
 }
 
+namespace {
+
+// The values the Green coordinates multiply: cage vertices, then each face's stretched normal.
+Eigen::MatrixX3d greenCageValues(const TriangleMesh& rest, const Eigen::MatrixX3d& deformed) {
+  const Eigen::VectorXd stretch = greenFaceStretch(rest, deformed);
+  Eigen::MatrixX3d x(deformed.rows() + rest.faces.rows(), 3);
+  x.topRows(deformed.rows()) = deformed;
+  x.bottomRows(rest.faces.rows()) = stretch.asDiagonal() * faceNormals(deformed, rest.faces);
+  return x;
+}
+
+}  // namespace
+
 CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads)
     : cage_(cage),
       embedding_(embedInCage(mesh, cage, threads)),
       solver_(mesh, embedding_.cageVertices, embedding_.cageTets),
       threads_(threads) {
   const GreenCoordinates& gc = embedding_.coordinates;
-  coefficients_.resize(gc.phi.rows(), gc.phi.cols() + gc.psi.cols());
-  coefficients_ << gc.phi.cast<float>(), gc.psi.cast<float>();
-  phiSum_ = gc.phi.rowwise().sum();
+  restCageValues_ = greenCageValues(cage_, cage_.vertices);
+  restPositions_ = applyGreenCoordinates(gc, cage_, cage_.vertices);
+  coefficients_ = std::make_unique<CompactGreenMatrix>(gc.phi, gc.psi);
   embedding_.coordinates = GreenCoordinates();  // the compact copy is what frames use
 }
 
-Eigen::MatrixX3d CageDeformation::greenPositions(const Eigen::MatrixX3d& deformedCage) const {
+CageDeformation::~CageDeformation() = default;
+CageDeformation::CageDeformation(CageDeformation&&) noexcept = default;
+CageDeformation& CageDeformation::operator=(CageDeformation&&) noexcept = default;
+
+std::size_t CageDeformation::coefficientBytes() const {
+  return coefficients_->bytes();
+}
+
+Eigen::MatrixX3d CageDeformation::greenPositions(const Eigen::MatrixX3d& deformedCage,
+                                                 GreenPrecision precision) const {
   if (deformedCage.rows() != cage_.vertices.rows())
     throw Error("deformed cage has the wrong number of vertices");
-  // Coordinates relative to the deformed centroid keep float coefficients accurate for bodies
-  // far from the origin: sum phi_i v_i = sum phi_i (v_i - c) + c sum phi_i.
-  const Eigen::RowVector3d centre = deformedCage.colwise().mean();
-  const Eigen::MatrixX3d normals = faceNormals(deformedCage, cage_.faces);
-  const Eigen::VectorXd stretch = greenFaceStretch(cage_, deformedCage);
-  const Eigen::Index nv = deformedCage.rows(), nf = cage_.faces.rows();
-  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(nv + nf, 3);
-  x.topRows(nv) = deformedCage.rowwise() - centre;
-  x.bottomRows(nf) = stretch.asDiagonal() * normals;
-  Eigen::MatrixX3d out(coefficients_.rows(), 3);
-  parallelFor(coefficients_.rows(), threads_, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t r = begin; r < end; ++r) {
-      const float* a = coefficients_.row(r).data();
-      const double* xi = x.data();
-      double y0 = 0, y1 = 0, y2 = 0;
-      for (Eigen::Index i = 0; i < nv + nf; ++i, xi += 3) {
-        const double w = a[i];
-        y0 += w * xi[0], y1 += w * xi[1], y2 += w * xi[2];
-      }
-      out.row(r) = Eigen::RowVector3d(y0, y1, y2) + phiSum_[r] * centre;
-    }
-  });
-  return out;
+  // Linear in the cage values: p = p_rest + C (x - x_rest). An unmoved cage gives p_rest exactly.
+  const Eigen::MatrixX3d delta = greenCageValues(cage_, deformedCage) - restCageValues_;
+  return restPositions_ +
+         coefficients_->multiply(delta, precision == GreenPrecision::Preview, threads_);
 }
 
 Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
-                                         std::vector<Eigen::Matrix3d>* B) const {
-  return solver_.solve(greenPositions(deformedCage), B);
+                                         std::vector<Eigen::Matrix3d>* B,
+                                         GreenPrecision precision) const {
+  return solver_.solve(greenPositions(deformedCage, precision), B);
 }
 
 }  // namespace repose

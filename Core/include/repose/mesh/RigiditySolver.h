@@ -11,6 +11,8 @@
 
 namespace repose {
 
+class CompactGreenMatrix;
+
 class RigiditySolver {
  public:
   // Factorizes both least-squares systems (CHOLMOD) for this mesh and these constraints.
@@ -38,27 +40,41 @@ class RigiditySolver {
 Eigen::Matrix3d tetLinearMap(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3d& deformed,
                              const Eigen::RowVector4i& tet);
 
+// How a frame evaluates the Green coordinates. Exact: float-precise coefficients, double sums
+// (exports, refinement, tests). Preview: half-precision coefficients, half the memory traffic,
+// for frames during a drag; its position error is about 1e-3 of the cage's displacement from rest
+// (measured in RigiditySolverTest), and an undeformed cage is reproduced exactly in both modes.
+enum class GreenPrecision { Exact, Preview };
+
 // One interaction frame: deformed cage -> Green coordinates on V_c -> rigidity solve.
 // The dense coordinate matrix [phi psi] (V_c rows) is the frame's largest cost and is memory-
-// bound, so it is kept once, compactly: row-major float, read row by row on all cores with
-// double accumulation (the double copy is dropped after construction).
+// bound, so it is kept once, compactly (CompactGreenMatrix: two half-float arrays), and applied
+// to the cage's displacement from rest on all cores; the double coordinates are dropped.
 class CageDeformation {
  public:
   CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0);
+  ~CageDeformation();
+  CageDeformation(CageDeformation&&) noexcept;
+  CageDeformation& operator=(CageDeformation&&) noexcept;
+
   const Embedding& embedding() const { return embedding_; }
   const RigiditySolver& solver() const { return solver_; }
+  std::size_t coefficientBytes() const;
   // Positions of V_c (rows follow embedding().cageVertices) for a deformed cage.
-  Eigen::MatrixX3d greenPositions(const Eigen::MatrixX3d& deformedCage) const;
+  Eigen::MatrixX3d greenPositions(const Eigen::MatrixX3d& deformedCage,
+                                  GreenPrecision precision = GreenPrecision::Exact) const;
   // deformedCage: #cage vertices by 3. Returns #V TM positions (and tet maps if B is given).
   Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage,
-                          std::vector<Eigen::Matrix3d>* B = nullptr) const;
+                          std::vector<Eigen::Matrix3d>* B = nullptr,
+                          GreenPrecision precision = GreenPrecision::Exact) const;
 
  private:
   TriangleMesh cage_;
   Embedding embedding_;
   RigiditySolver solver_;
-  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> coefficients_;  // [phi psi]
-  Eigen::VectorXd phiSum_;  // row sums of phi in double: the centroid term stays exact
+  std::unique_ptr<CompactGreenMatrix> coefficients_;  // [phi psi], rows follow V_c
+  Eigen::MatrixX3d restCageValues_;  // [cage vertices; stretch * normals] of the rest cage
+  Eigen::MatrixX3d restPositions_;   // the exact Green image of the rest cage (double)
   int threads_ = 0;
 };
 

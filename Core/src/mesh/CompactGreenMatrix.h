@@ -1,0 +1,37 @@
+// The dense Green-coordinate matrix [phi psi] of V_c, stored for the interaction frame.
+//
+// The frame's product (#V_c rows by ~1500 columns) is memory-bound: at the seed's sizes the
+// matrix is 180 MB as float and streaming it takes longer than a frame may. Each coefficient is
+// stored as two IEEE half floats, high = half(c) and low = half(c - high), in two separate
+// arrays: a preview frame streams only the high halves (half the bytes), an exact product reads
+// both (float precision, c = high + low / 2^11). The product is taken on displacements from the rest
+// cage, so the preview's ~1e-3 relative coefficient error scales with how far the cage moved, not
+// with the body's distance from the origin, and an undeformed cage is reproduced exactly.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace repose {
+
+class CompactGreenMatrix {
+ public:
+  CompactGreenMatrix() = default;
+  // phi: rows by #cage vertices, psi: rows by #cage faces; stored side by side.
+  CompactGreenMatrix(const Eigen::MatrixXd& phi, const Eigen::MatrixXd& psi);
+
+  Eigen::Index rows() const { return rows_; }
+  Eigen::Index cols() const { return cols_; }
+  std::size_t bytes() const { return 2 * high_.size() * sizeof(std::uint16_t); }
+
+  // y = C x for x (cols by 3); preview reads the high halves only. Rows run on `threads`.
+  Eigen::MatrixX3d multiply(const Eigen::MatrixX3d& x, bool preview, int threads) const;
+
+ private:
+  Eigen::Index rows_ = 0, cols_ = 0, stride_ = 0;  // stride_: cols_ padded to 16 halves
+  double scale_ = 1;  // coefficients are stored times scale_ to stay inside half range
+  std::vector<std::uint16_t> high_, low_;
+};
+
+}  // namespace repose
