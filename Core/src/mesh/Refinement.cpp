@@ -28,6 +28,32 @@ SizingField initialSizingField(const Volume& parts, double sizeMm) {
   return SizingField::uniform(coarse, sizeMm);
 }
 
+RefinementStep measureDeformationError(const TransferMesh& mesh, const TriangleMesh& cage,
+                                       const Eigen::MatrixX3d& deformedCage,
+                                       const VolumeGeometry& grid, int threads,
+                                       std::vector<float>* errorGrid, std::vector<char>* covered) {
+  const CageDeformation deformation(mesh, cage, threads);
+  std::vector<Eigen::Matrix3d> B;
+  deformation.deform(deformedCage, &B);
+  const Eigen::VectorXd et = tetErrors(mesh, B);
+  std::vector<char> inside;
+  const std::vector<float> values =
+      rasterizeVertexField(mesh, vertexErrors(mesh, et), grid, &inside);
+  RefinementStep step;
+  step.vertices = static_cast<int>(mesh.vertices.rows());
+  step.tets = static_cast<int>(mesh.tets.rows());
+  step.maxTetError = et.size() ? et.maxCoeff() : 0;
+  double sum = 0;
+  std::int64_t n = 0;
+  for (std::size_t v = 0; v < values.size(); ++v)
+    if (inside[v])
+      step.maxError = std::max(step.maxError, double(values[v])), sum += values[v], ++n;
+  step.meanError = n ? sum / n : 0;
+  if (errorGrid) *errorGrid = values;
+  if (covered) *covered = std::move(inside);
+  return step;
+}
+
 RefinementResult refineTransferMesh(const Volume& parts, const TriangleMesh& cage,
                                     const Eigen::MatrixX3d& deformedCage,
                                     const RefinementOptions& options) {
@@ -40,22 +66,13 @@ RefinementResult refineTransferMesh(const Volume& parts, const TriangleMesh& cag
     TransferMesh mesh = buildTransferMesh(parts, tmo);
     if (mesh.vertices.rows() > options.maxVertices && it > 0)
       break;  // keep the last mesh in budget
-    const CageDeformation deformation(mesh, cage, options.threads);
-    std::vector<Eigen::Matrix3d> B;
-    deformation.deform(deformedCage, &B);
-    const Eigen::VectorXd et = tetErrors(mesh, B);
+    std::vector<float> grid;
     std::vector<char> covered;
-    const std::vector<float> grid =
-        rasterizeVertexField(mesh, vertexErrors(mesh, et), field.grid, &covered);
-    RefinementStep step;
-    step.vertices = static_cast<int>(mesh.vertices.rows());
-    step.tets = static_cast<int>(mesh.tets.rows());
-    step.maxTetError = et.size() ? et.maxCoeff() : 0;
+    RefinementStep step = measureDeformationError(mesh, cage, deformedCage, field.grid,
+                                                  options.threads, &grid, &covered);
     // The result always pairs a mesh with the field that built it; the update is for the next step.
     result.mesh = std::move(mesh);
     result.sizing = field;
-    for (std::size_t v = 0; v < grid.size(); ++v)
-      if (covered[v]) step.maxError = std::max(step.maxError, double(grid[v]));
     step.meanError = updateSizingField(field, grid, covered);
     result.steps.push_back(step);
     if (step.meanError <= 0 || step.maxError <= options.uniformity * step.meanError) break;

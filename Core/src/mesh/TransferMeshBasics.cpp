@@ -52,6 +52,46 @@ double SizingField::at(const Eigen::Vector3d& ras) const {
   return (c00 * (1 - f[1]) + c10 * f[1]) * (1 - f[2]) + (c01 * (1 - f[1]) + c11 * f[1]) * f[2];
 }
 
+void cleanTransferMesh(TransferMesh& mesh, double frameSign, TransferMeshReport& r) {
+  const Eigen::Index nt = mesh.tets.rows();
+  double meanVolume = 0;
+  for (Eigen::Index t = 0; t < nt; ++t)
+    meanVolume += std::fabs(tetVolume(mesh.vertices, mesh.tets.row(t)));
+  meanVolume /= std::max<double>(1, static_cast<double>(nt));
+  r.degenerateTets = r.invertedTets = 0;
+  std::vector<char> used(static_cast<std::size_t>(mesh.vertices.rows()), 0);
+  Eigen::Index kept = 0;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    Eigen::RowVector4i tet = mesh.tets.row(t);
+    const double vol = tetVolume(mesh.vertices, tet);
+    if (!(std::fabs(vol) >= 1e-9 * meanVolume) || meanVolume == 0) {  // also catches NaN
+      ++r.degenerateTets;
+      continue;
+    }
+    if (frameSign * vol < 0) ++r.invertedTets;
+    if (vol < 0) std::swap(tet[2], tet[3]);
+    for (int c = 0; c < 4; ++c) used[tet[c]] = 1;
+    mesh.tets.row(kept) = tet;
+    mesh.labels[kept++] = mesh.labels[t];
+  }
+  mesh.tets.conservativeResize(kept, 4);
+  mesh.labels.conservativeResize(kept);
+  // Renumber the vertices that are still used, keeping their order.
+  std::vector<int> newIndex(used.size(), -1);
+  int nv = 0;
+  for (std::size_t v = 0; v < used.size(); ++v)
+    if (used[v])
+      mesh.vertices.row(nv) = mesh.vertices.row(static_cast<Eigen::Index>(v)), newIndex[v] = nv++;
+  mesh.vertices.conservativeResize(nv, 3);
+  for (Eigen::Index t = 0; t < kept; ++t)
+    for (int c = 0; c < 4; ++c) mesh.tets(t, c) = newIndex[mesh.tets(t, c)];
+  std::map<int, int> perLabel;
+  for (Eigen::Index t = 0; t < kept; ++t) ++perLabel[mesh.labels[t]];
+  r.vertices = nv;
+  r.tets = static_cast<int>(kept);
+  r.tetsPerLabel.assign(perLabel.begin(), perLabel.end());
+}
+
 int separateLabels(TransferMesh& mesh, int labelA, int labelB, const Region& region) {
   bool hasA = false, hasB = false;
   for (Eigen::Index t = 0; t < mesh.labels.size(); ++t)

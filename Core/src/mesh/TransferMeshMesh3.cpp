@@ -142,37 +142,14 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
     throw Error("meshing produced no tetrahedron (is the segmentation thinner than a voxel?)");
   mesh.vertices.resize(static_cast<Eigen::Index>(vertices.size()), 3);
   for (std::size_t v = 0; v < vertices.size(); ++v) mesh.vertices.row(v) = vertices[v];
+  mesh.tets.resize(static_cast<Eigen::Index>(tets.size()), 4);
+  mesh.labels.resize(static_cast<Eigen::Index>(tets.size()));
+  for (std::size_t i = 0; i < tets.size(); ++i)
+    mesh.tets.row(i) = tets[i], mesh.labels[i] = labels[i];
   // CGAL's cells are positively oriented in the image frame; a mirrored IJK->RAS (LPS-like grids)
-  // flips them all, which is not an inversion. Only tets negative beyond that are counted.
-  const double frameSign = g.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0;
-  double meanVolume = 0;
-  for (const auto& t : tets) meanVolume += std::fabs(tetVolume(mesh.vertices, t));
-  meanVolume /= static_cast<double>(tets.size());
-  std::vector<Eigen::RowVector4i> kept;
-  std::vector<int> keptLabels;
-  for (std::size_t i = 0; i < tets.size(); ++i) {
-    Eigen::RowVector4i t = tets[i];
-    const double vol = tetVolume(mesh.vertices, t);
-    if (std::fabs(vol) < 1e-9 * meanVolume) {
-      ++r.degenerateTets;
-      continue;
-    }
-    if (frameSign * vol < 0) ++r.invertedTets;
-    if (vol < 0) std::swap(t[2], t[3]);
-    kept.push_back(t);
-    keptLabels.push_back(labels[i]);
-  }
-  mesh.tets.resize(static_cast<Eigen::Index>(kept.size()), 4);
-  mesh.labels.resize(static_cast<Eigen::Index>(kept.size()));
-  std::map<int, int> perLabel;
-  for (std::size_t i = 0; i < kept.size(); ++i) {
-    mesh.tets.row(i) = kept[i];
-    mesh.labels[i] = keptLabels[i];
-    ++perLabel[keptLabels[i]];
-  }
-  r.vertices = static_cast<int>(mesh.vertices.rows());
-  r.tets = static_cast<int>(mesh.tets.rows());
-  r.tetsPerLabel.assign(perLabel.begin(), perLabel.end());
+  // flips them all, which is not an inversion.
+  cleanTransferMesh(mesh, g.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0, r);
+  if (mesh.tets.rows() == 0) throw Error("meshing produced only degenerate tetrahedra");
   if (report) *report = r;
   reportProgress(options.progress, 1.0, "transfer mesh");
   return mesh;

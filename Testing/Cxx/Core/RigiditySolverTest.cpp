@@ -142,3 +142,15 @@ TEST(RigiditySolver, RefusesACageAroundNothingAndBadTargets) {
   nan(0, 0) = std::nan("");
   EXPECT_THROW(d.deform(nan), Error);
 }
+
+TEST(RigiditySolver, RefusesAFlatTetNamingIt) {
+  TransferMesh mesh = limb();
+  const Eigen::Index t = 5;
+  mesh.vertices.row(mesh.tets(t, 3)) = mesh.vertices.row(mesh.tets(t, 0));  // collapse one tet
+  try {
+    const CageDeformation d(mesh, limbCage());
+    FAIL() << "a flat tet was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("degenerate or inverted"), std::string::npos) << e.what();
+  }
+}

@@ -1,6 +1,7 @@
 // The transfer mesh from CGAL Mesh_3: positive tets whose labels follow S, the body's volume,
 // the sizing field's effect; label separation that lets a hand leave the hip; .vtu round trips.
 #include "TestPaths.h"
+#include "TestTetMeshes.h"
 
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/TransferMesh.h"
@@ -255,4 +256,37 @@ TEST(TransferMesh, VtuReaderRefusesMalformedFilesNamingThem) {
       EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
   }
+}
+
+// The builder's fallback for bad tets: a flat one is dropped with its now unused vertices, an
+// inverted one is reoriented and counted, the rest is untouched.
+TEST(TransferMesh, CleaningDropsFlatTetsAndReorientsInvertedOnes) {
+  TransferMesh mesh = tetBox({0, 0, 0}, {20, 20, 20}, {2, 2, 2}, 7);
+  const Eigen::Index nv = mesh.vertices.rows(), nt = mesh.tets.rows();
+  // A flat tet on four new coplanar vertices, and an inverted copy of tet 0 with label 9.
+  mesh.vertices.conservativeResize(nv + 4, 3);
+  mesh.vertices.bottomRows(4) << 50, 0, 0, 60, 0, 0, 50, 10, 0, 60, 10, 0;
+  mesh.tets.conservativeResize(nt + 2, 4);
+  mesh.tets.row(nt) << nv, nv + 1, nv + 2, nv + 3;
+  mesh.tets.row(nt + 1) << mesh.tets(0, 0), mesh.tets(0, 1), mesh.tets(0, 3), mesh.tets(0, 2);
+  mesh.labels.conservativeResize(nt + 2);
+  mesh.labels.tail(2) << 8, 9;
+  TransferMeshReport report;
+  cleanTransferMesh(mesh, 1.0, report);
+  EXPECT_EQ(report.degenerateTets, 1);
+  EXPECT_EQ(report.invertedTets, 1);
+  EXPECT_EQ(mesh.vertices.rows(), nv);  // the flat tet's vertices are gone
+  ASSERT_EQ(mesh.tets.rows(), nt + 1);
+  EXPECT_EQ(mesh.labels[nt], 9);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    EXPECT_GT(tetVolume(mesh.vertices, mesh.tets.row(t)), 0);
+  EXPECT_EQ(report.tets, nt + 1);
+  EXPECT_EQ(report.tetsPerLabel, (std::vector<std::pair<int, int>>{{7, int(nt)}, {9, 1}}));
+  // A mirrored grid flips every tet: that alone is not an inversion.
+  TransferMesh mirrored = tetBox({0, 0, 0}, {20, 20, 20}, {2, 2, 2});
+  for (Eigen::Index t = 0; t < mirrored.tets.rows(); ++t)
+    std::swap(mirrored.tets(t, 2), mirrored.tets(t, 3));
+  cleanTransferMesh(mirrored, -1.0, report);
+  EXPECT_EQ(report.invertedTets, 0);
+  EXPECT_EQ(report.degenerateTets, 0);
 }

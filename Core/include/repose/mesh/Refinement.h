@@ -31,6 +31,15 @@ struct RefinementResult {
   std::vector<RefinementStep> steps;
 };
 
+// Embeds `mesh` in the cage, deforms it (exact precision) and measures the metric: e_t, and e^G
+// on `grid` (errorGrid and covered receive it when given). Also measures uniform meshes, to
+// compare them with refined ones.
+RefinementStep measureDeformationError(const TransferMesh& mesh, const TriangleMesh& cage,
+                                       const Eigen::MatrixX3d& deformedCage,
+                                       const VolumeGeometry& grid, int threads = 0,
+                                       std::vector<float>* errorGrid = nullptr,
+                                       std::vector<char>* covered = nullptr);
+
 // The sizing grid is S's grid coarsened by a whole factor to at most ~8M voxels.
 SizingField initialSizingField(const Volume& parts, double sizeMm);
 

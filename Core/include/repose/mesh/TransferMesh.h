@@ -47,6 +47,13 @@ struct TransferMeshReport {
 TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& options = {},
                                TransferMeshReport* report = nullptr);
 
+// The builder's last pass, public so the fallback is testable: orients every tet positively in
+// RAS; drops tets whose |volume| is below 1e-9 of the mean volume (report.degenerateTets; they
+// carry no voxel and would make the rigidity system singular) and then the vertices no tet uses;
+// counts as inverted (report.invertedTets) the tets negative beyond the grid's mirroring
+// (frameSign -1 when IJK->RAS is mirrored, as for LPS grids). Fills the report's counts.
+void cleanTransferMesh(TransferMesh& mesh, double frameSign, TransferMeshReport& report);
+
 // Inside `region`, duplicates every vertex shared by a tet of label a and a tet of label b (on a
 // common face, as the seed says, but also along an edge or at a single vertex). Around each such
 // vertex the copy goes to the b tets and to the tets face-connected to them without crossing an a
