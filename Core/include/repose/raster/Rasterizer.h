@@ -1,0 +1,68 @@
+// The deformed transfer mesh back to voxels (seed §4.3): for every output voxel, the deformed tet
+// containing its centre, the rest position there (barycentric), and the input's value at it.
+// In-core, on all cores; slabs of output slices are independent, which the out-of-core path uses.
+#pragma once
+
+#include "repose/mesh/TransferMesh.h"
+#include "repose/util/Progress.h"
+#include "repose/volume/Volume.h"
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace repose {
+
+// The output grid for a deformation: the input's axis directions and spacing (or `spacingMm` along
+// every axis when > 0), shifted by whole input voxels when the spacing is kept (so an identity or
+// a whole-voxel translation maps voxel centres onto voxel centres), and grown to contain every
+// deformed vertex plus `marginVoxels`: the body is never clipped.
+VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d& deformed,
+                            double spacingMm = 0, int marginVoxels = 1);
+
+// Per tet, one bit per face (bit f: the face opposite vertex f) on the mesh's outer surface: a
+// face no other tet shares, unless another such face lies at the same rest place (the two sides of
+// a cut made by separateLabels, which are inside the body).
+std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh);
+
+struct RasterOptions {
+  int threads = 0;
+  ProgressFn progress;  // called from worker threads, one call at a time; false cancels
+  // Mesh_3 puts the TM's surface only to within a voxel of the label boundary, so some labelled
+  // voxel centres (the skin) lie just outside the mesh. Voxels no tet covers but within shellMm
+  // outside an outer face take that boundary tet's map, extrapolated. < 0: twice the input's
+  // largest spacing; 0: off (only voxels inside tets are written).
+  double shellMm = -1;
+  const std::vector<std::uint8_t>* outerFaces = nullptr;  // outerFaces(mesh), computed if null
+};
+
+struct RasterReport {
+  std::int64_t voxelWrites = 0;  // voxel centres found inside tets (twice where the body folds)
+  std::int64_t shellVoxels = 0;  // voxels written from the shell outside the outer faces
+  int invertedTets = 0;  // deformed tets turned inside out (a fold): still written, in tet order
+  int flatTets = 0;      // deformed tets of zero volume: nothing is inside them
+};
+
+// Labels: each output voxel whose centre lies in a deformed tet (or its shell, see RasterOptions)
+// takes the value of `labels` at the nearest input voxel to its rest position (0 beyond the input
+// grid); other voxels are 0. Where
+// folded tets overlap, the highest-numbered tet wins. Every layer of `labels` is mapped; the
+// scalar type and label table are kept.
+Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
+                       const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                       const RasterOptions& options = {}, RasterReport* report = nullptr);
+
+// Intensities (CT, MR): trilinear interpolation at the rest position, `background` where no tet
+// covers the voxel or the rest position is outside the input. Integer types are rounded and
+// clamped to their range.
+Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
+                      const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                      double background, const RasterOptions& options = {},
+                      RasterReport* report = nullptr);
+
+// How many deformed tets contain each output voxel centre (UInt8, saturating at 255): 1 inside a
+// conforming deformed mesh, 0 outside it, 2 or more where it folds over itself. No shell.
+Volume rasterizeCoverage(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                         const VolumeGeometry& output, const RasterOptions& options = {});
+
+}  // namespace repose

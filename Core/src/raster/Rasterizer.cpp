@@ -1,0 +1,357 @@
+#include "repose/raster/Rasterizer.h"
+
+#include "TetScan.h"
+#include "repose/util/Error.h"
+#include "repose/util/Parallel.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <map>
+#include <unordered_map>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <type_traits>
+
+namespace repose {
+namespace {
+
+using raster::ScanInput;
+using raster::ScanTet;
+
+void checkDeformation(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed) {
+  if (deformed.rows() != mesh.vertices.rows())
+    throw Error("rasterizer: " + std::to_string(deformed.rows()) + " deformed positions for " +
+                std::to_string(mesh.vertices.rows()) + " mesh vertices");
+  if (!deformed.allFinite()) throw Error("rasterizer: deformed positions are not finite");
+}
+
+// Inverted and flat deformed tets, for the report. Rest tets are positive in RAS; the output
+// grid's handedness is taken out.
+void countBadTets(const ScanInput& in, double frameSign, RasterReport& r) {
+  const Eigen::MatrixX4i& T = *in.tets;
+  for (Eigen::Index t = 0; t < T.rows(); ++t) {
+    Eigen::Matrix3d D;
+    for (int c = 0; c < 3; ++c) D.col(c) = in.out[T(t, c + 1)] - in.out[T(t, 0)];
+    const double v = frameSign * D.determinant();
+    if (v == 0 || !std::isfinite(v))
+      ++r.flatTets;
+    else if (v < 0)
+      ++r.invertedTets;
+  }
+}
+
+// How the shell around the outer faces is scanned (RasterOptions::shellMm).
+struct Shell {
+  std::vector<std::uint8_t> outer;  // empty: no shell
+  double mm = 0;
+  Eigen::Matrix3d normalToMm = Eigen::Matrix3d::Identity();
+  std::array<double, 3> boxGrowth{0, 0, 0};
+};
+
+Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const VolumeGeometry& output,
+                const RasterOptions& options) {
+  Shell sh;
+  sh.mm = options.shellMm < 0 ? 2 * input.spacing().maxCoeff() : options.shellMm;
+  if (sh.mm <= 0) return sh;
+  sh.outer = options.outerFaces ? *options.outerFaces : outerFaces(mesh);
+  if (sh.outer.size() != static_cast<std::size_t>(mesh.tets.rows()))
+    throw Error("rasterizer: outer-face flags do not match the mesh");
+  const Eigen::Matrix3d M = output.ijkToRas.block<3, 3>(0, 0);
+  sh.normalToMm = M.inverse().transpose();
+  const Eigen::Matrix3d Minv = M.inverse();
+  for (int c = 0; c < 3; ++c) sh.boxGrowth[c] = sh.mm * Minv.row(c).norm();
+  return sh;
+}
+
+// Runs the scan over slabs of output slices on all cores. Each slab is written by one thread,
+// tets in index order, so overlapping (folded) tets resolve the same way on every run; then the
+// shell pass writes the voxels of the slab still uncovered.
+template <class Write>
+void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& options,
+             const std::string& stage, RasterReport* report, double frameSign, Write&& write) {
+  const Eigen::MatrixX4i& T = *in.tets;
+  const Eigen::Index nt = T.rows();
+  const double kGrowth = shell.outer.empty() ? 0 : shell.boxGrowth[2];
+  std::vector<std::int32_t> kmin(nt), kmax(nt);
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    double lo = in.out[T(t, 0)].z(), hi = lo;
+    for (int c = 1; c < 4; ++c)
+      lo = std::min(lo, in.out[T(t, c)].z()), hi = std::max(hi, in.out[T(t, c)].z());
+    kmin[t] =
+        static_cast<std::int32_t>(std::clamp(std::ceil(lo - kGrowth), -1.0, double(in.dims[2])));
+    kmax[t] =
+        static_cast<std::int32_t>(std::clamp(std::floor(hi + kGrowth), -1.0, double(in.dims[2])));
+  }
+  const int threads = resolveThreads(options.threads);
+  const std::int64_t slabs =
+      std::max<std::int64_t>(1, std::min<std::int64_t>(in.dims[2], 8 * threads));
+  const std::int64_t nx = in.dims[0], plane = in.dims[0] * in.dims[1];
+  std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0};
+  std::atomic<bool> stop{false};
+  std::mutex progressMutex;
+  parallelFor(
+      slabs, threads,
+      [&](std::int64_t sb, std::int64_t se) {
+        std::int64_t localWrites = 0, localShell = 0;
+        std::vector<std::uint8_t> covered;
+        for (std::int64_t slab = sb; slab < se && !stop; ++slab) {
+          const std::int64_t k0 = in.dims[2] * slab / slabs, k1 = in.dims[2] * (slab + 1) / slabs;
+          if (!shell.outer.empty()) covered.assign(static_cast<std::size_t>(plane * (k1 - k0)), 0);
+          ScanTet s;
+          for (Eigen::Index t = 0; t < nt; ++t) {
+            if (kmax[t] < k0 || kmin[t] >= k1 || !raster::prepareTet(in, t, s)) continue;
+            raster::scanTet(s, k0, k1,
+                            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                                const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
+                              localWrites += i1 - i0 + 1;
+                              if (!covered.empty())
+                                std::fill_n(covered.begin() + ((k - k0) * plane + j * nx + i0),
+                                            i1 - i0 + 1, std::uint8_t(1));
+                              write(k, j, i0, i1, rest0, step);
+                            });
+          }
+          for (Eigen::Index t = 0; t < nt && !shell.outer.empty(); ++t) {
+            if (!shell.outer[t] || kmax[t] < k0 || kmin[t] >= k1 ||
+                !raster::prepareShell(in, t, shell.outer[t], shell.mm, shell.normalToMm,
+                                      shell.boxGrowth, s))
+              continue;
+            raster::scanTet(s, k0, k1,
+                            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                                const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
+                              std::uint8_t* c = covered.data() + ((k - k0) * plane + j * nx);
+                              for (std::int64_t a = i0; a <= i1;) {
+                                if (c[a]) {
+                                  ++a;
+                                  continue;
+                                }
+                                std::int64_t b = a;
+                                while (b + 1 <= i1 && !c[b + 1]) ++b;
+                                std::fill(c + a, c + b + 1, std::uint8_t(1));
+                                localShell += b - a + 1;
+                                write(k, j, a, b, Eigen::Vector3d(rest0 + double(a - i0) * step),
+                                      step);
+                                a = b + 1;
+                              }
+                            });
+          }
+          const double fraction = double(++done) / double(slabs);
+          std::lock_guard<std::mutex> lock(progressMutex);
+          try {
+            reportProgress(options.progress, fraction, stage);
+          } catch (...) {
+            stop = true;
+            throw;
+          }
+        }
+        writes += localWrites;
+        shellWrites += localShell;
+      },
+      1);
+  if (report) {
+    *report = RasterReport();
+    report->voxelWrites = writes;
+    report->shellVoxels = shellWrites;
+    countBadTets(in, frameSign, *report);
+  }
+}
+
+double frameSign(const VolumeGeometry& output) {
+  return output.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0;
+}
+
+template <class T>
+T fromDouble(double v) {
+  if constexpr (std::is_integral_v<T>) {
+    const double r = std::round(v);
+    return static_cast<T>(std::clamp(r, double(std::numeric_limits<T>::lowest()),
+                                     double(std::numeric_limits<T>::max())));
+  } else {
+    return static_cast<T>(v);
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh) {
+  using Key = std::array<int, 3>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      return (std::size_t(k[0]) * 73856093u) ^ (std::size_t(k[1]) * 19349663u) ^
+             (std::size_t(k[2]) * 83492791u);
+    }
+  };
+  const Eigen::Index nt = mesh.tets.rows();
+  std::unordered_map<Key, int, KeyHash> uses;
+  uses.reserve(static_cast<std::size_t>(2 * nt + 16));
+  auto faceKey = [&](Eigen::Index t, int f) {
+    Key k;
+    for (int c = 0, n = 0; c < 4; ++c)
+      if (c != f) k[n++] = mesh.tets(t, c);
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int f = 0; f < 4; ++f) ++uses[faceKey(t, f)];
+  // Boundary faces, then drop those whose rest place another boundary face also occupies (cuts).
+  std::vector<std::uint8_t> outer(static_cast<std::size_t>(nt), 0);
+  std::map<std::array<double, 9>, int> places;
+  auto place = [&](const Key& k) {
+    std::array<std::array<double, 3>, 3> p;
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) p[c][a] = mesh.vertices(k[c], a);
+    std::sort(p.begin(), p.end());
+    std::array<double, 9> flat;
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) flat[3 * c + a] = p[c][a];
+    return flat;
+  };
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int f = 0; f < 4; ++f) {
+      const Key k = faceKey(t, f);
+      if (uses[k] == 1) {
+        outer[t] |= std::uint8_t(1u << f);
+        ++places[place(k)];
+      }
+    }
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int f = 0; f < 4; ++f)
+      if ((outer[t] & (1u << f)) && places[place(faceKey(t, f))] > 1)
+        outer[t] &= std::uint8_t(~(1u << f));
+  return outer;
+}
+
+VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d& deformed,
+                            double spacingMm, int marginVoxels) {
+  input.validate("rasterizer input grid");
+  if (deformed.rows() == 0 || !deformed.allFinite())
+    throw Error("rasterizer: no finite deformed vertex to size the output grid");
+  Eigen::Matrix3d M = input.ijkToRas.block<3, 3>(0, 0);
+  if (spacingMm > 0) M = input.directions() * spacingMm;
+  const Eigen::Matrix3d Minv = M.inverse();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
+    const Eigen::Vector3d u = Minv * (deformed.row(v).transpose() - input.origin());
+    lo = lo.cwiseMin(u), hi = hi.cwiseMax(u);
+  }
+  VolumeGeometry g;
+  Eigen::Vector3d start;
+  for (int c = 0; c < 3; ++c) {
+    start[c] = std::floor(lo[c]) - marginVoxels;
+    g.dims[c] = static_cast<std::int64_t>(std::ceil(hi[c]) + marginVoxels - start[c]) + 1;
+  }
+  g.ijkToRas = Eigen::Matrix4d::Identity();
+  g.ijkToRas.block<3, 3>(0, 0) = M;
+  g.ijkToRas.block<3, 1>(0, 3) = input.origin() + M * start;
+  return g;
+}
+
+Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
+                       const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                       const RasterOptions& options, RasterReport* report) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  const ScanInput in = raster::makeScanInput(mesh, deformed, labels.geometry(), output);
+  Volume out(output, labels.scalarType(), labels.layers());
+  out.setLabelMap(true);
+  out.labels() = labels.labels();
+  const auto d = labels.dims();
+  const std::int64_t nx = output.dims[0], ny = output.dims[1], plane = nx * ny;
+  dispatchScalar(labels.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const int layers = labels.layers();
+    std::vector<const T*> src(layers);
+    std::vector<T*> dst(layers);
+    for (int l = 0; l < layers; ++l) src[l] = labels.data<T>(l), dst[l] = out.data<T>(l);
+    runScan(in, makeShell(mesh, labels.geometry(), output, options), options, "rasterize labels",
+            report, frameSign(output),
+            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
+                const Eigen::Vector3d& step) {
+              const std::int64_t row = k * plane + j * nx;
+              for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+                const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
+                                   y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
+                                   z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
+                const bool in = x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2];
+                const std::int64_t at = x + d[0] * (y + d[1] * z);
+                for (int l = 0; l < layers; ++l) dst[l][row + i] = in ? src[l][at] : T(0);
+              }
+            });
+  });
+  return out;
+}
+
+Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
+                      const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                      double background, const RasterOptions& options, RasterReport* report) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  if (image.layers() != 1) throw Error("rasterizer: an intensity image must have one layer");
+  const ScanInput in = raster::makeScanInput(mesh, deformed, image.geometry(), output);
+  Volume out(output, image.scalarType());
+  const auto d = image.dims();
+  const std::int64_t nx = output.dims[0], ny = output.dims[1], plane = nx * ny;
+  dispatchScalar(image.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const T fill = fromDouble<T>(background);
+    T* dst = out.data<T>();
+    std::fill(dst, dst + out.numVoxels(), fill);
+    const T* src = image.data<T>();
+    runScan(in, makeShell(mesh, image.geometry(), output, options), options, "rasterize image",
+            report, frameSign(output),
+            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
+                const Eigen::Vector3d& step) {
+              const std::int64_t row = k * plane + j * nx;
+              for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+                // Trilinear over the 8 voxel centres around p, clamped at the grid's edge;
+                // background beyond half a voxel outside it.
+                if (!(p.x() >= -0.5 && p.y() >= -0.5 && p.z() >= -0.5 && p.x() <= d[0] - 0.5 &&
+                      p.y() <= d[1] - 0.5 && p.z() <= d[2] - 0.5)) {
+                  dst[row + i] = fill;
+                  continue;
+                }
+                const double fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
+                const double tx = p.x() - fx, ty = p.y() - fy, tz = p.z() - fz;
+                auto clampTo = [](double f, std::int64_t n) {
+                  return std::clamp<std::int64_t>(std::int64_t(f), 0, n - 1);
+                };
+                const std::int64_t x = clampTo(fx, d[0]), y = clampTo(fy, d[1]),
+                                   z = clampTo(fz, d[2]);
+                const std::int64_t x1 = clampTo(fx + 1, d[0]), y1 = clampTo(fy + 1, d[1]),
+                                   z1 = clampTo(fz + 1, d[2]);
+                auto v = [&](std::int64_t a, std::int64_t b, std::int64_t c) {
+                  return double(src[a + d[0] * (b + d[1] * c)]);
+                };
+                const double c00 = v(x, y, z) * (1 - tx) + v(x1, y, z) * tx;
+                const double c10 = v(x, y1, z) * (1 - tx) + v(x1, y1, z) * tx;
+                const double c01 = v(x, y, z1) * (1 - tx) + v(x1, y, z1) * tx;
+                const double c11 = v(x, y1, z1) * (1 - tx) + v(x1, y1, z1) * tx;
+                const double c0 = c00 * (1 - ty) + c10 * ty, c1 = c01 * (1 - ty) + c11 * ty;
+                dst[row + i] = fromDouble<T>(c0 * (1 - tz) + c1 * tz);
+              }
+            });
+  });
+  return out;
+}
+
+Volume rasterizeCoverage(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                         const VolumeGeometry& output, const RasterOptions& options) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  const ScanInput in = raster::makeScanInput(mesh, deformed, output, output);
+  Volume out(output, ScalarType::UInt8);
+  std::uint8_t* dst = out.data<std::uint8_t>();
+  const std::int64_t nx = output.dims[0], plane = nx * output.dims[1];
+  runScan(in, Shell(), options, "coverage", nullptr, frameSign(output),
+          [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+              const Eigen::Vector3d&, const Eigen::Vector3d&) {
+            std::uint8_t* row = dst + k * plane + j * nx;
+            for (std::int64_t i = i0; i <= i1; ++i)
+              if (row[i] < 255) ++row[i];
+          });
+  return out;
+}
+
+}  // namespace repose

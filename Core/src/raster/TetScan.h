@@ -1,0 +1,183 @@
+// Scan conversion of deformed tets onto an output grid (seed §4.3), the engine behind the label,
+// image, coverage and slice rasterizers.
+//
+// Everything happens in the output grid's continuous IJK space, where voxel (i,j,k)'s centre is
+// the point (i,j,k). For each tet and each row (j,k) of its bounding box the voxels inside form
+// one interval, found from the four face planes and then checked voxel by voxel at its ends, so
+// the interval is exactly the set the inside predicate accepts. The rest position (input IJK) is
+// affine in the output position, so along a row it advances by a constant step.
+//
+// Tie rule: each face plane is computed from its three vertices in increasing index order, so the
+// two tets sharing a face evaluate bit-identical plane values at every voxel centre. A centre on a
+// plane is decided as if moved by (e, e^2, e^3) for an infinitesimal e (simulation of
+// simplicity): the sign of the value, else of the normal's x, y, z. Every centre then lies strictly
+// inside or outside each tet, and one inside a conforming mesh is in exactly one tet. This is
+// exact when the plane values are (vertices on the grid, as for an identity or a whole-voxel
+// shift: RasterizerTest). A centre exactly on a face or edge through vertices at arbitrary
+// positions is decided by the rounded value, which can write it twice or not at all; for a
+// deformed mesh that is a measure-zero event (exact predicates would remove it at some cost).
+// (ReposeCore is compiled with -ffp-contract=off so no fused multiply-add breaks that identity.)
+#pragma once
+
+#include "repose/mesh/TransferMesh.h"
+#include "repose/volume/VolumeGeometry.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace repose::raster {
+
+// Vertex positions mapped once into the grids the scan works in.
+struct ScanInput {
+  const Eigen::MatrixX4i* tets = nullptr;
+  std::vector<Eigen::Vector3d> out;           // deformed positions in output IJK
+  std::vector<Eigen::Vector3d> rest;          // rest positions in input IJK
+  std::array<std::int64_t, 3> dims{0, 0, 0};  // output grid
+};
+
+inline ScanInput makeScanInput(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                               const VolumeGeometry& input, const VolumeGeometry& output) {
+  ScanInput s;
+  s.tets = &mesh.tets;
+  s.dims = output.dims;
+  const Eigen::Matrix4d toOut = output.ijkToRas.inverse(), toIn = input.ijkToRas.inverse();
+  s.out.resize(static_cast<std::size_t>(deformed.rows()));
+  s.rest.resize(s.out.size());
+  for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
+    s.out[v] = toOut.block<3, 3>(0, 0) * deformed.row(v).transpose() + toOut.block<3, 1>(0, 3);
+    s.rest[v] = toIn.block<3, 3>(0, 0) * mesh.vertices.row(v).transpose() + toIn.block<3, 1>(0, 3);
+  }
+  return s;
+}
+
+struct Plane {
+  Eigen::Vector3d n;
+  double d = 0;
+  int side = 0;  // +1 or -1: the sign the tet's inside has
+  double at(double i, double j, double k) const {
+    return ((n.x() * i + n.y() * j) + n.z() * k) - d;
+  }
+  // Sign at (i,j,k) after the infinitesimal shift (e, e^2, e^3).
+  int sign(double i, double j, double k) const {
+    const double s = at(i, j, k);
+    if (s != 0) return s > 0 ? 1 : -1;
+    if (n.x() != 0) return n.x() > 0 ? 1 : -1;
+    if (n.y() != 0) return n.y() > 0 ? 1 : -1;
+    return n.z() > 0 ? 1 : (n.z() < 0 ? -1 : 0);
+  }
+  bool accepts(double i, double j, double k) const { return sign(i, j, k) == side; }
+};
+
+// One deformed tet ready to scan.
+struct ScanTet {
+  std::array<Plane, 4> faces;
+  Eigen::Matrix3d A;                   // d(rest input IJK) / d(output IJK)
+  Eigen::Vector3d q0, r0;              // vertex 0: output and rest positions
+  std::array<std::int64_t, 3> lo, hi;  // voxel-centre bounding box, clipped to the grid
+  double signedVolume = 0;             // in output IJK units; < 0 for a tet turned inside out
+};
+
+// False for a tet whose deformed volume is zero (no voxel can be inside it) or whose box misses
+// the grid.
+inline bool prepareTet(const ScanInput& in, Eigen::Index t, ScanTet& s,
+                       const std::array<double, 3>& boxGrowth = {0, 0, 0}) {
+  const Eigen::MatrixX4i& T = *in.tets;
+  const std::array<int, 4> v{T(t, 0), T(t, 1), T(t, 2), T(t, 3)};
+  Eigen::Matrix3d D, R;
+  for (int c = 0; c < 3; ++c) {
+    D.col(c) = in.out[v[c + 1]] - in.out[v[0]];
+    R.col(c) = in.rest[v[c + 1]] - in.rest[v[0]];
+  }
+  s.signedVolume = D.determinant() / 6;
+  if (!(s.signedVolume != 0) || !std::isfinite(s.signedVolume)) return false;
+  for (int c = 0; c < 3; ++c) {
+    double mn = in.out[v[0]][c], mx = mn;
+    for (int k = 1; k < 4; ++k)
+      mn = std::min(mn, in.out[v[k]][c]), mx = std::max(mx, in.out[v[k]][c]);
+    s.lo[c] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(mn - boxGrowth[c])));
+    s.hi[c] = std::min<std::int64_t>(in.dims[c] - 1,
+                                     static_cast<std::int64_t>(std::floor(mx + boxGrowth[c])));
+    if (s.lo[c] > s.hi[c]) return false;
+  }
+  // Face f is opposite vertex f; its plane from the other three in increasing index order.
+  for (int f = 0; f < 4; ++f) {
+    std::array<int, 3> w;
+    for (int k = 0, n = 0; k < 4; ++k)
+      if (k != f) w[n++] = v[k];
+    std::sort(w.begin(), w.end());
+    const Eigen::Vector3d &a = in.out[w[0]], &b = in.out[w[1]], &c = in.out[w[2]];
+    Plane& p = s.faces[f];
+    p.n = (b - a).cross(c - a);
+    p.d = (p.n.x() * a.x() + p.n.y() * a.y()) + p.n.z() * a.z();
+    const double opposite = p.at(in.out[v[f]].x(), in.out[v[f]].y(), in.out[v[f]].z());
+    if (opposite == 0) return false;  // flat in floating point
+    p.side = opposite > 0 ? 1 : -1;
+  }
+  s.A = R * D.inverse();
+  s.q0 = in.out[v[0]];
+  s.r0 = in.rest[v[0]];
+  return true;
+}
+
+// The tet grown beyond its outer faces (bits of `outer`, face f opposite vertex f) by `shell` mm
+// (`normalToMm` = M^-T for the output's IJK->RAS linear part M, so |M^-T n| turns a plane value
+// into mm), clipped to its box grown by `boxGrowth` voxels per axis. For the voxels just outside
+// the mesh's surface, which Mesh_3 places only to within a voxel of the label boundary.
+inline bool prepareShell(const ScanInput& in, Eigen::Index t, unsigned outer, double shell,
+                         const Eigen::Matrix3d& normalToMm, const std::array<double, 3>& boxGrowth,
+                         ScanTet& s) {
+  if (!prepareTet(in, t, s, boxGrowth)) return false;
+  for (int f = 0; f < 4; ++f)
+    if (outer & (1u << f)) {
+      Plane& p = s.faces[f];
+      p.d -= p.side * shell * (normalToMm * p.n).norm();
+    }
+  return true;
+}
+
+inline bool inside(const ScanTet& s, double i, double j, double k) {
+  return s.faces[0].accepts(i, j, k) && s.faces[1].accepts(i, j, k) &&
+         s.faces[2].accepts(i, j, k) && s.faces[3].accepts(i, j, k);
+}
+
+// Calls span(k, j, i0, i1, rest0, step) for every row interval [i0, i1] of voxels of slices
+// [k0, k1) inside the tet; rest0 is the rest position (input IJK) of voxel i0 and step its change
+// per voxel along i.
+template <class Span>
+void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, Span&& span) {
+  const std::int64_t kb = std::max(k0, s.lo[2]), ke = std::min(k1 - 1, s.hi[2]);
+  const Eigen::Vector3d step = s.A.col(0);
+  for (std::int64_t k = kb; k <= ke; ++k)
+    for (std::int64_t j = s.lo[1]; j <= s.hi[1]; ++j) {
+      // Interval from the planes, widened by a voxel, then trimmed by the exact predicate.
+      double a = static_cast<double>(s.lo[0]) - 1, b = static_cast<double>(s.hi[0]) + 1;
+      bool empty = false;
+      for (const Plane& p : s.faces) {
+        const double slope = p.side * p.n.x();
+        const double c = p.side * p.at(0, double(j), double(k));
+        if (slope > 0)
+          a = std::max(a, std::floor(-c / slope) - 1);
+        else if (slope < 0)
+          b = std::min(b, std::ceil(-c / slope) + 1);
+        else if (!p.accepts(0, double(j), double(k)))
+          empty = true;
+      }
+      if (empty) continue;
+      std::int64_t i0 = std::max(s.lo[0], static_cast<std::int64_t>(a));
+      std::int64_t i1 = std::min(s.hi[0], static_cast<std::int64_t>(b));
+      while (i0 <= i1 && !inside(s, double(i0), double(j), double(k))) ++i0;
+      while (i1 >= i0 && !inside(s, double(i1), double(j), double(k))) --i1;
+      if (i0 > i1) continue;
+      const Eigen::Vector3d x{static_cast<double>(i0), static_cast<double>(j),
+                              static_cast<double>(k)};
+      span(k, j, i0, i1, Eigen::Vector3d(s.r0 + s.A * (x - s.q0)), step);
+    }
+}
+
+}  // namespace repose::raster

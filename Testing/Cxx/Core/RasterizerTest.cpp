@@ -1,0 +1,318 @@
+// The rasterizer (seed §4.3): every voxel centre written exactly once under the tie rule, exact
+// identity / quarter-turn / whole-voxel translation on the phantom, a rigid forearm under elbow
+// flexion, images with trilinear interpolation, a grid that never clips, folds reported.
+#include "TestTetMeshes.h"
+
+#include "repose/cage/CageBuilder.h"
+#include "repose/mesh/RigiditySolver.h"
+#include "repose/mesh/TransferMesh.h"
+#include "repose/phantom/Phantom.h"
+#include "repose/phantom/PhantomPoses.h"
+#include "repose/raster/Rasterizer.h"
+#include "repose/util/Error.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+VolumeGeometry unitGrid(std::array<std::int64_t, 3> dims) {
+  return VolumeGeometry::make(dims, {1, 1, 1}, {0, 0, 0});
+}
+
+// Voxel centres on many faces, edges and vertices: a box of 6x5x4 cells of 2 voxels each.
+TransferMesh alignedBox() {
+  return tetBox({2, 2, 2}, {14, 12, 10}, {6, 5, 4});
+}
+
+// Under the tie rule a centre on the boundary counts as inside iff moving it by (+e, +e^2, +e^3)
+// enters the box: the half-open box [lo, hi) in every axis.
+void expectHalfOpenBox(const Volume& coverage, const Eigen::Vector3i& lo,
+                       const Eigen::Vector3i& hi) {
+  const std::uint8_t* c = coverage.data<std::uint8_t>();
+  const auto d = coverage.dims();
+  int wrong = 0;
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    for (std::int64_t j = 0; j < d[1]; ++j)
+      for (std::int64_t i = 0; i < d[0]; ++i) {
+        const bool in =
+            i >= lo.x() && i < hi.x() && j >= lo.y() && j < hi.y() && k >= lo.z() && k < hi.z();
+        wrong += c[coverage.index(i, j, k)] != (in ? 1 : 0);
+      }
+  EXPECT_EQ(wrong, 0);
+}
+
+struct PhantomScene {
+  Phantom phantom;
+  Volume organs, parts;
+  TriangleMesh cage;
+  TransferMesh mesh;
+  std::unique_ptr<CageDeformation> deformation;
+};
+
+const PhantomScene& phantomScene() {
+  static const PhantomScene* s = [] {
+    PhantomOptions po;
+    po.voxelMm = 4;
+    auto* p = new PhantomScene{Phantom(po), {}, {}, {}, {}, nullptr};
+    std::tie(p->organs, p->parts) = p->phantom.makeVolumes();
+    p->cage = buildCage(p->parts, {}).mesh;
+    p->mesh = buildTransferMesh(p->parts, {});
+    p->deformation = std::make_unique<CageDeformation>(p->mesh, p->cage);
+    return p;
+  }();
+  return *s;
+}
+
+// Expected output: the label of G at the rest position rest(c) of each output voxel centre c.
+template <class RestOf>
+Volume mapDirectly(const Volume& G, const VolumeGeometry& out, RestOf&& restOf) {
+  Volume v(out, G.scalarType());
+  const auto d = out.dims;
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    for (std::int64_t j = 0; j < d[1]; ++j)
+      for (std::int64_t i = 0; i < d[0]; ++i) {
+        const Eigen::Vector3d p = G.geometry().rasToVoxel(restOf(out.voxelToRas(i, j, k)));
+        const Eigen::Vector3d r = (p.array() + 0.5).floor();
+        if ((r.array() < 0).any() || r.x() >= G.dims()[0] || r.y() >= G.dims()[1] ||
+            r.z() >= G.dims()[2])
+          continue;
+        v.data<std::uint8_t>()[v.index(i, j, k)] = G.data<std::uint8_t>()[G.index(
+            std::int64_t(r.x()), std::int64_t(r.y()), std::int64_t(r.z()))];
+      }
+  return v;
+}
+
+std::int64_t countDifferent(const Volume& a, const Volume& b) {
+  EXPECT_EQ(a.dims(), b.dims());
+  std::int64_t n = 0;
+  for (std::int64_t v = 0; v < a.numVoxels(); ++v)
+    n += a.data<std::uint8_t>()[v] != b.data<std::uint8_t>()[v];
+  return n;
+}
+
+}  // namespace
+
+TEST(Rasterizer, EveryCentreOnSharedFacesEdgesAndVerticesIsWrittenOnce) {
+  const TransferMesh box = alignedBox();
+  const Volume coverage = rasterizeCoverage(box, box.vertices, unitGrid({18, 16, 14}));
+  expectHalfOpenBox(coverage, {2, 2, 2}, {14, 12, 10});
+}
+
+// Interior vertices in general position: no crack and no double write across any shared face.
+// (The grid is offset by a fraction of a voxel so no centre lies exactly on a face or edge through
+// a moved vertex: there the plane value is rounding noise, see TetScan.h.)
+TEST(Rasterizer, NoCrackOrOverlapWhenInteriorVerticesMove) {
+  TransferMesh box = alignedBox();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  Eigen::MatrixX3d moved = box.vertices;
+  for (Eigen::Index v = 0; v < moved.rows(); ++v) {
+    const Eigen::RowVector3d p = moved.row(v);
+    const bool interior =
+        p.x() > 2 && p.x() < 14 && p.y() > 2 && p.y() < 12 && p.z() > 2 && p.z() < 10;
+    if (interior) moved.row(v) += Eigen::RowVector3d(jitter(rng), jitter(rng), jitter(rng));
+  }
+  RasterReport report;
+  const VolumeGeometry grid =
+      VolumeGeometry::make({18, 16, 14}, {1, 1, 1}, {0.6234, 0.5567, 0.5891});
+  const Volume coverage = rasterizeCoverage(box, moved, grid);
+  expectHalfOpenBox(coverage, {2, 2, 2}, {14, 12, 10});
+  // Same through the label path, which also reports: no fold, every covered voxel once.
+  Volume G(grid, ScalarType::UInt8);
+  std::fill(G.data<std::uint8_t>(), G.data<std::uint8_t>() + G.numVoxels(), 3);
+  rasterizeLabels(G, box, moved, G.geometry(), {}, &report);
+  EXPECT_EQ(report.voxelWrites, 12 * 10 * 8);
+  EXPECT_EQ(report.invertedTets, 0);
+  EXPECT_EQ(report.flatTets, 0);
+}
+
+TEST(Rasterizer, FoldsAreCountedAndResolvedTheSameWayEveryRun) {
+  TransferMesh box = alignedBox();
+  Eigen::MatrixX3d folded = box.vertices;
+  // Push one interior vertex through its neighbours: some tets turn inside out.
+  for (Eigen::Index v = 0; v < folded.rows(); ++v)
+    if (folded.row(v) == Eigen::RowVector3d(8, 6, 6)) folded(v, 0) += 5;
+  Volume G(unitGrid({18, 16, 14}), ScalarType::UInt8);
+  for (std::int64_t v = 0; v < G.numVoxels(); ++v)
+    G.data<std::uint8_t>()[v] = std::uint8_t(v % 7 + 1);
+  RasterReport r1, r2;
+  RasterOptions one, two;
+  one.threads = 1, two.threads = 2;
+  const Volume a = rasterizeLabels(G, box, folded, G.geometry(), one, &r1);
+  const Volume b = rasterizeLabels(G, box, folded, G.geometry(), two, &r2);
+  EXPECT_GT(r1.invertedTets, 0);
+  EXPECT_GT(r1.voxelWrites, 12 * 10 * 8);  // the fold covers some centres twice
+  EXPECT_EQ(r1.invertedTets, r2.invertedTets);
+  EXPECT_EQ(a.bytes(), b.bytes());
+  const Volume c = rasterizeCoverage(box, folded, G.geometry());
+  EXPECT_GT(*std::max_element(c.data<std::uint8_t>(), c.data<std::uint8_t>() + c.numVoxels()), 1);
+}
+
+TEST(Rasterizer, OutputGridKeepsAxesAndSpacingShiftsByWholeVoxelsAndNeverClips) {
+  const VolumeGeometry in = VolumeGeometry::make(
+      {20, 30, 40}, {1.5, 1.5, 3}, {-10, 4, 7},
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix());
+  Eigen::MatrixX3d pts(3, 3);
+  pts << -200, 5, 9, 300, 40, -60, 0, 0, 500;
+  const VolumeGeometry out = deformedGrid(in, pts);
+  const Eigen::Matrix3d Min = in.ijkToRas.block<3, 3>(0, 0), Mout = out.ijkToRas.block<3, 3>(0, 0);
+  EXPECT_TRUE(Mout.isApprox(Min));
+  const Eigen::Vector3d shift = in.rasToVoxel(out.origin());
+  EXPECT_LT((shift - shift.array().round().matrix()).norm(), 1e-9);
+  for (int p = 0; p < 3; ++p) {
+    const Eigen::Vector3d v = out.rasToVoxel(pts.row(p).transpose());
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GE(v[c], 0);
+      EXPECT_LE(v[c], out.dims[c] - 1);
+    }
+  }
+  const VolumeGeometry coarse = deformedGrid(in, pts, 2.0);
+  EXPECT_TRUE(coarse.spacing().isApprox(Eigen::Vector3d(2, 2, 2)));
+  EXPECT_TRUE(coarse.directions().isApprox(in.directions()));
+}
+
+TEST(Rasterizer, IdentityReproducesThePhantomVoxelForVoxel) {
+  const PhantomScene& s = phantomScene();
+  RasterReport report;
+  const Volume out =
+      rasterizeLabels(s.organs, s.mesh, s.mesh.vertices, s.organs.geometry(), {}, &report);
+  EXPECT_EQ(countDifferent(out, s.organs), 0);
+  EXPECT_EQ(report.invertedTets, 0);
+  EXPECT_EQ(out.labels().size(), s.organs.labels().size());
+}
+
+TEST(Rasterizer, QuarterTurnOfTheCageEqualsTheRotatedLabelMap) {
+  const PhantomScene& s = phantomScene();
+  // 90 degrees about z through a voxel centre near the body's middle.
+  const Eigen::Vector3d pivot = s.organs.geometry().voxelToRas(40, 20, 100);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::MatrixX3d cage =
+      ((s.cage.vertices.rowwise() - pivot.transpose()) * R.transpose()).rowwise() +
+      pivot.transpose();
+  const Eigen::MatrixX3d deformed = s.deformation->deform(cage);
+  const VolumeGeometry grid = deformedGrid(s.organs.geometry(), deformed);
+  const Volume out = rasterizeLabels(s.organs, s.mesh, deformed, grid);
+  const Volume expected = mapDirectly(s.organs, grid, [&](const Eigen::Vector3d& c) {
+    return Eigen::Vector3d(R.transpose() * (c - pivot) + pivot);
+  });
+  EXPECT_EQ(countDifferent(out, expected), 0);
+}
+
+TEST(Rasterizer, WholeVoxelTranslationEqualsTheShiftedLabelMap) {
+  const PhantomScene& s = phantomScene();
+  const Eigen::Vector3d t =
+      s.organs.geometry().ijkToRas.block<3, 3>(0, 0) * Eigen::Vector3d(3, -5, 11);
+  const Eigen::MatrixX3d deformed =
+      s.deformation->deform(s.cage.vertices.rowwise() + t.transpose());
+  const VolumeGeometry grid = deformedGrid(s.organs.geometry(), deformed);
+  const Volume out = rasterizeLabels(s.organs, s.mesh, deformed, grid);
+  const Volume expected =
+      mapDirectly(s.organs, grid, [&](const Eigen::Vector3d& c) { return Eigen::Vector3d(c - t); });
+  EXPECT_EQ(countDifferent(out, expected), 0);
+}
+
+TEST(Rasterizer, ImagesAreInterpolatedTrilinearly) {
+  // A linear ramp is reproduced exactly by trilinear interpolation under any affine map.
+  const TransferMesh box = alignedBox();
+  Volume I(unitGrid({18, 16, 14}), ScalarType::Float32);
+  for (std::int64_t k = 0; k < 14; ++k)
+    for (std::int64_t j = 0; j < 16; ++j)
+      for (std::int64_t i = 0; i < 18; ++i)
+        I.data<float>()[I.index(i, j, k)] = float(2 * i - j + 3 * k);
+  const Eigen::RowVector3d shift(0.5, 0.25, 0);  // half a voxel: values between centres
+  const Eigen::MatrixX3d moved = box.vertices.rowwise() + shift;
+  const Volume out = rasterizeImage(I, box, moved, I.geometry(), -1000);
+  int checked = 0;
+  for (std::int64_t k = 0; k < 14; ++k)
+    for (std::int64_t j = 0; j < 16; ++j)
+      for (std::int64_t i = 0; i < 18; ++i) {
+        const float v = out.data<float>()[out.index(i, j, k)];
+        const bool inside = i >= 3 && i < 15 && j >= 3 && j < 13 && k >= 2 && k < 10;
+        if (!inside) {
+          EXPECT_TRUE(v == -1000 || std::fabs(v - (2 * (i - 0.5) - (j - 0.25) + 3 * k)) < 1e-4);
+          continue;
+        }
+        EXPECT_NEAR(v, 2 * (i - 0.5) - (j - 0.25) + 3 * k, 1e-4);
+        ++checked;
+      }
+  EXPECT_GT(checked, 500);
+  // Integer images are rounded and clamped.
+  Volume ct(unitGrid({18, 16, 14}), ScalarType::Int16);
+  std::fill(ct.data<std::int16_t>(), ct.data<std::int16_t>() + ct.numVoxels(), std::int16_t(-1024));
+  const Volume posed = rasterizeImage(ct, box, box.vertices, ct.geometry(), -40000);
+  EXPECT_EQ(posed.data<std::int16_t>()[posed.index(17, 15, 13)], -32768);  // clamped background
+  EXPECT_EQ(posed.data<std::int16_t>()[posed.index(5, 5, 5)], -1024);      // interpolated
+}
+
+TEST(Rasterizer, RefusesMismatchedOrNonFiniteDeformations) {
+  const TransferMesh box = alignedBox();
+  Volume G(unitGrid({18, 16, 14}), ScalarType::UInt8);
+  EXPECT_THROW(rasterizeLabels(G, box, Eigen::MatrixX3d::Zero(3, 3), G.geometry()), Error);
+  Eigen::MatrixX3d bad = box.vertices;
+  bad(4, 1) = std::nan("");
+  EXPECT_THROW(rasterizeLabels(G, box, bad, G.geometry()), Error);
+  RasterOptions cancel;
+  cancel.progress = [](double, const std::string&) { return false; };
+  EXPECT_THROW(rasterizeLabels(G, box, box.vertices, G.geometry(), cancel), Cancelled);
+}
+
+// The shell: voxels up to shellMm outside the mesh's outer faces follow the boundary tets' maps
+// (the skin Mesh_3 leaves just outside the TM); faces shared by two tets or cut by a label
+// separation get none; shellMm = 0 writes only voxels inside tets.
+TEST(Rasterizer, ShellCoversVoxelsJustOutsideTheOuterFacesOnly) {
+  const TransferMesh box = alignedBox();  // [2, 14) x [2, 12) x [2, 10)
+  const std::vector<std::uint8_t> outer = outerFaces(box);
+  int outerCount = 0;
+  for (std::uint8_t m : outer) outerCount += __builtin_popcount(m);
+  EXPECT_EQ(outerCount, 2 * 2 * (6 * 5 + 6 * 4 + 5 * 4));  // two triangles per boundary square
+  Volume G(unitGrid({18, 16, 14}), ScalarType::UInt8);
+  std::fill(G.data<std::uint8_t>(), G.data<std::uint8_t>() + G.numVoxels(), 5);
+  RasterOptions none, shell;
+  none.shellMm = 0;
+  shell.shellMm = 1.5;
+  RasterReport r0, r1;
+  const Volume inside = rasterizeLabels(G, box, box.vertices, G.geometry(), none, &r0);
+  const Volume grown = rasterizeLabels(G, box, box.vertices, G.geometry(), shell, &r1);
+  EXPECT_EQ(r0.shellVoxels, 0);
+  EXPECT_EQ(r1.voxelWrites, r0.voxelWrites);
+  // Inside tets: [2, 14) etc. With a 1.5 mm shell: one more layer below (x = 1) and the face
+  // layer above (x = 14), along each axis; corners within 1.5 mm of the box too.
+  std::int64_t faceLayers = 0;
+  for (std::int64_t k = 0; k < 14; ++k)
+    for (std::int64_t j = 0; j < 16; ++j)
+      for (std::int64_t i = 0; i < 18; ++i) {
+        const std::int64_t at = G.index(i, j, k);
+        const bool in = i >= 2 && i < 14 && j >= 2 && j < 12 && k >= 2 && k < 10;
+        EXPECT_EQ(inside.data<std::uint8_t>()[at], in ? 5 : 0);
+        if (in) {
+          EXPECT_EQ(grown.data<std::uint8_t>()[at], 5);
+        }
+        const bool layer = i >= 1 && i <= 14 && j >= 2 && j < 12 && k >= 2 && k < 10;
+        if (layer && !in) {
+          EXPECT_EQ(grown.data<std::uint8_t>()[at], 5) << i << " " << j << " " << k;
+          ++faceLayers;
+        }
+        const double dx = std::max({2.0 - i, i - 14.0, 0.0}),
+                     dy = std::max({2.0 - j, j - 12.0, 0.0}),
+                     dz = std::max({2.0 - k, k - 10.0, 0.0});
+        if (std::sqrt(dx * dx + dy * dy + dz * dz) > 1.5 * std::sqrt(3.0) + 1e-9) {
+          EXPECT_EQ(grown.data<std::uint8_t>()[at], 0) << i << " " << j << " " << k;
+        }
+      }
+  EXPECT_EQ(faceLayers, 2 * 10 * 8);
+  EXPECT_GE(r1.shellVoxels, faceLayers);
+  // Two boxes side by side that were separated (vertices duplicated at x = 14): the cut faces
+  // are not outer, so neither side grows into the other.
+  const TransferMesh cut = concatenate(alignedBox(), tetBox({14, 2, 2}, {16, 12, 10}, {1, 5, 4}));
+  const std::vector<std::uint8_t> cutOuter = outerFaces(cut);
+  int cutCount = 0;
+  for (std::uint8_t m : cutOuter) cutCount += __builtin_popcount(m);
+  EXPECT_EQ(cutCount, 2 * 2 * (7 * 5 + 7 * 4 + 5 * 4));
+}
