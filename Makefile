@@ -36,4 +36,5 @@ bench: build
 	$(BUILD_DIR)/bin/ReposeIOBench --benchmark_min_time=0.2
 	$(BUILD_DIR)/bin/ReposeCageBench --benchmark_min_time=0.2
 	$(BUILD_DIR)/bin/ReposeFrameBench --benchmark_min_time=0.5
+	$(BUILD_DIR)/bin/ReposeRasterBench
 	$(BUILD_DIR)/bin/ReposeRefinementBench

@@ -223,6 +223,24 @@ std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh) {
   return outer;
 }
 
+VolumeGeometry slicePlaneGrid(SliceOrientation orientation, double positionMm,
+                              const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int pixels) {
+  if (pixels < 1) throw Error("a slice needs at least one pixel");
+  // In-plane RAS axes (u, v) and the normal n of each orientation.
+  int u = 0, v = 1, n = 2;
+  if (orientation == SliceOrientation::Coronal) u = 0, v = 2, n = 1;
+  if (orientation == SliceOrientation::Sagittal) u = 1, v = 2, n = 0;
+  const double pixel = std::max(hi[u] - lo[u], hi[v] - lo[v]) / pixels;
+  if (!(pixel > 0) || !std::isfinite(pixel)) throw Error("a slice needs a box with an extent");
+  VolumeGeometry g;
+  g.dims = {pixels, pixels, 1};
+  g.ijkToRas = Eigen::Matrix4d::Zero();
+  g.ijkToRas(u, 0) = pixel, g.ijkToRas(v, 1) = pixel, g.ijkToRas(n, 2) = 1, g.ijkToRas(3, 3) = 1;
+  g.ijkToRas(u, 3) = lo[u] + pixel / 2, g.ijkToRas(v, 3) = lo[v] + pixel / 2;
+  g.ijkToRas(n, 3) = positionMm;
+  return g;
+}
+
 VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d& deformed,
                             double spacingMm, int marginVoxels) {
   input.validate("rasterizer input grid");

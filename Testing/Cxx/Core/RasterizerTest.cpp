@@ -316,3 +316,37 @@ TEST(Rasterizer, ShellCoversVoxelsJustOutsideTheOuterFacesOnly) {
   for (std::uint8_t m : cutOuter) cutCount += __builtin_popcount(m);
   EXPECT_EQ(cutCount, 2 * 2 * (7 * 5 + 7 * 4 + 5 * 4));
 }
+
+// A live slice is the rasterizer on a one-voxel-thick grid: on the full output's own voxel
+// centres it gives exactly that slice of the full output.
+TEST(Rasterizer, SliceEqualsThatPlaneOfTheFullOutput) {
+  const PhantomScene& s = phantomScene();
+  const Eigen::Vector3d t(12, -30, 40);
+  const Eigen::MatrixX3d deformed =
+      s.deformation->deform(s.cage.vertices.rowwise() + t.transpose());
+  const VolumeGeometry full = deformedGrid(s.organs.geometry(), deformed);
+  const Volume out = rasterizeLabels(s.organs, s.mesh, deformed, full);
+  const std::int64_t k = full.dims[2] / 2;
+  VolumeGeometry plane = full;
+  plane.dims[2] = 1;
+  plane.ijkToRas.block<3, 1>(0, 3) = full.voxelToRas(0, 0, double(k));
+  const Volume slice = rasterizeLabels(s.organs, s.mesh, deformed, plane);
+  const std::int64_t n = full.dims[0] * full.dims[1];
+  EXPECT_TRUE(std::equal(slice.data<std::uint8_t>(), slice.data<std::uint8_t>() + n,
+                         out.data<std::uint8_t>() + k * n));
+  // The view grids: square pixels, RAS-aligned, on the requested plane.
+  const Eigen::Vector3d lo(-100, -50, 0), hi(100, 50, 1000);
+  const VolumeGeometry axial = slicePlaneGrid(SliceOrientation::Axial, 700, lo, hi, 512);
+  EXPECT_EQ(axial.dims, (std::array<std::int64_t, 3>{512, 512, 1}));
+  EXPECT_NEAR(axial.voxelToRas(0, 0, 0).z(), 700, 1e-9);
+  EXPECT_NEAR(axial.spacing()[0], 200.0 / 512, 1e-12);
+  const VolumeGeometry coronal = slicePlaneGrid(SliceOrientation::Coronal, 5, lo, hi, 512);
+  EXPECT_NEAR(coronal.voxelToRas(3, 7, 0).y(), 5, 1e-9);
+  EXPECT_NEAR(coronal.spacing()[1], 1000.0 / 512, 1e-12);
+  const VolumeGeometry sagittal = slicePlaneGrid(SliceOrientation::Sagittal, -20, lo, hi, 256);
+  EXPECT_NEAR(sagittal.voxelToRas(9, 2, 0).x(), -20, 1e-9);
+  const Volume live = rasterizeLabels(s.organs, s.mesh, deformed, sagittal);
+  EXPECT_GT(
+      *std::max_element(live.data<std::uint8_t>(), live.data<std::uint8_t>() + live.numVoxels()),
+      0);
+}

@@ -25,6 +25,14 @@ VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d&
 // a cut made by separateLabels, which are inside the body).
 std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh);
 
+// Live slices: a one-voxel-thick RAS-aligned grid on a slice plane at `positionMm` along its
+// normal (S for axial, A for coronal, R for sagittal), square pixels, `pixels` across the larger
+// in-plane side of the box [lo, hi]. Rasterizing onto it gives the deformed labels on that plane
+// only (a view's slice while the cage is dragged).
+enum class SliceOrientation { Axial, Coronal, Sagittal };
+VolumeGeometry slicePlaneGrid(SliceOrientation orientation, double positionMm,
+                              const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int pixels);
+
 struct RasterOptions {
   int threads = 0;
   ProgressFn progress;  // called from worker threads, one call at a time; false cancels
