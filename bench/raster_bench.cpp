@@ -168,5 +168,9 @@ void BM_LiveSlice(benchmark::State& state) {
 
 BENCHMARK(BM_RasterizeLabels)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VtkProbeFilterBaseline)->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_LiveSlice)->Arg(0)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+// Arguments: orientation (0 axial, 1 coronal, 2 sagittal), threads (0: all cores).
+BENCHMARK(BM_LiveSlice)
+    ->ArgsProduct({{0, 1, 2}, {1, 0}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -74,21 +74,38 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
              const std::string& stage, RasterReport* report, double frameSign, Write&& write) {
   const Eigen::MatrixX4i& T = *in.tets;
   const Eigen::Index nt = T.rows();
-  const double kGrowth = shell.outer.empty() ? 0 : shell.boxGrowth[2];
-  std::vector<std::int32_t> kmin(nt), kmax(nt);
+  // Each tet's box in j and k (grown for the shell if it has an outer face), to skip it cheaply
+  // outside a work item. Only tets whose box meets the grid are kept: for a live slice, the few
+  // crossing it, found with plain comparisons first since every tet is looked at.
+  const bool withShell = !shell.outer.empty();
+  std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax;
   for (Eigen::Index t = 0; t < nt; ++t) {
-    double lo = in.out[T(t, 0)].z(), hi = lo;
-    for (int c = 1; c < 4; ++c)
-      lo = std::min(lo, in.out[T(t, c)].z()), hi = std::max(hi, in.out[T(t, c)].z());
-    kmin[t] =
-        static_cast<std::int32_t>(std::clamp(std::ceil(lo - kGrowth), -1.0, double(in.dims[2])));
-    kmax[t] =
-        static_cast<std::int32_t>(std::clamp(std::floor(hi + kGrowth), -1.0, double(in.dims[2])));
+    const double growth = withShell && shell.outer[t] ? 1.0 : 0.0;
+    const Eigen::Vector3d &p0 = in.out[T(t, 0)], &p1 = in.out[T(t, 1)], &p2 = in.out[T(t, 2)],
+                          &p3 = in.out[T(t, 3)];
+    const double zlo =
+        std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - growth * shell.boxGrowth[2];
+    const double zhi =
+        std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + growth * shell.boxGrowth[2];
+    if (zhi < 0 || zlo > double(in.dims[2] - 1)) continue;
+    const double ylo =
+        std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - growth * shell.boxGrowth[1];
+    const double yhi =
+        std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + growth * shell.boxGrowth[1];
+    if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
+    candidates.push_back(static_cast<std::int32_t>(t));
+    kmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(zlo))));
+    kmax.push_back(static_cast<std::int32_t>(std::min(double(in.dims[2] - 1), std::floor(zhi))));
+    jmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(ylo))));
+    jmax.push_back(static_cast<std::int32_t>(std::min(double(in.dims[1] - 1), std::floor(yhi))));
   }
+  // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
+  // bands of j-rows across all slices, so every core has work either way.
   const int threads = resolveThreads(options.threads);
-  const std::int64_t slabs =
-      std::max<std::int64_t>(1, std::min<std::int64_t>(in.dims[2], 8 * threads));
-  const std::int64_t nx = in.dims[0], plane = in.dims[0] * in.dims[1];
+  const bool bands = in.dims[2] < 2 * threads;
+  const std::int64_t split = bands ? in.dims[1] : in.dims[2];
+  const std::int64_t slabs = std::max<std::int64_t>(1, std::min<std::int64_t>(split, 8 * threads));
+  const std::int64_t nx = in.dims[0];
   std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0};
   std::atomic<bool> stop{false};
   std::mutex progressMutex;
@@ -98,30 +115,40 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
         std::int64_t localWrites = 0, localShell = 0;
         std::vector<std::uint8_t> covered;
         for (std::int64_t slab = sb; slab < se && !stop; ++slab) {
-          const std::int64_t k0 = in.dims[2] * slab / slabs, k1 = in.dims[2] * (slab + 1) / slabs;
-          if (!shell.outer.empty()) covered.assign(static_cast<std::size_t>(plane * (k1 - k0)), 0);
+          const std::int64_t s0 = split * slab / slabs, s1 = split * (slab + 1) / slabs;
+          const std::int64_t k0 = bands ? 0 : s0, k1 = bands ? in.dims[2] : s1;
+          const std::int64_t j0 = bands ? s0 : 0, j1 = bands ? s1 : in.dims[1];
+          // Voxels of this work item already written, row by row (rows j0..j1 of slices k0..k1).
+          const std::int64_t rows = j1 - j0;
+          if (!shell.outer.empty())
+            covered.assign(static_cast<std::size_t>(nx * rows * (k1 - k0)), 0);
           ScanTet s;
-          for (Eigen::Index t = 0; t < nt; ++t) {
-            if (kmax[t] < k0 || kmin[t] >= k1 || !raster::prepareTet(in, t, s)) continue;
-            raster::scanTet(s, k0, k1,
+          for (std::size_t c = 0; c < candidates.size(); ++c) {
+            const std::int32_t t = candidates[c];
+            if (kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
+                !raster::prepareTet(in, t, s))
+              continue;
+            raster::scanTet(s, k0, k1, j0, j1,
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
                               localWrites += i1 - i0 + 1;
                               if (!covered.empty())
-                                std::fill_n(covered.begin() + ((k - k0) * plane + j * nx + i0),
-                                            i1 - i0 + 1, std::uint8_t(1));
+                                std::fill_n(
+                                    covered.begin() + (((k - k0) * rows + (j - j0)) * nx + i0),
+                                    i1 - i0 + 1, std::uint8_t(1));
                               write(k, j, i0, i1, rest0, step);
                             });
           }
-          for (Eigen::Index t = 0; t < nt && !shell.outer.empty(); ++t) {
-            if (!shell.outer[t] || kmax[t] < k0 || kmin[t] >= k1 ||
+          for (std::size_t c = 0; c < candidates.size() && !shell.outer.empty(); ++c) {
+            const std::int32_t t = candidates[c];
+            if (!shell.outer[t] || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
                 !raster::prepareShell(in, t, shell.outer[t], shell.mm, shell.normalToMm,
                                       shell.boxGrowth, s))
               continue;
-            raster::scanTet(s, k0, k1,
+            raster::scanTet(s, k0, k1, j0, j1,
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
-                              std::uint8_t* c = covered.data() + ((k - k0) * plane + j * nx);
+                              std::uint8_t* c = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
                               for (std::int64_t a = i0; a <= i1;) {
                                 if (c[a]) {
                                   ++a;

@@ -146,36 +146,60 @@ inline bool inside(const ScanTet& s, double i, double j, double k) {
          s.faces[2].accepts(i, j, k) && s.faces[3].accepts(i, j, k);
 }
 
-// Calls span(k, j, i0, i1, rest0, step) for every row interval [i0, i1] of voxels of slices
-// [k0, k1) inside the tet; rest0 is the rest position (input IJK) of voxel i0 and step its change
-// per voxel along i.
+// Calls span(k, j, i0, i1, rest0, step) for every row interval [i0, i1] of voxels inside the tet
+// with k in [k0, k1) and j in [j0, j1); rest0 is the rest position (input IJK) of voxel i0 and
+// step its change per voxel along i.
 template <class Span>
-void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, Span&& span) {
+void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0, std::int64_t j1,
+             Span&& span) {
   const std::int64_t kb = std::max(k0, s.lo[2]), ke = std::min(k1 - 1, s.hi[2]);
+  const std::int64_t jb = std::max(j0, s.lo[1]), je = std::min(j1 - 1, s.hi[1]);
   const Eigen::Vector3d step = s.A.col(0);
+  // Along a row each face's signed value is slope * i + c(j, k); the real interval is where all
+  // four are positive. Its rounded ends are then settled by the exact predicate (at most a step
+  // or two, since the rounding error is far below a voxel).
+  std::array<double, 4> slope, negInv;
+  for (int f = 0; f < 4; ++f) {
+    slope[f] = s.faces[f].side * s.faces[f].n.x();
+    negInv[f] = slope[f] != 0 ? -1.0 / slope[f] : 0.0;
+  }
+  const double lo = double(s.lo[0]), hi = double(s.hi[0]);
   for (std::int64_t k = kb; k <= ke; ++k)
-    for (std::int64_t j = s.lo[1]; j <= s.hi[1]; ++j) {
-      // Interval from the planes, widened by a voxel, then trimmed by the exact predicate.
-      double a = static_cast<double>(s.lo[0]) - 1, b = static_cast<double>(s.hi[0]) + 1;
+    for (std::int64_t j = jb; j <= je; ++j) {
+      const double dj = double(j), dk = double(k);
+      double a = lo, b = hi;
       bool empty = false;
-      for (const Plane& p : s.faces) {
-        const double slope = p.side * p.n.x();
-        const double c = p.side * p.at(0, double(j), double(k));
-        if (slope > 0)
-          a = std::max(a, std::floor(-c / slope) - 1);
-        else if (slope < 0)
-          b = std::min(b, std::ceil(-c / slope) + 1);
-        else if (!p.accepts(0, double(j), double(k)))
-          empty = true;
+      for (int f = 0; f < 4; ++f) {
+        const Plane& p = s.faces[f];
+        if (slope[f] == 0) {
+          empty = empty || !p.accepts(0, dj, dk);
+          continue;
+        }
+        const double root = p.side * p.at(0, dj, dk) * negInv[f];
+        if (slope[f] > 0)
+          a = std::max(a, root);
+        else
+          b = std::min(b, root);
       }
-      if (empty) continue;
-      std::int64_t i0 = std::max(s.lo[0], static_cast<std::int64_t>(a));
-      std::int64_t i1 = std::min(s.hi[0], static_cast<std::int64_t>(b));
-      while (i0 <= i1 && !inside(s, double(i0), double(j), double(k))) ++i0;
-      while (i1 >= i0 && !inside(s, double(i1), double(j), double(k))) --i1;
+      if (empty || a > b + 1) continue;
+      std::int64_t i0 = static_cast<std::int64_t>(std::ceil(a));
+      std::int64_t i1 = static_cast<std::int64_t>(std::floor(b));
+      if (i0 > s.lo[0] && inside(s, double(i0 - 1), dj, dk)) {
+        do --i0;
+        while (i0 > s.lo[0] && inside(s, double(i0 - 1), dj, dk));
+      } else {
+        // A non-empty row starts at most one past floor(b), whatever the rounding.
+        const std::int64_t last = std::min(s.hi[0], i1 + 1);
+        while (i0 <= last && !inside(s, double(i0), dj, dk)) ++i0;
+      }
+      if (i1 < s.hi[0] && inside(s, double(i1 + 1), dj, dk)) {
+        do ++i1;
+        while (i1 < s.hi[0] && inside(s, double(i1 + 1), dj, dk));
+      } else {
+        while (i1 >= i0 && !inside(s, double(i1), dj, dk)) --i1;
+      }
       if (i0 > i1) continue;
-      const Eigen::Vector3d x{static_cast<double>(i0), static_cast<double>(j),
-                              static_cast<double>(k)};
+      const Eigen::Vector3d x{double(i0), dj, dk};
       span(k, j, i0, i1, Eigen::Vector3d(s.r0 + s.A * (x - s.q0)), step);
     }
 }
