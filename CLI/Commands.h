@@ -14,6 +14,7 @@ int runConvert(const Args& args);
 int runPhantom(const Args& args);
 int runCage(const Args& args);
 int runMesh(const Args& args);
+int runWarp(const Args& args);
 
 struct Command {
   const char* name;
@@ -29,6 +30,7 @@ inline const Command kCommands[] = {
      runPhantom},
     {"cage", "build the control cage around the body (optionally separating two parts)", runCage},
     {"mesh", "build the transfer mesh and embed it in the cage", runMesh},
+    {"warp", "pose a label map (and image) at full resolution from a posed cage", runWarp},
 };
 
 }  // namespace repose::cli

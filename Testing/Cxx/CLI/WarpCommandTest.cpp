@@ -1,0 +1,107 @@
+// `repose warp` as a user runs it: phantom -> cage -> mesh -> a posed cage -> the posed label map
+// and image. A whole-voxel translation of the cage must give the input shifted, voxel for voxel;
+// bad requests fail with one line naming the problem and write nothing.
+#include "CommandRunner.h"
+#include "TestPaths.h"
+
+#include "repose/io/MeshIO.h"
+#include "repose/io/VolumeIO.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+struct Prepared {
+  ScratchDir dir{"warp"};
+  std::string organs, parts, cage, mesh;
+  Prepared() {
+    const std::string d = shellQuote(dir.path().string());
+    organs = dir.file("G.nii.gz"), parts = dir.file("S.nii.gz");
+    cage = dir.file("cage.obj"), mesh = dir.file("tm.vtu");
+    EXPECT_EQ(runCommand("repose", "phantom --voxel 4 --out " + d).exitCode, 0);
+    EXPECT_EQ(
+        runCommand("repose", "cage --parts " + shellQuote(parts) + " --out " + shellQuote(cage))
+            .exitCode,
+        0);
+    EXPECT_EQ(runCommand("repose", "mesh --parts " + shellQuote(parts) + " --cage " +
+                                       shellQuote(cage) + " --out " + shellQuote(mesh))
+                  .exitCode,
+              0);
+  }
+  std::string common(const std::string& posed) const {
+    return "warp --input " + shellQuote(organs) + " --mesh " + shellQuote(mesh) + " --cage " +
+           shellQuote(cage) + " --posed-cage " + shellQuote(posed);
+  }
+};
+
+}  // namespace
+
+TEST(WarpCommand, WholeVoxelTranslationGivesTheShiftedMapAndImage) {
+  Prepared p;
+  const Volume G = readVolume(p.organs);
+  // Move the cage by (2, -3, 5) voxels of 4 mm.
+  TriangleMesh cage = readTriangleMesh(p.cage);
+  const Eigen::RowVector3d t(8, -12, 20);
+  cage.vertices.rowwise() += t;
+  const std::string posed = p.dir.file("posed.obj"), out = p.dir.file("posed.nii.gz"),
+                    imageOut = p.dir.file("posed_image.nii.gz");
+  writeTriangleMesh(cage, posed);
+  const CommandResult r = runCommand(
+      "repose", p.common(posed) + " --out " + shellQuote(out) + " --image " + shellQuote(p.organs) +
+                    " --image-out " + shellQuote(imageOut) + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["labels_lost"], 0);
+  EXPECT_EQ(j["inverted_tets"], 0);
+  for (const auto& l : j["labels"]) EXPECT_EQ(l["change_percent"].get<double>(), 0.0) << l;
+  const Volume posedG = readVolume(out);
+  const Volume posedI = readVolume(imageOut);
+  std::int64_t differ = 0, imageDiffer = 0;
+  const auto d = posedG.dims();
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    for (std::int64_t jj = 0; jj < d[1]; ++jj)
+      for (std::int64_t i = 0; i < d[0]; ++i) {
+        const Eigen::Vector3d rest =
+            G.geometry().rasToVoxel(posedG.geometry().voxelToRas(i, jj, k) - t.transpose());
+        const Eigen::Vector3d r0 = rest.array().round();
+        double expected = 0;
+        if ((r0.array() >= 0).all() && r0.x() < G.dims()[0] && r0.y() < G.dims()[1] &&
+            r0.z() < G.dims()[2])
+          expected = G.valueAsDouble(
+              G.index(std::int64_t(r0.x()), std::int64_t(r0.y()), std::int64_t(r0.z())));
+        differ += posedG.valueAsDouble(posedG.index(i, jj, k)) != expected;
+        imageDiffer += posedI.valueAsDouble(posedI.index(i, jj, k)) != expected;
+      }
+  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(imageDiffer, 0);  // an image on the same grid, moved by whole voxels, is exact too
+}
+
+TEST(WarpCommand, RefusesBadRequestsWithOneLineAndNoOutput) {
+  Prepared p;
+  TriangleMesh wrong = readTriangleMesh(p.cage);
+  wrong.vertices.conservativeResize(wrong.vertices.rows() - 1, 3);
+  wrong.faces.conservativeResize(1, 3);
+  const std::string wrongCage = p.dir.file("wrong.obj");
+  writeTriangleMesh(wrong, wrongCage);
+  const std::string out = p.dir.file("never.nii.gz");
+  for (const std::string& cmd :
+       {p.common(wrongCage) + " --out " + shellQuote(out),
+        p.common(p.cage) + " --out " + shellQuote(out) + " --memory 1K",
+        p.common(p.cage) + " --out " + shellQuote(out) + " --image " + shellQuote(p.organs),
+        p.common(p.cage) + " --out " + shellQuote(p.organs)}) {
+    const CommandResult bad = runCommand("repose", cmd);
+    EXPECT_NE(bad.exitCode, 0) << cmd;
+    EXPECT_EQ(lineCount(bad.err), 1) << bad.err;
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  const CommandResult memory =
+      runCommand("repose", p.common(p.cage) + " --out " + shellQuote(out) + " --memory 1K");
+  EXPECT_NE(memory.err.find("budget"), std::string::npos) << memory.err;
+  EXPECT_NE(memory.err.find("never.nii.gz"), std::string::npos) << memory.err;
+}
