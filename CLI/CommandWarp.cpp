@@ -7,6 +7,7 @@
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/MeshIO.h"
+#include "repose/io/NrrdIO.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
@@ -74,6 +75,8 @@ int runWarp(const Args& args) {
       .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
       .option("image-out", "FILE", "posed image (with --image)")
       .option("background", "VALUE", "image value where no tissue is (with --image)", "0")
+      .option("transform-out", "FILE",
+              "displacement-field transform (.nrrd, LPS, output->input as ITK and Slicer use)")
       .option("spacing-mm", "MM", "output voxel size along every axis (0: the input's)", "0")
       .option("shell-mm", "MM", "extrapolate this far outside the mesh (-1: 2 voxels)", "-1")
       .option("memory", "BYTES", "memory budget, e.g. 2G (default: half the RAM)", "")
@@ -84,11 +87,14 @@ int runWarp(const Args& args) {
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
   if (p.has("image") != p.has("image-out")) throw UsageError{"--image and --image-out go together"};
   const std::string out = p.get("out");
+  const std::string transformOut = p.has("transform-out") ? p.get("transform-out") : "";
+  if (!transformOut.empty() &&
+      (transformOut.size() < 5 || transformOut.compare(transformOut.size() - 5, 5, ".nrrd") != 0))
+    throw UsageError{"--transform-out must name a .nrrd file"};
   for (const char* in : {"input", "mesh", "cage", "posed-cage", "image"})
-    if (p.has(in)) {
-      refuseOverwritingInput(p.get(in), out);
-      if (p.has("image-out")) refuseOverwritingInput(p.get(in), p.get("image-out"));
-    }
+    if (p.has(in))
+      for (const char* o : {"out", "image-out", "transform-out"})
+        if (p.has(o)) refuseOverwritingInput(p.get(in), p.get(o));
   const double spacing = p.getDouble("spacing-mm");
   if (spacing < 0) throw UsageError{"--spacing-mm must be >= 0"};
   const double budget =
@@ -137,6 +143,9 @@ int runWarp(const Args& args) {
         rasterizeImage(image, mesh, deformed, grid, p.getDouble("background"), ro);
     writeVolume(posedImage, p.get("image-out"));
   }
+  if (p.has("transform-out"))
+    writeDisplacementFieldNrrd(rasterizeDisplacement(mesh, deformed, labels.geometry(), grid, ro),
+                               grid, p.get("transform-out"));
   writeVolume(posedLabels, out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

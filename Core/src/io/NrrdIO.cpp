@@ -301,4 +301,36 @@ void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions
   reportProgress(options.progress, 1.0, "writing");
 }
 
+void writeDisplacementFieldNrrd(const std::vector<float>& rasVectors, const VolumeGeometry& grid,
+                                const std::string& path) {
+  grid.validate(path);
+  if (rasVectors.size() != static_cast<std::size_t>(3 * grid.numVoxels()))
+    throwFileError(path, "the displacement field does not match its grid");
+  AtomicOutput output(path);
+  std::vector<float> lps(rasVectors);
+  for (std::size_t v = 0; v < lps.size(); v += 3) lps[v] = -lps[v], lps[v + 1] = -lps[v + 1];
+  std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), &nrrdNix);
+  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
+                                                                   &nrrdIoStateNix);
+  size_t sizes[4] = {3, size_t(grid.dims[0]), size_t(grid.dims[1]), size_t(grid.dims[2])};
+  if (nrrdWrap_nva(nrrd.get(), lps.data(), nrrdTypeFloat, 4, sizes) != 0)
+    throwFileError(path, takeBiffMessage());
+  nrrdSpaceSet(nrrd.get(), nrrdSpaceLeftPosteriorSuperior);
+  const Eigen::Matrix4d m = flipLpsRas(grid.ijkToRas);
+  double dirs[4][NRRD_SPACE_DIM_MAX];
+  for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[0][r] = AIR_NAN;
+  for (int a = 0; a < 3; ++a)
+    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[a + 1][r] = r < 3 ? m(r, a) : AIR_NAN;
+  int kinds[4] = {nrrdKindVector, nrrdKindDomain, nrrdKindDomain, nrrdKindDomain};
+  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoSpaceDirection, dirs);
+  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoKind, kinds);
+  const double origin[3] = {m(0, 3), m(1, 3), m(2, 3)};
+  nrrdSpaceOriginSet(nrrd.get(), origin);
+  nio->encoding = nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
+  nio->zlibLevel = 1;
+  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0)
+    throwFileError(path, takeBiffMessage());
+  output.commit();
+}
+
 }  // namespace repose

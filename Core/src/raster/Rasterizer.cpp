@@ -381,6 +381,49 @@ Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
   return out;
 }
 
+std::vector<float> rasterizeDisplacement(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                                         const VolumeGeometry& input, const VolumeGeometry& output,
+                                         const RasterOptions& options) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  input.validate("rasterizer input grid");
+  const ScanInput in = raster::makeScanInput(mesh, deformed, input, output);
+  const std::int64_t n = output.numVoxels();
+  std::vector<float> field(static_cast<std::size_t>(3 * n));
+  // Uncovered voxels aim at one point ten diagonals below the input grid's lower corner.
+  const auto [lo, hi] = input.rasBounds();
+  const Eigen::Vector3d outside = lo - 10 * (hi - lo) - Eigen::Vector3d::Constant(1000);
+  const Eigen::Matrix3d O = output.ijkToRas.block<3, 3>(0, 0), I = input.ijkToRas.block<3, 3>(0, 0);
+  const Eigen::Vector3d oo = output.origin(), io = input.origin();
+  parallelFor(
+      output.dims[2], options.threads,
+      [&](std::int64_t k0, std::int64_t k1) {
+        for (std::int64_t k = k0; k < k1; ++k)
+          for (std::int64_t j = 0; j < output.dims[1]; ++j)
+            for (std::int64_t i = 0; i < output.dims[0]; ++i) {
+              const Eigen::Vector3d d =
+                  outside - (O * Eigen::Vector3d(double(i), double(j), double(k)) + oo);
+              float* f = &field[static_cast<std::size_t>(
+                  3 * (i + output.dims[0] * (j + output.dims[1] * k)))];
+              f[0] = float(d.x()), f[1] = float(d.y()), f[2] = float(d.z());
+            }
+      },
+      1);
+  const std::int64_t nx = output.dims[0], plane = nx * output.dims[1];
+  runScan(in, makeShell(mesh, input, output, options), options, "displacement field", nullptr,
+          frameSign(output),
+          [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
+              const Eigen::Vector3d& step) {
+            for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+              const Eigen::Vector3d d =
+                  (I * p + io) - (O * Eigen::Vector3d(double(i), double(j), double(k)) + oo);
+              float* f = &field[static_cast<std::size_t>(3 * (k * plane + j * nx + i))];
+              f[0] = float(d.x()), f[1] = float(d.y()), f[2] = float(d.z());
+            }
+          });
+  return field;
+}
+
 Volume rasterizeCoverage(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
                          const VolumeGeometry& output, const RasterOptions& options) {
   checkDeformation(mesh, deformed);

@@ -68,6 +68,15 @@ Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
                       double background, const RasterOptions& options = {},
                       RasterReport* report = nullptr);
 
+// The inverse map as a displacement field on `output`: per voxel, 3 floats (x fastest, voxels in
+// IJK order) in RAS mm from the voxel centre to its rest position, the point of the input the
+// rasterizer samples (ITK's output-to-input resampling direction). Voxels no tet (or shell)
+// covers point to `outside`, a place beyond the input grid, so any resampler gives them
+// background as the rasterizer does.
+std::vector<float> rasterizeDisplacement(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                                         const VolumeGeometry& input, const VolumeGeometry& output,
+                                         const RasterOptions& options = {});
+
 // How many deformed tets contain each output voxel centre (UInt8, saturating at 255): 1 inside a
 // conforming deformed mesh, 0 outside it, 2 or more where it folds over itself. No shell.
 Volume rasterizeCoverage(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
