@@ -229,6 +229,38 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
   return volume;
 }
 
+NiftiLayout readNiftiLayout(const std::string& path) {
+  const UnambiguousNiftiPath alias(path);
+  NiftiPtr nim = readHeader(path, alias.path());
+  io::DiskType diskType;
+  if (!diskTypeFromNifti(nim->datatype, diskType))
+    throwFileError(
+        path, std::string("unsupported voxel type ") + nifti_datatype_to_string(nim->datatype));
+  const bool scaled = nim->scl_slope != 0.0 && (nim->scl_slope != 1.0 || nim->scl_inter != 0.0);
+  const ScalarType memType = io::memoryTypeFor(diskType);
+  if (scaled || scalarSize(memType) != io::diskTypeSize(diskType) ||
+      diskType == io::DiskType::UInt32 || diskType == io::DiskType::Int8)
+    throwFileError(path,
+                   "voxels are scaled or of a type read by conversion; convert the file "
+                   "(repose convert) before posing it out of core");
+  NiftiLayout layout;
+  layout.geometry = geometryOf(*nim, path);
+  layout.type = memType;
+  layout.dataOffset = nim->iname_offset;
+  layout.gzip = nifti_is_gzfile(nim->iname) != 0;
+  for (int e = 0; e < nim->num_ext; ++e) {
+    const nifti1_extension& ext = nim->ext_list[e];
+    if (ext.edata && ext.esize > 8) {
+      const std::string text(ext.edata, strnlen(ext.edata, ext.esize - 8));
+      if (text.find("LabelTable") != std::string::npos)
+        layout.labels = nifti::parseCaretLabelTable(text);
+    }
+  }
+  layout.labelMap =
+      nim->intent_code == kIntentLabel || !layout.labels.empty() || isIntegerType(memType);
+  return layout;
+}
+
 namespace {
 
 // A nifti_image describing `geometry` (no data), ready for niftilib's header writer.

@@ -1,6 +1,7 @@
 #include "repose/raster/Rasterizer.h"
 
 #include "TetScan.h"
+#include "repose/io/NiftiIO.h"
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 
@@ -71,7 +72,11 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
 // shell pass writes the voxels of the slab still uncovered.
 template <class Write>
 void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& options,
-             const std::string& stage, RasterReport* report, double frameSign, Write&& write) {
+             const std::string& stage, RasterReport* report, double frameSign, Write&& write,
+             std::int64_t kBegin = 0, std::int64_t kEnd = -1) {
+  // Only slices [kBegin, kEnd) are scanned (the out-of-core path's slab), in the full grid's
+  // coordinates, so a slab's voxels get exactly the values the whole grid would.
+  if (kEnd < 0) kEnd = in.dims[2];
   const Eigen::MatrixX4i& T = *in.tets;
   const Eigen::Index nt = T.rows();
   // Each tet's box in j and k (grown for the shell if it has an outer face), to skip it cheaply
@@ -87,23 +92,24 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
         std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - growth * shell.boxGrowth[2];
     const double zhi =
         std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + growth * shell.boxGrowth[2];
-    if (zhi < 0 || zlo > double(in.dims[2] - 1)) continue;
+    if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
     const double ylo =
         std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - growth * shell.boxGrowth[1];
     const double yhi =
         std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + growth * shell.boxGrowth[1];
     if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
     candidates.push_back(static_cast<std::int32_t>(t));
-    kmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(zlo))));
-    kmax.push_back(static_cast<std::int32_t>(std::min(double(in.dims[2] - 1), std::floor(zhi))));
+    kmin.push_back(static_cast<std::int32_t>(std::max(double(kBegin), std::ceil(zlo))));
+    kmax.push_back(static_cast<std::int32_t>(std::min(double(kEnd - 1), std::floor(zhi))));
     jmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(ylo))));
     jmax.push_back(static_cast<std::int32_t>(std::min(double(in.dims[1] - 1), std::floor(yhi))));
   }
   // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
   // bands of j-rows across all slices, so every core has work either way.
   const int threads = resolveThreads(options.threads);
-  const bool bands = in.dims[2] < 2 * threads;
-  const std::int64_t split = bands ? in.dims[1] : in.dims[2];
+  const std::int64_t depth = kEnd - kBegin;
+  const bool bands = depth < 2 * threads;
+  const std::int64_t split = bands ? in.dims[1] : depth;
   const std::int64_t slabs = std::max<std::int64_t>(1, std::min<std::int64_t>(split, 8 * threads));
   const std::int64_t nx = in.dims[0];
   std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0};
@@ -116,7 +122,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
         std::vector<std::uint8_t> covered;
         for (std::int64_t slab = sb; slab < se && !stop; ++slab) {
           const std::int64_t s0 = split * slab / slabs, s1 = split * (slab + 1) / slabs;
-          const std::int64_t k0 = bands ? 0 : s0, k1 = bands ? in.dims[2] : s1;
+          const std::int64_t k0 = kBegin + (bands ? 0 : s0), k1 = bands ? kEnd : kBegin + s1;
           const std::int64_t j0 = bands ? s0 : 0, j1 = bands ? s1 : in.dims[1];
           // Voxels of this work item already written, row by row (rows j0..j1 of slices k0..k1).
           const std::int64_t rows = j1 - j0;
@@ -326,6 +332,59 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
             });
   });
   return out;
+}
+
+void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
+                           const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                           const std::string& path, std::size_t slabBytes,
+                           const RasterOptions& options, RasterReport* report) {
+  checkDeformation(mesh, deformed);
+  output.validate(path);
+  const NiftiLayout& layout = input.layout();
+  const ScanInput in = raster::makeScanInput(mesh, deformed, layout.geometry, output);
+  const Shell shell = makeShell(mesh, layout.geometry, output, options);
+  const auto d = layout.geometry.dims;
+  const std::int64_t nx = output.dims[0], plane = nx * output.dims[1];
+  const std::int64_t slab = std::max<std::int64_t>(
+      1, std::int64_t(slabBytes / (std::size_t(plane) * scalarSize(layout.type))));
+  NiftiSlabWriter writer(path, output, layout.type, layout.labels, true);
+  RasterOptions one = options;
+  one.threads = 1;
+  RasterReport total;
+  dispatchScalar(layout.type, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    std::vector<T> buffer;
+    for (std::int64_t k0 = 0; k0 < output.dims[2]; k0 += slab) {
+      const std::int64_t k1 = std::min(output.dims[2], k0 + slab);
+      buffer.assign(static_cast<std::size_t>(plane * (k1 - k0)), T(0));
+      one.progress = [&](double f, const std::string& stage) {
+        return !options.progress ||
+               options.progress((double(k0) + f * double(k1 - k0)) / double(output.dims[2]), stage);
+      };
+      RasterReport part;
+      runScan(
+          in, shell, one, "rasterize labels (out of core)", &part, frameSign(output),
+          [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
+              const Eigen::Vector3d& step) {
+            T* row = buffer.data() + (k - k0) * plane + j * nx;
+            for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+              const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
+                                 y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
+                                 z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
+              const bool inside = x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2];
+              row[i] = inside ? static_cast<const T*>(input.slice(z))[x + d[0] * y] : T(0);
+            }
+          },
+          k0, k1);
+      total.voxelWrites += part.voxelWrites;
+      total.shellVoxels += part.shellVoxels;
+      total.invertedTets = part.invertedTets;
+      total.flatTets = part.flatTets;
+      writer.writeSlices(buffer.data(), k1 - k0);
+    }
+  });
+  writer.finish();
+  if (report) *report = total;
 }
 
 Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,

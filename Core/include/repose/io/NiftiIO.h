@@ -12,6 +12,20 @@ namespace repose {
 Volume readNifti(const std::string& path, const ReadOptions& options = {});
 void writeNifti(const Volume& volume, const std::string& path, const WriteOptions& options = {});
 
+// Where and how a NIfTI file's voxels lie, to read them in place (out-of-core): geometry, label
+// table, in-memory type (the disk type, unscaled), the byte offset of voxel 0, and whether the file
+// is gzip-compressed. Throws naming the file when its voxels cannot be used as they are on disk
+// (scaled, or a type Repose converts when reading).
+struct NiftiLayout {
+  VolumeGeometry geometry;
+  ScalarType type = ScalarType::UInt8;
+  LabelTable labels;
+  bool labelMap = false;
+  std::int64_t dataOffset = 0;
+  bool gzip = false;
+};
+NiftiLayout readNiftiLayout(const std::string& path);
+
 // Writes a single-layer NIfTI slice by slice (k slabs in order) so a volume larger than memory
 // can be produced with bounded memory. Atomic: nothing appears at path until finish().
 class NiftiSlabWriter {

@@ -3,12 +3,14 @@
 // In-core, on all cores; slabs of output slices are independent, which the out-of-core path uses.
 #pragma once
 
+#include "repose/io/SliceCache.h"
 #include "repose/mesh/TransferMesh.h"
 #include "repose/util/Progress.h"
 #include "repose/volume/Volume.h"
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace repose {
@@ -59,6 +61,14 @@ struct RasterReport {
 Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
                        const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
                        const RasterOptions& options = {}, RasterReport* report = nullptr);
+
+// Out of core: the same labels, voxel for voxel, for an input read in place through `input` and an
+// output written slab by slab to the NIfTI file `path` (.nii or .nii.gz; atomic), holding at most
+// `slabBytes` of output at a time. The scan runs on one thread (the cache is not shared).
+void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
+                           const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                           const std::string& path, std::size_t slabBytes,
+                           const RasterOptions& options = {}, RasterReport* report = nullptr);
 
 // Intensities (CT, MR): trilinear interpolation at the rest position, `background` where no tet
 // covers the voxel or the rest position is outside the input. Integer types are rounded and
