@@ -7,7 +7,9 @@
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/MeshIO.h"
+#include "repose/io/NiftiIO.h"
 #include "repose/io/NrrdIO.h"
+#include "repose/io/SliceCache.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
@@ -22,6 +24,8 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <optional>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -34,6 +38,40 @@ std::string gib(double bytes) {
   s.precision(3);
   s << bytes / (1024.0 * 1024 * 1024) << " GiB";
   return s.str();
+}
+
+// The process's peak resident set so far (VmHWM), in bytes; 0 if unknown.
+double peakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  while (status >> key) {
+    if (key == "VmHWM:") {
+      double kb = 0;
+      status >> kb;
+      return kb * 1024;
+    }
+    status.ignore(1 << 20, '\n');
+  }
+  return 0;
+}
+
+// Voxels per non-zero label of a file read through a slice cache, as mm3.
+std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
+  const NiftiLayout& l = cache.layout();
+  const std::int64_t n = l.geometry.dims[0] * l.geometry.dims[1];
+  const Eigen::Vector3d s = l.geometry.spacing();
+  std::map<int, std::int64_t> counts;
+  dispatchScalar(l.type, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    for (std::int64_t k = 0; k < l.geometry.dims[2]; ++k) {
+      const T* v = static_cast<const T*>(cache.slice(k));
+      for (std::int64_t i = 0; i < n; ++i)
+        if (v[i] != 0) ++counts[static_cast<int>(v[i])];
+    }
+  });
+  std::map<int, double> mm3;
+  for (const auto& [value, count] : counts) mm3[value] = double(count) * s.prod();
+  return mm3;
 }
 
 double physicalMemory() {
@@ -102,9 +140,21 @@ int runWarp(const Args& args) {
   AtomicOutput probe(out);  // an unwritable output fails before the work
   const auto start = std::chrono::steady_clock::now();
 
-  const Volume labels = readVolume(p.get("input"));
-  if (!isIntegerType(labels.scalarType()))
-    throw Error(p.get("input") + ": not a label map (float voxels); pose images with --image");
+  // The input's grid and type first: its voxels are read in core only if they fit the budget.
+  const std::string input = p.get("input");
+  const bool niftiInput = formatForPath(input) == FileFormat::Nifti;
+  std::optional<Volume> labels;
+  NiftiLayout layout;
+  if (niftiInput) {
+    layout = readNiftiLayout(input);
+  } else {
+    labels = readVolume(input);
+    layout.geometry = labels->geometry(), layout.type = labels->scalarType();
+    layout.labels = labels->labels();
+  }
+  if (!isIntegerType(layout.type))
+    throw Error(input + ": not a label map (float voxels); pose images with --image");
+  const int layers = labels ? labels->layers() : 1;
   const TransferMesh mesh = readTransferMesh(p.get("mesh"));
   const TriangleMesh cage = readTriangleMesh(p.get("cage"));
   const TriangleMesh posed = readTriangleMesh(p.get("posed-cage"));
@@ -114,16 +164,29 @@ int runWarp(const Args& args) {
   const int threads = static_cast<int>(p.getInt("threads"));
   const CageDeformation deformation(mesh, cage, threads);
   const Eigen::MatrixX3d deformed = deformation.deform(posed.vertices);
-  const VolumeGeometry grid = deformedGrid(labels.geometry(), deformed, spacing);
+  const VolumeGeometry grid = deformedGrid(layout.geometry, deformed, spacing);
 
-  // Refuse before the work when the output cannot fit in memory or on disk.
-  const double outBytes =
-      double(grid.numVoxels()) * double(scalarSize(labels.scalarType())) * labels.layers();
-  const double need = outBytes + double(labels.byteSize());
-  if (need > budget)
-    throw Error(out + ": the posed volume needs " + gib(need) + " in memory (" +
-                std::to_string(grid.numVoxels()) + " voxels), more than the budget of " +
-                gib(budget));
+  // What the volumes need against what the budget leaves after the mesh and cage (the process's
+  // peak so far): in core if both fit, else out of core, else refuse before the work.
+  const double voxelBytes = double(scalarSize(layout.type)) * layers;
+  const double outBytes = double(grid.numVoxels()) * voxelBytes;
+  const double inBytes = double(layout.geometry.numVoxels()) * voxelBytes;
+  const double used = peakResidentBytes();
+  const double available = budget - used;
+  const bool inCore = inBytes + outBytes <= available;
+  const bool niftiOutput = formatForPath(out) == FileFormat::Nifti;
+  if (!inCore) {
+    const std::string why = out + ": posing in memory needs " + gib(inBytes + outBytes) + " (" +
+                            std::to_string(grid.numVoxels()) + " output voxels) beyond the " +
+                            gib(used) + " the mesh and cage use, more than the budget of " +
+                            gib(budget);
+    if (!niftiInput || !niftiOutput || layers > 1)
+      throw Error(why + "; out of core needs NIfTI in and out");
+    if (p.has("image") || p.has("transform-out"))
+      throw Error(why + "; --image and --transform-out are not available out of core yet");
+    if (available < 16.0 * double(grid.dims[0] * grid.dims[1]) * voxelBytes)
+      throw Error(why + ", even out of core");
+  }
   const auto space = std::filesystem::space(std::filesystem::absolute(out).parent_path());
   if (double(space.available) < outBytes)
     throw Error(out + ": " + gib(outBytes) + " uncompressed would not fit in the " +
@@ -136,29 +199,41 @@ int runWarp(const Args& args) {
   const std::vector<std::uint8_t> outer = outerFaces(mesh);
   ro.outerFaces = &outer;
   RasterReport report;
-  const Volume posedLabels = rasterizeLabels(labels, mesh, deformed, grid, ro, &report);
-  if (p.has("image")) {
-    const Volume image = readVolume(p.get("image"));
-    const Volume posedImage =
-        rasterizeImage(image, mesh, deformed, grid, p.getDouble("background"), ro);
-    writeVolume(posedImage, p.get("image-out"));
+  std::map<std::pair<int, int>, std::pair<double, double>> volumes;  // (layer, value) -> mm3
+  if (inCore) {
+    if (!labels) labels = readVolume(input);
+    const Volume posedLabels = rasterizeLabels(*labels, mesh, deformed, grid, ro, &report);
+    if (p.has("image")) {
+      const Volume image = readVolume(p.get("image"));
+      const Volume posedImage =
+          rasterizeImage(image, mesh, deformed, grid, p.getDouble("background"), ro);
+      writeVolume(posedImage, p.get("image-out"));
+    }
+    if (p.has("transform-out"))
+      writeDisplacementFieldNrrd(
+          rasterizeDisplacement(mesh, deformed, labels->geometry(), grid, ro), grid,
+          p.get("transform-out"));
+    writeVolume(posedLabels, out);
+    for (const LabelCount& c : countLabels(*labels))
+      volumes[{c.layer, c.value}].first = c.volumeMm3;
+    for (const LabelCount& c : countLabels(posedLabels))
+      volumes[{c.layer, c.value}].second = c.volumeMm3;
+  } else {
+    SliceCache cache(input, static_cast<std::size_t>(available / 2));
+    rasterizeLabelsToFile(cache, mesh, deformed, grid, out, static_cast<std::size_t>(available / 4),
+                          ro, &report);
+    for (const auto& [value, mm3] : streamedLabelVolumes(cache)) volumes[{0, value}].first = mm3;
+    SliceCache written(out, static_cast<std::size_t>(available / 2));
+    for (const auto& [value, mm3] : streamedLabelVolumes(written)) volumes[{0, value}].second = mm3;
   }
-  if (p.has("transform-out"))
-    writeDisplacementFieldNrrd(rasterizeDisplacement(mesh, deformed, labels.geometry(), grid, ro),
-                               grid, p.get("transform-out"));
-  writeVolume(posedLabels, out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // Per-label volumes before and after (layer 0 and others alike).
-  std::map<std::pair<int, int>, std::pair<double, double>> volumes;
-  for (const LabelCount& c : countLabels(labels)) volumes[{c.layer, c.value}].first = c.volumeMm3;
-  for (const LabelCount& c : countLabels(posedLabels))
-    volumes[{c.layer, c.value}].second = c.volumeMm3;
   nlohmann::json perLabel = nlohmann::json::array();
   int lost = 0;
   for (const auto& [key, v] : volumes) {
-    const Label* l = labels.labels().find(key.second, key.first);
+    const Label* l = layout.labels.find(key.second, key.first);
     perLabel.push_back({{"layer", key.first},
                         {"value", key.second},
                         {"name", l ? l->name : ""},
@@ -172,6 +247,9 @@ int runWarp(const Args& args) {
       {"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}},
       {"spacing_mm", {grid.spacing()[0], grid.spacing()[1], grid.spacing()[2]}},
       {"voxels", grid.numVoxels()},
+      {"out_of_core", !inCore},
+      {"memory_budget_bytes", budget},
+      {"peak_resident_bytes", peakResidentBytes()},
       {"voxels_inside_tets", report.voxelWrites},
       {"voxels_in_shell", report.shellVoxels},
       {"inverted_tets", report.invertedTets},

@@ -16,6 +16,7 @@ namespace repose::test {
 struct CommandResult {
   int exitCode = -1;
   std::string out, err;
+  long peakRssKb = -1;  // with measureMemory
 };
 
 inline std::string shellQuote(const std::string& s) {
@@ -24,12 +25,17 @@ inline std::string shellQuote(const std::string& s) {
   return q + "'";
 }
 
-// `args` is appended verbatim (quote paths with shellQuote).
-inline CommandResult runCommand(const std::string& exe, const std::string& args) {
+// `args` is appended verbatim (quote paths with shellQuote). With measureMemory the command runs
+// under /usr/bin/time and peakRssKb receives its peak resident set.
+inline CommandResult runCommand(const std::string& exe, const std::string& args,
+                                bool measureMemory = false) {
   ScratchDir io("run");  // its own folder: the calling test's ScratchDir must survive
-  const std::string outFile = io.file("stdout"), errFile = io.file("stderr");
-  const std::string cmd = shellQuote(binPath(exe)) + " " + args + " >" + shellQuote(outFile) +
-                          " 2>" + shellQuote(errFile) + " </dev/null";
+  const std::string outFile = io.file("stdout"), errFile = io.file("stderr"),
+                    rssFile = io.file("rss");
+  const std::string prefix =
+      measureMemory ? "/usr/bin/time -f %M -o " + shellQuote(rssFile) + " " : std::string();
+  const std::string cmd = prefix + shellQuote(binPath(exe)) + " " + args + " >" +
+                          shellQuote(outFile) + " 2>" + shellQuote(errFile) + " </dev/null";
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -41,6 +47,12 @@ inline CommandResult runCommand(const std::string& exe, const std::string& args)
   };
   r.out = slurp(outFile);
   r.err = slurp(errFile);
+  if (measureMemory) {
+    std::string rss = slurp(rssFile);
+    const std::size_t at = rss.find_last_of("0123456789");  // the last line holds the figure
+    const std::size_t from = rss.find_last_not_of("0123456789", at);
+    r.peakRssKb = at == std::string::npos ? -1 : std::stol(rss.substr(from + 1, at - from));
+  }
   return r;
 }
 

@@ -6,6 +6,8 @@
 
 #include "repose/io/MeshIO.h"
 #include "repose/io/VolumeIO.h"
+#include "repose/phantom/Phantom.h"
+#include "repose/phantom/PhantomPoses.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -20,11 +22,13 @@ namespace {
 struct Prepared {
   ScratchDir dir{"warp"};
   std::string organs, parts, cage, mesh;
-  Prepared() {
+  explicit Prepared(double voxelMm = 4) {
     const std::string d = shellQuote(dir.path().string());
     organs = dir.file("G.nii.gz"), parts = dir.file("S.nii.gz");
     cage = dir.file("cage.obj"), mesh = dir.file("tm.vtu");
-    EXPECT_EQ(runCommand("repose", "phantom --voxel 4 --out " + d).exitCode, 0);
+    EXPECT_EQ(
+        runCommand("repose", "phantom --voxel " + std::to_string(voxelMm) + " --out " + d).exitCode,
+        0);
     EXPECT_EQ(
         runCommand("repose", "cage --parts " + shellQuote(parts) + " --out " + shellQuote(cage))
             .exitCode,
@@ -104,4 +108,34 @@ TEST(WarpCommand, RefusesBadRequestsWithOneLineAndNoOutput) {
       runCommand("repose", p.common(p.cage) + " --out " + shellQuote(out) + " --memory 1K");
   EXPECT_NE(memory.err.find("budget"), std::string::npos) << memory.err;
   EXPECT_NE(memory.err.find("never.nii.gz"), std::string::npos) << memory.err;
+}
+
+// Out of core under a budget the in-core run would exceed: the same voxels, a peak resident set
+// under the budget (measured by /usr/bin/time), and the JSON says which path ran.
+TEST(WarpCommand, OutOfCoreStaysUnderTheBudgetAndEqualsInCore) {
+  Prepared p(2);
+  PhantomOptions po;
+  po.voxelMm = 2;
+  TriangleMesh cage = readTriangleMesh(p.cage);
+  cage.vertices = phantomElbowFlexion(Phantom(po), cage, 60);
+  const std::string posed = p.dir.file("posed.obj");
+  writeTriangleMesh(cage, posed);
+  const std::string inCoreOut = p.dir.file("in.nii.gz"), outOfCoreOut = p.dir.file("out.nii.gz");
+  const CommandResult inCore = runCommand(
+      "repose", p.common(posed) + " --out " + shellQuote(inCoreOut) + " --memory 4G --json", true);
+  ASSERT_EQ(inCore.exitCode, 0) << inCore.err;
+  EXPECT_FALSE(nlohmann::json::parse(inCore.out)["out_of_core"].get<bool>());
+  ASSERT_GT(inCore.peakRssKb, 0);
+  const long budgetKb = inCore.peakRssKb * 85 / 100;
+  const CommandResult outOfCore =
+      runCommand("repose",
+                 p.common(posed) + " --out " + shellQuote(outOfCoreOut) + " --memory " +
+                     std::to_string(budgetKb) + "K --json",
+                 true);
+  ASSERT_EQ(outOfCore.exitCode, 0) << outOfCore.err;
+  const auto j = nlohmann::json::parse(outOfCore.out);
+  EXPECT_TRUE(j["out_of_core"].get<bool>());
+  EXPECT_LT(outOfCore.peakRssKb, budgetKb) << "in core: " << inCore.peakRssKb << " KB";
+  EXPECT_EQ(readVolume(inCoreOut).bytes(), readVolume(outOfCoreOut).bytes());
+  EXPECT_EQ(j["labels"], nlohmann::json::parse(inCore.out)["labels"]);
 }
