@@ -120,25 +120,42 @@ __attribute__((target("avx2,fma,f16c"))) void multiplyRowsExact(
 }  // namespace
 
 CompactGreenMatrix::CompactGreenMatrix(const Eigen::MatrixXd& phi, const Eigen::MatrixXd& psi)
-    : rows_(phi.rows()), cols_(phi.cols() + psi.cols()) {
-  if (psi.rows() != rows_) throw Error("Green coordinates: phi and psi have different rows");
-  const double largest = std::max(phi.size() ? phi.cwiseAbs().maxCoeff() : 0.0,
-                                  psi.size() ? psi.cwiseAbs().maxCoeff() : 0.0);
-  if (!std::isfinite(largest)) throw Error("Green coordinates are not finite");
-  scale_ = largest > kHalfLimit ? kHalfLimit / largest : 1.0;
+    : CompactGreenMatrix(phi.rows(), phi.cols(), psi.cols()) {
+  setRows(0, phi, psi);
+}
+
+CompactGreenMatrix::CompactGreenMatrix(Eigen::Index rows, Eigen::Index vertexCols,
+                                       Eigen::Index faceCols)
+    : rows_(rows), cols_(vertexCols + faceCols), vertexCols_(vertexCols) {
   stride_ = (cols_ + kLanes - 1) / kLanes * kLanes;
   high_.assign(static_cast<std::size_t>(rows_ * stride_), 0);
   low_.assign(high_.size(), 0);
-  const Eigen::Index nv = phi.cols();
-  parallelFor(rows_, 0, [&](std::int64_t begin, std::int64_t end) {
-    for (std::int64_t r = begin; r < end; ++r)
+  rowScale_ = Eigen::VectorXd::Ones(rows_);
+}
+
+void CompactGreenMatrix::setRows(Eigen::Index first, const Eigen::MatrixXd& phi,
+                                 const Eigen::MatrixXd& psi) {
+  if (psi.rows() != phi.rows() || phi.cols() != vertexCols_ || phi.cols() + psi.cols() != cols_ ||
+      first < 0 || first + phi.rows() > rows_)
+    throw Error("Green coordinates: a block that does not fit the matrix");
+  const Eigen::Index nv = vertexCols_;
+  parallelFor(phi.rows(), 0, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t b = begin; b < end; ++b) {
+      const std::int64_t r = first + b;
+      double largest = 0;
+      for (Eigen::Index j = 0; j < cols_; ++j)
+        largest = std::max(largest, std::fabs(j < nv ? phi(b, j) : psi(b, j - nv)));
+      if (!std::isfinite(largest)) throw Error("Green coordinates are not finite");
+      const double scale = largest > kHalfLimit ? kHalfLimit / largest : 1.0;
+      rowScale_[r] = scale;
       for (Eigen::Index j = 0; j < cols_; ++j) {
-        const double c = scale_ * (j < nv ? phi(r, j) : psi(r, j - nv));
+        const double c = scale * (j < nv ? phi(b, j) : psi(b, j - nv));
         const std::uint16_t h = toHalf(static_cast<float>(c));
         const std::size_t at = static_cast<std::size_t>(r * stride_ + j);
         high_[at] = h;
         low_[at] = toHalf(static_cast<float>(kLowScale * (c - double(fromHalf(h)))));
       }
+    }
   });
 }
 
@@ -171,7 +188,7 @@ Eigen::MatrixX3d CompactGreenMatrix::multiply(const Eigen::MatrixX3d& x, bool pr
     multiplyRowsScalar(high_.data(), preview ? nullptr : low_.data(), stride_, cols_, d,
                        d + stride_, d + 2 * stride_, begin, end, out.data());
   });
-  return out / scale_;
+  return rowScale_.cwiseInverse().asDiagonal() * out;
 }
 
 }  // namespace repose

@@ -7,7 +7,8 @@
 
 namespace repose {
 
-Embedding embedInCage(const TransferMesh& mesh, const TriangleMesh& cage, int threads) {
+Embedding embedInCage(const TransferMesh& mesh, const TriangleMesh& cage, int threads,
+                      bool withCoordinates) {
   Embedding e;
   const Eigen::VectorXd w = windingNumbers(cage, mesh.vertices, threads);
   e.inside.assign(static_cast<std::size_t>(mesh.vertices.rows()), 0);
@@ -24,6 +25,7 @@ Embedding embedInCage(const TransferMesh& mesh, const TriangleMesh& cage, int th
     if (e.inside[mesh.tets(t, 0)] && e.inside[mesh.tets(t, 1)] && e.inside[mesh.tets(t, 2)] &&
         e.inside[mesh.tets(t, 3)])
       e.cageTets.push_back(static_cast<int>(t));
+  if (!withCoordinates) return e;
   Eigen::MatrixX3d points(e.cageVertices.size(), 3);
   for (std::size_t i = 0; i < e.cageVertices.size(); ++i)
     points.row(i) = mesh.vertices.row(e.cageVertices[i]);

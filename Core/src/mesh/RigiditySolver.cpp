@@ -308,14 +308,27 @@ Eigen::MatrixX3d greenCageValues(const TriangleMesh& rest, const Eigen::MatrixX3
 
 CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads)
     : cage_(cage),
-      embedding_(embedInCage(mesh, cage, threads)),
+      embedding_(embedInCage(mesh, cage, threads, false)),
       solver_(mesh, embedding_.cageVertices, embedding_.cageTets),
       threads_(threads) {
-  const GreenCoordinates& gc = embedding_.coordinates;
+  // Green coordinates of V_c in blocks of rows, each compacted at once, so the double matrix
+  // (12 bytes more per coefficient) never exists for the whole mesh: at the seed's sizes it would
+  // be ~430 MB, more than the rest of a posing job.
+  constexpr Eigen::Index kBlock = 1024;
+  const Eigen::Index n = static_cast<Eigen::Index>(embedding_.cageVertices.size());
   restCageValues_ = greenCageValues(cage_, cage_.vertices);
-  restPositions_ = applyGreenCoordinates(gc, cage_, cage_.vertices);
-  coefficients_ = std::make_unique<CompactGreenMatrix>(gc.phi, gc.psi);
-  embedding_.coordinates = GreenCoordinates();  // the compact copy is what frames use
+  restPositions_.resize(n, 3);
+  coefficients_ =
+      std::make_unique<CompactGreenMatrix>(n, cage_.vertices.rows(), cage_.faces.rows());
+  for (Eigen::Index first = 0; first < n; first += kBlock) {
+    const Eigen::Index rows = std::min(kBlock, n - first);
+    Eigen::MatrixX3d points(rows, 3);
+    for (Eigen::Index r = 0; r < rows; ++r)
+      points.row(r) = mesh.vertices.row(embedding_.cageVertices[first + r]);
+    const GreenCoordinates gc = computeGreenCoordinates(cage_, points, threads);
+    restPositions_.middleRows(first, rows) = applyGreenCoordinates(gc, cage_, cage_.vertices);
+    coefficients_->setRows(first, gc.phi, gc.psi);
+  }
 }
 
 CageDeformation::~CageDeformation() = default;

@@ -18,7 +18,9 @@ struct Embedding {
 };
 
 // Inside means generalized winding number >= 0.5. Throws repose::Error when no TM vertex is
-// inside the cage (nothing would move).
-Embedding embedInCage(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0);
+// inside the cage (nothing would move). Without coordinates, `coordinates` stays empty (a caller
+// computing them in blocks to bound memory).
+Embedding embedInCage(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0,
+                      bool withCoordinates = true);
 
 }  // namespace repose

@@ -49,7 +49,8 @@ enum class GreenPrecision { Exact, Preview };
 // One interaction frame: deformed cage -> Green coordinates on V_c -> rigidity solve.
 // The dense coordinate matrix [phi psi] (V_c rows) is the frame's largest cost and is memory-
 // bound, so it is kept once, compactly (CompactGreenMatrix: two half-float arrays), and applied
-// to the cage's displacement from rest on all cores; the double coordinates are dropped.
+// to the cage's displacement from rest on all cores; the double coordinates are computed in
+// blocks of rows and never held for the whole mesh.
 class CageDeformation {
  public:
   CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0);
