@@ -3,6 +3,7 @@
 #include "ArgParser.h"
 #include "SeparationOptions.h"
 #include "Commands.h"
+#include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
 #include "repose/cage/CageBuilder.h"
@@ -30,6 +31,10 @@ int runCage(const Args& args) {
       .option("dilate-mm", "MM", "dilation of the body before meshing", "10")
       .option("working-voxel-mm", "MM", "voxel size of the working grid (0: automatic)", "0")
       .option("threads", "N", "worker threads (0: all cores)", "0")
+      .option("memory", "BYTES",
+              "memory budget, e.g. 2G (default: half the RAM); above it a downsampled proxy of "
+              "PARTS (label mode per block) is used",
+              "")
       .flag("json", "print a JSON report on stdout");
   declareSeparationOptions(p, "the cage passes between");
   if (!p.parse(args)) return 0;
@@ -46,7 +51,10 @@ int runCage(const Args& args) {
   AtomicOutput probe(out);  // an unwritable output fails now, not after the work
   o.progress = terminalProgress();
   const auto start = std::chrono::steady_clock::now();
-  const Volume parts = readVolume(p.get("parts"));
+  // The builder holds S and working grids: about 3 bytes per voxel of S.
+  int proxy = 1;
+  const Volume parts =
+      readLabelsWithinBudget(p.get("parts"), parseMemoryBudget(p.get("memory")), 3, proxy);
   const Cage cage = buildCage(parts, o);
   writeTriangleMesh(cage.mesh, out);
   const double seconds =
@@ -61,6 +69,7 @@ int runCage(const Args& args) {
                         {"simplification", r.simplification},
                         {"frozen_dense_vertices", r.frozenVertices},
                         {"dilate_mm", o.dilateMm},
+                        {"proxy_factor", proxy},
                         {"checks",
                          {{"closed", r.closed},
                           {"manifold", r.manifold},

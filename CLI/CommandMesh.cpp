@@ -3,6 +3,7 @@
 #include "ArgParser.h"
 #include "SeparationOptions.h"
 #include "Commands.h"
+#include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
 #include "repose/io/AtomicOutput.h"
@@ -32,6 +33,10 @@ int runMesh(const Args& args) {
       .option("out", "FILE", "output transfer mesh (.vtu)")
       .option("size-mm", "MM", "tet size (0: 5% of the volume's diagonal)", "0")
       .option("threads", "N", "worker threads (0: all cores)", "0")
+      .option("memory", "BYTES",
+              "memory budget, e.g. 2G (default: half the RAM); above it a downsampled proxy of "
+              "PARTS (label mode per block) is used",
+              "")
       .flag("json", "print a JSON summary on stdout");
   declareSeparationOptions(p, "split the mesh between");
   if (!p.parse(args)) return 0;
@@ -42,7 +47,10 @@ int runMesh(const Args& args) {
   refuseOverwritingInput(p.get("parts"), out);
   AtomicOutput probe(out);  // an unwritable output fails before the work
   const auto start = std::chrono::steady_clock::now();
-  const Volume parts = readVolume(p.get("parts"));
+  // Mesh_3 holds S, a padded 16-bit copy and its triangulation: about 8 bytes per voxel of S.
+  int proxy = 1;
+  const Volume parts =
+      readLabelsWithinBudget(p.get("parts"), parseMemoryBudget(p.get("memory")), 8, proxy);
   const TriangleMesh cage = readTriangleMesh(p.get("cage"));
   TransferMeshOptions o;
   o.sizeMm = p.getDouble("size-mm");
@@ -71,6 +79,7 @@ int runMesh(const Args& args) {
                             {"vertices_inside_cage", embedding.cageVertices.size()},
                             {"tets_inside_cage", embedding.cageTets.size()},
                             {"outliers", embedding.outliers()},
+                            {"proxy_factor", proxy},
                             {"unreachable_vertices", solver.unconstrainedVertices()},
                             {"seconds", seconds}};
   if (p.has("json")) {

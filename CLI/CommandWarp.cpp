@@ -3,6 +3,7 @@
 // before and after, so a dosimetry user sees at once whether a tissue lost or gained volume.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
 #include "repose/io/AtomicOutput.h"
@@ -33,28 +34,6 @@
 namespace repose::cli {
 namespace {
 
-std::string gib(double bytes) {
-  std::ostringstream s;
-  s.precision(3);
-  s << bytes / (1024.0 * 1024 * 1024) << " GiB";
-  return s.str();
-}
-
-// The process's peak resident set so far (VmHWM), in bytes; 0 if unknown.
-double peakResidentBytes() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmHWM:") {
-      double kb = 0;
-      status >> kb;
-      return kb * 1024;
-    }
-    status.ignore(1 << 20, '\n');
-  }
-  return 0;
-}
-
 // Voxels per non-zero label of a file read through a slice cache, as mm3.
 std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
   const NiftiLayout& l = cache.layout();
@@ -72,28 +51,6 @@ std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
   std::map<int, double> mm3;
   for (const auto& [value, count] : counts) mm3[value] = double(count) * s.prod();
   return mm3;
-}
-
-double physicalMemory() {
-  return double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
-}
-
-// "512M", "1G", "2.5G", or bytes.
-double parseBytes(const std::string& text) {
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  const std::string unit = end ? std::string(end) : "";
-  double scale = 1;
-  if (unit == "K" || unit == "k")
-    scale = 1024;
-  else if (unit == "M" || unit == "m")
-    scale = 1024.0 * 1024;
-  else if (unit == "G" || unit == "g")
-    scale = 1024.0 * 1024 * 1024;
-  else if (!unit.empty())
-    throw UsageError{"--memory: unknown unit in '" + text + "' (use K, M or G)"};
-  if (!(v > 0)) throw UsageError{"--memory must be positive"};
-  return v * scale;
 }
 
 }  // namespace
@@ -116,7 +73,10 @@ int runWarp(const Args& args) {
       .option("transform-out", "FILE",
               "displacement-field transform (.nrrd, LPS, output->input as ITK and Slicer use)")
       .option("spacing-mm", "MM", "output voxel size along every axis (0: the input's)", "0")
-      .option("shell-mm", "MM", "extrapolate this far outside the mesh (-1: 2 voxels)", "-1")
+      .option("shell-mm", "MM",
+              "extrapolate this far outside the mesh (-1: two voxels of G or of the grid the mesh "
+              "was built on, whichever is coarser)",
+              "-1")
       .option("memory", "BYTES", "memory budget, e.g. 2G (default: half the RAM)", "")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("json", "print a JSON summary on stdout");
@@ -135,8 +95,7 @@ int runWarp(const Args& args) {
         if (p.has(o)) refuseOverwritingInput(p.get(in), p.get(o));
   const double spacing = p.getDouble("spacing-mm");
   if (spacing < 0) throw UsageError{"--spacing-mm must be >= 0"};
-  const double budget =
-      p.get("memory").empty() ? 0.5 * physicalMemory() : parseBytes(p.get("memory"));
+  const double budget = parseMemoryBudget(p.get("memory"));
   AtomicOutput probe(out);  // an unwritable output fails before the work
   const auto start = std::chrono::steady_clock::now();
 

@@ -148,6 +148,7 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
     mesh.tets.row(i) = tets[i], mesh.labels[i] = labels[i];
   // CGAL's cells are positively oriented in the image frame; a mirrored IJK->RAS (LPS-like grids)
   // flips them all, which is not an inversion.
+  mesh.sourceSpacingMm = g.spacing().maxCoeff();
   cleanTransferMesh(mesh, g.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0, r);
   if (mesh.tets.rows() == 0) throw Error("meshing produced only degenerate tetrahedra");
   if (report) *report = r;

@@ -46,6 +46,9 @@ void writeTransferMesh(const TransferMesh& mesh, const std::string& path) {
            "'label' -->\n"
         << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
            "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
+        << "<FieldData>\n<DataArray type=\"Float64\" Name=\"source_spacing_mm\" "
+           "NumberOfTuples=\"1\" format=\"ascii\">\n"
+        << mesh.sourceSpacingMm << "\n</DataArray>\n</FieldData>\n"
         << "<Piece NumberOfPoints=\"" << mesh.vertices.rows() << "\" NumberOfCells=\""
         << mesh.tets.rows() << "\">\n"
         << "<Points>\n<DataArray type=\"Float64\" Name=\"Points\" NumberOfComponents=\"3\" "
@@ -103,6 +106,11 @@ TransferMesh readTransferMesh(const std::string& path) {
   auto l = dataArray(xml, "label", path);
   for (long t = 0; t < cells; ++t)
     if (!(l >> mesh.labels[t])) throwFileError(path, "truncated label array");
+  if (xml.find("Name=\"source_spacing_mm\"") != std::string::npos) {  // optional (older files)
+    auto f = dataArray(xml, "source_spacing_mm", path);
+    if (!(f >> mesh.sourceSpacingMm) || !(mesh.sourceSpacingMm >= 0))
+      throwFileError(path, "bad source_spacing_mm");
+  }
   if (mesh.tets.minCoeff() < 0 || mesh.tets.maxCoeff() >= points)
     throwFileError(path, "a cell uses a point that does not exist");
   if (!mesh.vertices.allFinite()) throwFileError(path, "point coordinates are not finite");

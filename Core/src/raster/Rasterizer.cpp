@@ -55,7 +55,8 @@ struct Shell {
 Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const VolumeGeometry& output,
                 const RasterOptions& options) {
   Shell sh;
-  sh.mm = options.shellMm < 0 ? 2 * input.spacing().maxCoeff() : options.shellMm;
+  sh.mm = options.shellMm < 0 ? 2 * std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm)
+                              : options.shellMm;
   if (sh.mm <= 0) return sh;
   sh.outer = options.outerFaces ? *options.outerFaces : outerFaces(mesh);
   if (sh.outer.size() != static_cast<std::size_t>(mesh.tets.rows()))

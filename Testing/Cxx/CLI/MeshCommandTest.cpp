@@ -47,3 +47,34 @@ TEST(MeshCommand, BuildsEmbedsAndWritesTheTransferMesh) {
     EXPECT_FALSE(std::filesystem::exists(out));
   }
 }
+
+// Under a small --memory, the cage and the mesh are built on a downsampled proxy of S (label mode
+// per block): the mesh stays under the budget, the cage needs less than in core (its builder's
+// working grids are not yet bounded by the budget), and the mesh remembers the proxy's spacing.
+TEST(MeshCommand, ProxyKeepsCageAndMeshUnderTheBudget) {
+  ScratchDir dir;
+  ASSERT_EQ(
+      runCommand("repose", "phantom --voxel 2 --out " + shellQuote(dir.path().string())).exitCode,
+      0);
+  const std::string parts = shellQuote(dir.file("S.nii.gz")),
+                    cage = shellQuote(dir.file("cage.obj"));
+  const CommandResult inCore = runCommand(
+      "repose", "cage --parts " + parts + " --out " + shellQuote(dir.file("full.obj")) + " --json",
+      true);
+  ASSERT_EQ(inCore.exitCode, 0) << inCore.err;
+  EXPECT_EQ(nlohmann::json::parse(inCore.out)["proxy_factor"], 1);
+  const CommandResult c = runCommand(
+      "repose", "cage --parts " + parts + " --out " + cage + " --memory 60M --json", true);
+  ASSERT_EQ(c.exitCode, 0) << c.err;
+  EXPECT_GT(nlohmann::json::parse(c.out)["proxy_factor"].get<int>(), 1);
+  EXPECT_LT(c.peakRssKb, inCore.peakRssKb);
+  const CommandResult m = runCommand("repose",
+                                     "mesh --parts " + parts + " --cage " + cage + " --out " +
+                                         shellQuote(dir.file("tm.vtu")) + " --memory 100M --json",
+                                     true);
+  ASSERT_EQ(m.exitCode, 0) << m.err;
+  const int factor = nlohmann::json::parse(m.out)["proxy_factor"].get<int>();
+  EXPECT_GT(factor, 1);
+  EXPECT_LT(m.peakRssKb, 100 * 1024);
+  EXPECT_DOUBLE_EQ(readTransferMesh(dir.file("tm.vtu")).sourceSpacingMm, 2.0 * factor);
+}

@@ -16,6 +16,9 @@ struct TransferMesh {
   Eigen::MatrixX3d vertices;  // #V by 3 rest positions, RAS mm
   Eigen::MatrixX4i tets;      // #T by 4 vertex indices, positively oriented (volume > 0)
   Eigen::VectorXi labels;     // #T body-part label (subdomain of S) of each tet
+  // The largest voxel size of the grid it was meshed from (mm; 0 when unknown). Mesh_3 puts the
+  // surface to within about this of the label boundary; the rasterizer's shell covers the gap.
+  double sourceSpacingMm = 0;
 };
 
 // Signed volume (mm^3) of tet t: det[b-a, c-a, d-a] / 6, positive for the orientation TM uses.

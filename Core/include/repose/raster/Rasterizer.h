@@ -40,8 +40,9 @@ struct RasterOptions {
   ProgressFn progress;  // called from worker threads, one call at a time; false cancels
   // Mesh_3 puts the TM's surface only to within a voxel of the label boundary, so some labelled
   // voxel centres (the skin) lie just outside the mesh. Voxels no tet covers but within shellMm
-  // outside an outer face take that boundary tet's map, extrapolated. < 0: twice the input's
-  // largest spacing; 0: off (only voxels inside tets are written).
+  // outside an outer face take that boundary tet's map, extrapolated. < 0: twice the larger of
+  // the input's largest spacing and the mesh's sourceSpacingMm (a mesh built on a coarser proxy
+  // is further from the labels); 0: off (only voxels inside tets are written).
   double shellMm = -1;
   const std::vector<std::uint8_t>* outerFaces = nullptr;  // outerFaces(mesh), computed if null
 };

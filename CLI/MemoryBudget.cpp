@@ -1,0 +1,77 @@
+#include "MemoryBudget.h"
+
+#include "ArgParser.h"
+#include "TerminalProgress.h"
+
+#include "repose/io/LabelProxy.h"
+#include "repose/io/NiftiIO.h"
+#include "repose/io/SliceCache.h"
+#include "repose/io/VolumeIO.h"
+#include "repose/util/Error.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace repose::cli {
+
+double parseMemoryBudget(const std::string& text) {
+  if (text.empty()) return 0.5 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  const std::string unit = end ? std::string(end) : "";
+  double scale = 1;
+  if (unit == "K" || unit == "k")
+    scale = 1024;
+  else if (unit == "M" || unit == "m")
+    scale = 1024.0 * 1024;
+  else if (unit == "G" || unit == "g")
+    scale = 1024.0 * 1024 * 1024;
+  else if (!unit.empty())
+    throw UsageError{"--memory: unknown unit in '" + text + "' (use K, M or G)"};
+  if (!(v > 0)) throw UsageError{"--memory must be positive"};
+  return v * scale;
+}
+
+double peakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  while (status >> key) {
+    if (key == "VmHWM:") {
+      double kb = 0;
+      status >> kb;
+      return kb * 1024;
+    }
+    status.ignore(1 << 20, '\n');
+  }
+  return 0;
+}
+
+std::string gib(double bytes) {
+  std::ostringstream s;
+  s.precision(3);
+  s << bytes / (1024.0 * 1024 * 1024) << " GiB";
+  return s.str();
+}
+
+Volume readLabelsWithinBudget(const std::string& path, double budget, double bytesPerVoxelNeeded,
+                              int& factor) {
+  factor = 1;
+  if (formatForPath(path) != FileFormat::Nifti) return readVolume(path);
+  const NiftiLayout layout = readNiftiLayout(path);
+  const double available = budget - peakResidentBytes();
+  const std::int64_t voxels = layout.geometry.numVoxels();
+  if (double(voxels) * bytesPerVoxelNeeded <= available) return readVolume(path);
+  // The proxy must fit with the same overhead; the cache gets a quarter of what is left.
+  factor = proxyFactor(voxels, static_cast<std::size_t>(std::ceil(bytesPerVoxelNeeded)),
+                       0.5 * available);
+  const double cacheBytes = 0.25 * available;
+  if (cacheBytes <= 0)
+    throw Error(path + ": the memory budget of " + gib(budget) + " is already used up");
+  SliceCache cache(path, static_cast<std::size_t>(cacheBytes));
+  return labelModeProxy(cache, factor, terminalProgress());
+}
+
+}  // namespace repose::cli

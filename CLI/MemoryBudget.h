@@ -1,0 +1,23 @@
+// `--memory`: the budget a command keeps its volumes under, and the label-map reader that
+// switches to a downsampled proxy (io/LabelProxy.h) when a label map would not fit.
+#pragma once
+
+#include "repose/volume/Volume.h"
+
+#include <string>
+
+namespace repose::cli {
+
+// "512M", "1G", "2.5G", "300K", or bytes; empty: half the physical memory. Throws UsageError.
+double parseMemoryBudget(const std::string& text);
+// The process's peak resident set so far (VmHWM), in bytes; 0 if unknown.
+double peakResidentBytes();
+std::string gib(double bytes);
+
+// Reads the label map at `path` in core when voxels * bytesPerVoxelNeeded fit in `budget`;
+// otherwise (NIfTI only) builds its mode proxy through a slice cache, coarse enough to fit.
+// `factor` receives 1 or the proxy's factor.
+Volume readLabelsWithinBudget(const std::string& path, double budget, double bytesPerVoxelNeeded,
+                              int& factor);
+
+}  // namespace repose::cli
