@@ -84,26 +84,50 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // outside a work item. Only tets whose box meets the grid are kept: for a live slice, the few
   // crossing it, found with plain comparisons first since every tet is looked at.
   const bool withShell = !shell.outer.empty();
+  // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
+  struct Candidates {
+    std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;
+  };
+  const int selectThreads = resolveThreads(options.threads);
+  std::vector<Candidates> parts(static_cast<std::size_t>(selectThreads));
+  parallelFor(
+      selectThreads, selectThreads,
+      [&](std::int64_t pb, std::int64_t pe) {
+        for (std::int64_t part = pb; part < pe; ++part) {
+          Candidates& c = parts[static_cast<std::size_t>(part)];
+          for (Eigen::Index t = nt * part / selectThreads; t < nt * (part + 1) / selectThreads;
+               ++t) {
+            const double growth = withShell && shell.outer[t] ? 1.0 : 0.0;
+            const Eigen::Vector3d &p0 = in.out[T(t, 0)], &p1 = in.out[T(t, 1)],
+                                  &p2 = in.out[T(t, 2)], &p3 = in.out[T(t, 3)];
+            const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) -
+                               growth * shell.boxGrowth[2];
+            const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) +
+                               growth * shell.boxGrowth[2];
+            if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
+            const double ylo = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) -
+                               growth * shell.boxGrowth[1];
+            const double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) +
+                               growth * shell.boxGrowth[1];
+            if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
+            c.tet.push_back(static_cast<std::int32_t>(t));
+            c.kmin.push_back(static_cast<std::int32_t>(std::max(double(kBegin), std::ceil(zlo))));
+            c.kmax.push_back(
+                static_cast<std::int32_t>(std::min(double(kEnd - 1), std::floor(zhi))));
+            c.jmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(ylo))));
+            c.jmax.push_back(
+                static_cast<std::int32_t>(std::min(double(in.dims[1] - 1), std::floor(yhi))));
+          }
+        }
+      },
+      1);
   std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax;
-  for (Eigen::Index t = 0; t < nt; ++t) {
-    const double growth = withShell && shell.outer[t] ? 1.0 : 0.0;
-    const Eigen::Vector3d &p0 = in.out[T(t, 0)], &p1 = in.out[T(t, 1)], &p2 = in.out[T(t, 2)],
-                          &p3 = in.out[T(t, 3)];
-    const double zlo =
-        std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - growth * shell.boxGrowth[2];
-    const double zhi =
-        std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + growth * shell.boxGrowth[2];
-    if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
-    const double ylo =
-        std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - growth * shell.boxGrowth[1];
-    const double yhi =
-        std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + growth * shell.boxGrowth[1];
-    if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
-    candidates.push_back(static_cast<std::int32_t>(t));
-    kmin.push_back(static_cast<std::int32_t>(std::max(double(kBegin), std::ceil(zlo))));
-    kmax.push_back(static_cast<std::int32_t>(std::min(double(kEnd - 1), std::floor(zhi))));
-    jmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(ylo))));
-    jmax.push_back(static_cast<std::int32_t>(std::min(double(in.dims[1] - 1), std::floor(yhi))));
+  for (const Candidates& c : parts) {
+    candidates.insert(candidates.end(), c.tet.begin(), c.tet.end());
+    jmin.insert(jmin.end(), c.jmin.begin(), c.jmin.end());
+    jmax.insert(jmax.end(), c.jmax.begin(), c.jmax.end());
+    kmin.insert(kmin.end(), c.kmin.begin(), c.kmin.end());
+    kmax.insert(kmax.end(), c.kmax.begin(), c.kmax.end());
   }
   // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
   // bands of j-rows across all slices, so every core has work either way.

@@ -29,6 +29,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace repose::raster {
@@ -156,8 +157,10 @@ void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0
   const std::int64_t jb = std::max(j0, s.lo[1]), je = std::min(j1 - 1, s.hi[1]);
   const Eigen::Vector3d step = s.A.col(0);
   // Along a row each face's signed value is slope * i + c(j, k); the real interval is where all
-  // four are positive. Its rounded ends are then settled by the exact predicate (at most a step
-  // or two, since the rounding error is far below a voxel).
+  // four are positive. A rounded root more than kSettle from a whole number decides like the exact
+  // predicate (the rounding error is ~1e-12 voxel); only an end within kSettle of a voxel centre is
+  // settled by the predicate itself, one voxel either way.
+  constexpr double kSettle = 1e-7;
   std::array<double, 4> slope, negInv;
   for (int f = 0; f < 4; ++f) {
     slope[f] = s.faces[f].side * s.faces[f].n.x();
@@ -167,7 +170,7 @@ void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0
   for (std::int64_t k = kb; k <= ke; ++k)
     for (std::int64_t j = jb; j <= je; ++j) {
       const double dj = double(j), dk = double(k);
-      double a = lo, b = hi;
+      double a = -std::numeric_limits<double>::infinity(), b = -a;
       bool empty = false;
       for (int f = 0; f < 4; ++f) {
         const Plane& p = s.faces[f];
@@ -181,22 +184,27 @@ void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0
         else
           b = std::min(b, root);
       }
-      if (empty || a > b + 1) continue;
-      std::int64_t i0 = static_cast<std::int64_t>(std::ceil(a));
-      std::int64_t i1 = static_cast<std::int64_t>(std::floor(b));
-      if (i0 > s.lo[0] && inside(s, double(i0 - 1), dj, dk)) {
-        do --i0;
-        while (i0 > s.lo[0] && inside(s, double(i0 - 1), dj, dk));
-      } else {
-        // A non-empty row starts at most one past floor(b), whatever the rounding.
-        const std::int64_t last = std::min(s.hi[0], i1 + 1);
-        while (i0 <= last && !inside(s, double(i0), dj, dk)) ++i0;
+      if (empty || a > b + 1 || a > hi + 1 || b < lo - 1) continue;
+      std::int64_t i0 = s.lo[0], i1 = s.hi[0];
+      if (a >= lo - kSettle) {
+        i0 = static_cast<std::int64_t>(std::ceil(a));
+        if (double(i0) - a < kSettle) {
+          if (!inside(s, double(i0), dj, dk)) ++i0;
+        } else if (a - double(i0 - 1) < kSettle && i0 - 1 >= s.lo[0] &&
+                   inside(s, double(i0 - 1), dj, dk)) {
+          --i0;
+        }
+        i0 = std::max(i0, s.lo[0]);
       }
-      if (i1 < s.hi[0] && inside(s, double(i1 + 1), dj, dk)) {
-        do ++i1;
-        while (i1 < s.hi[0] && inside(s, double(i1 + 1), dj, dk));
-      } else {
-        while (i1 >= i0 && !inside(s, double(i1), dj, dk)) --i1;
+      if (b <= hi + kSettle) {
+        i1 = static_cast<std::int64_t>(std::floor(b));
+        if (b - double(i1) < kSettle) {
+          if (!inside(s, double(i1), dj, dk)) --i1;
+        } else if (double(i1 + 1) - b < kSettle && i1 + 1 <= s.hi[0] &&
+                   inside(s, double(i1 + 1), dj, dk)) {
+          ++i1;
+        }
+        i1 = std::min(i1, s.hi[0]);
       }
       if (i0 > i1) continue;
       const Eigen::Vector3d x{double(i0), dj, dk};
