@@ -1,7 +1,7 @@
 // One interaction frame at the seed's sizes: deformed cage -> Green coordinates of V_c -> both
 // rigidity solves, on the 2 mm phantom with a ~500-vertex cage and a transfer mesh of ~36K
 // vertices (--benchmark_filter to pick parts). Prints where the time goes.
-#include "repose/cage/ArapDeformer.h"
+#include "BenchPoses.h"
 #include "repose/cage/CageBuilder.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
@@ -44,21 +44,7 @@ const Scene& scene() {
     s.mesh = buildTransferMesh(parts, to);
     s.deformation = std::make_unique<CageDeformation>(s.mesh, s.cage);
     // Raise the right arm 60 degrees about the shoulder with ARAP: a realistic drag.
-    std::vector<int> handles;
-    for (Eigen::Index v = 0; v < s.cage.vertices.rows(); ++v)
-      if (s.cage.vertices(v, 0) > 150 || s.cage.vertices(v, 2) < 100)
-        handles.push_back(static_cast<int>(v));
-    ArapDeformer arap(s.cage);
-    arap.setHandles(handles);
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(-60 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    const Eigen::Vector3d pivot(110, 0, 1000);
-    Eigen::MatrixX3d targets(handles.size(), 3);
-    for (std::size_t h = 0; h < handles.size(); ++h) {
-      const Eigen::Vector3d p = s.cage.vertices.row(handles[h]);
-      targets.row(h) = (p.x() > 150 ? Eigen::Vector3d(R * (p - pivot) + pivot) : p).transpose();
-    }
-    s.deformedCage = arap.solve(targets).positions;
+    s.deformedCage = bench::raiseRightArm60(s.cage);
     std::cout << "frame scene: cage " << s.cage.vertices.rows() << " vertices / "
               << s.cage.faces.rows() << " faces, TM " << s.mesh.vertices.rows() << " vertices / "
               << s.mesh.tets.rows() << " tets, V_c "

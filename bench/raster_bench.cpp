@@ -2,7 +2,7 @@
 // second, in-core, file I/O excluded) against a VTK baseline (vtkProbeFilter of the deformed TM
 // carrying rest positions, then the same nearest-label lookup), and one live 512x512 slice.
 // 2 mm phantom (REPOSE_RASTER_VOXEL_MM overrides), TM of ~36K vertices, right arm raised 60 deg.
-#include "repose/cage/ArapDeformer.h"
+#include "BenchPoses.h"
 #include "repose/cage/CageBuilder.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
@@ -55,21 +55,7 @@ const Scene& scene() {
     to.sizeMm = 8.5;
     s.mesh = buildTransferMesh(s.parts, to);
     const CageDeformation deformation(s.mesh, s.cage);
-    std::vector<int> handles;
-    for (Eigen::Index v = 0; v < s.cage.vertices.rows(); ++v)
-      if (s.cage.vertices(v, 0) > 150 || s.cage.vertices(v, 2) < 100)
-        handles.push_back(static_cast<int>(v));
-    ArapDeformer arap(s.cage);
-    arap.setHandles(handles);
-    const Eigen::Matrix3d R =
-        Eigen::AngleAxisd(-60 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    const Eigen::Vector3d pivot(110, 0, 1000);
-    Eigen::MatrixX3d targets(handles.size(), 3);
-    for (std::size_t h = 0; h < handles.size(); ++h) {
-      const Eigen::Vector3d p = s.cage.vertices.row(handles[h]);
-      targets.row(h) = (p.x() > 150 ? Eigen::Vector3d(R * (p - pivot) + pivot) : p).transpose();
-    }
-    s.deformed = deformation.deform(arap.solve(targets).positions);
+    s.deformed = deformation.deform(bench::raiseRightArm60(s.cage));
     s.output = deformedGrid(s.organs.geometry(), s.deformed);
     s.outer = outerFaces(s.mesh);
     std::cout << "raster scene: " << voxelMm() << " mm phantom, input " << s.organs.numVoxels()

@@ -160,17 +160,23 @@ NiftiPtr readHeader(const std::string& path, const std::string& libraryPath) {
   return nim;
 }
 
+// The file's voxel type, refused with the file's name when Repose cannot read it.
+io::DiskType checkedDiskType(const nifti_image& nim, const std::string& path) {
+  io::DiskType diskType;
+  if (!diskTypeFromNifti(nim.datatype, diskType))
+    throwFileError(path,
+                   std::string("unsupported voxel type ") + nifti_datatype_to_string(nim.datatype));
+  if (static_cast<std::size_t>(nim.nbyper) != io::diskTypeSize(diskType))
+    throwFileError(path, "inconsistent bytes per voxel in header");
+  return diskType;
+}
+
 }  // namespace
 
 Volume readNifti(const std::string& path, const ReadOptions& options) {
   const UnambiguousNiftiPath alias(path);
   NiftiPtr nim = readHeader(path, alias.path());
-  io::DiskType diskType;
-  if (!diskTypeFromNifti(nim->datatype, diskType))
-    throwFileError(
-        path, std::string("unsupported voxel type ") + nifti_datatype_to_string(nim->datatype));
-  if (static_cast<std::size_t>(nim->nbyper) != io::diskTypeSize(diskType))
-    throwFileError(path, "inconsistent bytes per voxel in header");
+  const io::DiskType diskType = checkedDiskType(*nim, path);
   const VolumeGeometry geometry = geometryOf(*nim, path);
 
   // An uncompressed file must hold all its voxels; say so before reading anything.
@@ -232,10 +238,7 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
 NiftiLayout readNiftiLayout(const std::string& path) {
   const UnambiguousNiftiPath alias(path);
   NiftiPtr nim = readHeader(path, alias.path());
-  io::DiskType diskType;
-  if (!diskTypeFromNifti(nim->datatype, diskType))
-    throwFileError(
-        path, std::string("unsupported voxel type ") + nifti_datatype_to_string(nim->datatype));
+  const io::DiskType diskType = checkedDiskType(*nim, path);
   const bool scaled = nim->scl_slope != 0.0 && (nim->scl_slope != 1.0 || nim->scl_inter != 0.0);
   const ScalarType memType = io::memoryTypeFor(diskType);
   if (scaled || scalarSize(memType) != io::diskTypeSize(diskType) ||

@@ -220,6 +220,15 @@ double frameSign(const VolumeGeometry& output) {
   return output.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0;
 }
 
+// Index of the input voxel nearest to the rest position p (input IJK), or -1 beyond the grid.
+inline std::int64_t nearestVoxel(const Eigen::Vector3d& p, const std::array<std::int64_t, 3>& d) {
+  const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
+                     y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
+                     z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
+  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]) return -1;
+  return x + d[0] * (y + d[1] * z);
+}
+
 template <class T>
 T fromDouble(double v) {
   if constexpr (std::is_integral_v<T>) {
@@ -347,12 +356,8 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
                 const Eigen::Vector3d& step) {
               const std::int64_t row = k * plane + j * nx;
               for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-                const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
-                                   y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
-                                   z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
-                const bool in = x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2];
-                const std::int64_t at = x + d[0] * (y + d[1] * z);
-                for (int l = 0; l < layers; ++l) dst[l][row + i] = in ? src[l][at] : T(0);
+                const std::int64_t at = nearestVoxel(p, d);
+                for (int l = 0; l < layers; ++l) dst[l][row + i] = at >= 0 ? src[l][at] : T(0);
               }
             });
   });
@@ -393,11 +398,9 @@ void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
               const Eigen::Vector3d& step) {
             T* row = buffer.data() + (k - k0) * plane + j * nx;
             for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-              const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
-                                 y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
-                                 z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
-              const bool inside = x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2];
-              row[i] = inside ? static_cast<const T*>(input.slice(z))[x + d[0] * y] : T(0);
+              const std::int64_t at = nearestVoxel(p, d), inPlane = d[0] * d[1];
+              row[i] =
+                  at >= 0 ? static_cast<const T*>(input.slice(at / inPlane))[at % inPlane] : T(0);
             }
           },
           k0, k1);
