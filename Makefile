@@ -38,3 +38,4 @@ bench: build
 	$(BUILD_DIR)/bin/ReposeFrameBench --benchmark_min_time=0.5
 	$(BUILD_DIR)/bin/ReposeRasterBench
 	$(BUILD_DIR)/bin/ReposeRefinementBench
+	$(BUILD_DIR)/bin/ReposeForearmBench
