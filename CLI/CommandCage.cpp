@@ -31,12 +31,9 @@ int runCage(const Args& args) {
       .option("dilate-mm", "MM", "dilation of the body before meshing", "10")
       .option("working-voxel-mm", "MM", "voxel size of the working grid (0: automatic)", "0")
       .option("threads", "N", "worker threads (0: all cores)", "0")
-      .option("memory", "BYTES",
-              "memory budget, e.g. 2G (default: half the RAM); above it a downsampled proxy of "
-              "PARTS (label mode per block) is used",
-              "")
       .flag("json", "print a JSON report on stdout");
   declareSeparationOptions(p, "the cage passes between");
+  declareMemoryOption(p, "above it a downsampled proxy of PARTS (label mode per block) is used");
   if (!p.parse(args)) return 0;
   if (!p.has("parts")) throw UsageError{"--parts is required"};
   if (!p.has("out")) throw UsageError{"--out is required"};

@@ -33,12 +33,9 @@ int runMesh(const Args& args) {
       .option("out", "FILE", "output transfer mesh (.vtu)")
       .option("size-mm", "MM", "tet size (0: 5% of the volume's diagonal)", "0")
       .option("threads", "N", "worker threads (0: all cores)", "0")
-      .option("memory", "BYTES",
-              "memory budget, e.g. 2G (default: half the RAM); above it a downsampled proxy of "
-              "PARTS (label mode per block) is used",
-              "")
       .flag("json", "print a JSON summary on stdout");
   declareSeparationOptions(p, "split the mesh between");
+  declareMemoryOption(p, "above it a downsampled proxy of PARTS (label mode per block) is used");
   if (!p.parse(args)) return 0;
   for (const char* required : {"parts", "cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};

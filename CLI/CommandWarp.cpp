@@ -77,9 +77,9 @@ int runWarp(const Args& args) {
               "extrapolate this far outside the mesh (-1: two voxels of G or of the grid the mesh "
               "was built on, whichever is coarser)",
               "-1")
-      .option("memory", "BYTES", "memory budget, e.g. 2G (default: half the RAM)", "")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("json", "print a JSON summary on stdout");
+  declareMemoryOption(p, "above it the posed volume is made out of core (NIfTI in and out)");
   if (!p.parse(args)) return 0;
   for (const char* required : {"input", "mesh", "cage", "posed-cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};

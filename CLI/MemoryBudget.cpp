@@ -17,6 +17,10 @@
 
 namespace repose::cli {
 
+void declareMemoryOption(ArgParser& p, const std::string& aboveIt) {
+  p.option("memory", "BYTES", "memory budget, e.g. 2G (default: half the RAM); " + aboveIt, "");
+}
+
 double parseMemoryBudget(const std::string& text) {
   if (text.empty()) return 0.5 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
   char* end = nullptr;

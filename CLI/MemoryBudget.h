@@ -8,6 +8,11 @@
 
 namespace repose::cli {
 
+class ArgParser;
+
+// Declares `--memory BYTES` with what the command does above the budget.
+void declareMemoryOption(ArgParser& p, const std::string& aboveIt);
+
 // "512M", "1G", "2.5G", "300K", or bytes; empty: half the physical memory. Throws UsageError.
 double parseMemoryBudget(const std::string& text);
 // The process's peak resident set so far (VmHWM), in bytes; 0 if unknown.
