@@ -178,14 +178,13 @@ int runWarp(const Args& args) {
     for (const LabelCount& c : countLabels(posedLabels))
       volumes[{c.layer, c.value}].second = c.volumeMm3;
   } else {
-    {  // each cache is gone before the next one fills
-      SliceCache cache(input, static_cast<std::size_t>(available / 2));
-      rasterizeLabelsToFile(cache, mesh, deformed, grid, out,
-                            static_cast<std::size_t>(available / 4), ro, &report);
-      for (const auto& [value, mm3] : streamedLabelVolumes(cache)) volumes[{0, value}].first = mm3;
-    }
-    SliceCache written(out, static_cast<std::size_t>(available / 2));
-    for (const auto& [value, mm3] : streamedLabelVolumes(written)) volumes[{0, value}].second = mm3;
+    SliceCache cache(input, static_cast<std::size_t>(available / 2));
+    rasterizeLabelsToFile(cache, mesh, deformed, grid, out, static_cast<std::size_t>(available / 4),
+                          ro, &report);
+    for (const auto& [value, mm3] : streamedLabelVolumes(cache)) volumes[{0, value}].first = mm3;
+    const double voxelMm3 = grid.spacing().prod();
+    for (const auto& [value, count] : report.labelVoxels)
+      volumes[{0, value}].second = double(count) * voxelMm3;
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -408,6 +408,8 @@ void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
       total.shellVoxels += part.shellVoxels;
       total.invertedTets = part.invertedTets;
       total.flatTets = part.flatTets;
+      for (const T v : buffer)
+        if (v != T(0)) ++total.labelVoxels[static_cast<int>(v)];
       writer.writeSlices(buffer.data(), k1 - k0);
     }
   });

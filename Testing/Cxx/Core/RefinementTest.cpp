@@ -9,12 +9,32 @@
 
 using namespace repose;
 
+namespace {
+
+// The 4 mm phantom, its parts map and its default cage, built once for both tests.
+struct ElbowScene {
+  Phantom phantom;
+  Volume parts;
+  TriangleMesh cage;
+};
+const ElbowScene& elbowScene() {
+  static const ElbowScene* s = [] {
+    PhantomOptions po;
+    po.voxelMm = 4;
+    auto* e = new ElbowScene{Phantom(po), {}, {}};
+    e->parts = e->phantom.makeVolumes().second;
+    e->cage = buildCage(e->parts, {}).mesh;
+    return e;
+  }();
+  return *s;
+}
+
+}  // namespace
+
 TEST(Refinement, RefinesWhereTheElbowBendsAndLowersTheMaximumError) {
-  PhantomOptions po;
-  po.voxelMm = 4;
-  const Phantom phantom(po);
-  const Volume parts = phantom.makeVolumes().second;
-  const TriangleMesh cage = buildCage(parts, {}).mesh;
+  const Phantom& phantom = elbowScene().phantom;
+  const Volume& parts = elbowScene().parts;
+  const TriangleMesh& cage = elbowScene().cage;
   RefinementOptions o;
   o.initialSizeMm = 45;
   o.maxIterations = 3;
@@ -35,11 +55,9 @@ TEST(Refinement, RefinesWhereTheElbowBendsAndLowersTheMaximumError) {
 // mesh's vertices (the adaptive one has 40% fewer) still has a larger maximum error. The full
 // comparison, with the ratio, is bench/refinement_bench.cpp.
 TEST(Refinement, BeatsAUniformMeshWithFortyPercentMoreVertices) {
-  PhantomOptions po;
-  po.voxelMm = 4;
-  const Phantom phantom(po);
-  const Volume parts = phantom.makeVolumes().second;
-  const TriangleMesh cage = buildCage(parts, {}).mesh;
+  const Phantom& phantom = elbowScene().phantom;
+  const Volume& parts = elbowScene().parts;
+  const TriangleMesh& cage = elbowScene().cage;
   const Eigen::MatrixX3d pose = phantomElbowFlexion(phantom, cage, 90);
   RefinementOptions o;
   o.maxIterations = 4;

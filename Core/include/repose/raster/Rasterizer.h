@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,9 @@ struct RasterReport {
   std::int64_t shellVoxels = 0;  // voxels written from the shell outside the outer faces
   int invertedTets = 0;  // deformed tets turned inside out (a fold): still written, in tet order
   int flatTets = 0;      // deformed tets of zero volume: nothing is inside them
+  // Out of core only: voxels per non-zero label of the written output, counted slab by slab so
+  // nobody has to read the file back.
+  std::map<int, std::int64_t> labelVoxels;
 };
 
 // Labels: each output voxel whose centre lies in a deformed tet (or its shell, see RasterOptions)
