@@ -3,6 +3,8 @@
 // an edge's line so the coordinates stay finite.
 #include "repose/cage/GreenCoordinates.h"
 
+#include "TriangleClosestPoint.h"
+
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 
@@ -54,29 +56,6 @@ double gcTriInt(const Eigen::Vector3d& p, const Eigen::Vector3d& v1, const Eigen
   const double I1 = integral(sinA, -cosA);
   const double I2 = integral(sinA * cosB + cosA * sinB, -(cosA * cosB - sinA * sinB));
   return -1 / (4 * kPi) * std::fabs(I1 - I2 - sqrtC * beta);
-}
-
-// Distance from p to triangle (a, b, c) (Ericson, Real-Time Collision Detection, 5.1.5).
-double pointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                             const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.norm();
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
-  const double denom = 1 / (va + vb + vc);
-  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
 }
 
 }  // namespace

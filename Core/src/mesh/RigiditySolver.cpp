@@ -355,4 +355,24 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
   return solver_.solve(greenPositions(deformedCage, precision), B);
 }
 
+Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
+                                         const HandleInfluence& influence,
+                                         const std::vector<RigidHandle>& handles,
+                                         std::vector<Eigen::Matrix3d>* B,
+                                         GreenPrecision precision) const {
+  Eigen::MatrixX3d targets = greenPositions(deformedCage, precision);
+  if (influence.group.size() != embedding_.inside.size())
+    throw Error("handle influence computed for another transfer mesh");
+  for (Eigen::Index r = 0; r < targets.rows(); ++r) {
+    const int v = embedding_.cageVertices[r], g = influence.group[v];
+    if (g < 0) continue;
+    if (g >= int(handles.size())) throw Error("handle influence names a group that is not given");
+    const Eigen::Vector3d rigid = handles[g].motion * Eigen::Vector3d(restPositions_.row(r));
+    const double w = influence.weight[v];
+    targets.row(r) = w == 1 ? rigid.transpose().eval()
+                            : (targets.row(r) + w * (rigid.transpose() - targets.row(r))).eval();
+  }
+  return solver_.solve(targets, B);
+}
+
 }  // namespace repose

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "repose/mesh/Embedding.h"
+#include "repose/mesh/RigidHandles.h"
 
 #include <Eigen/Core>
 #include <memory>
@@ -66,6 +67,14 @@ class CageDeformation {
                                   GreenPrecision precision = GreenPrecision::Exact) const;
   // deformedCage: #cage vertices by 3. Returns #V TM positions (and tet maps if B is given).
   Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage,
+                          std::vector<Eigen::Matrix3d>* B = nullptr,
+                          GreenPrecision precision = GreenPrecision::Exact) const;
+
+  // A frame whose handle groups moved rigidly (RigidHandles.h): the V_c vertices they dominate take
+  // their motions, blended with the Green positions where the domination is partial, then the
+  // rigidity solve. `influence` comes from computeHandleInfluence for this mesh, cage and list.
+  Eigen::MatrixX3d deform(const Eigen::MatrixX3d& deformedCage, const HandleInfluence& influence,
+                          const std::vector<RigidHandle>& handles,
                           std::vector<Eigen::Matrix3d>* B = nullptr,
                           GreenPrecision precision = GreenPrecision::Exact) const;
 

@@ -1,0 +1,57 @@
+// Tissue enclosed by a rigidly moved handle group moves with that group exactly.
+//
+// Green coordinates are not interior-local: a point of the forearm also "sees" the torso's cage
+// faces a few centimetres away across the gap beside the hip, so when only the forearm's cage
+// vertices turn about the elbow the forearm follows only part of the way, the wrist lags by
+// 2–4 cm and the bones bend (bench/forearm_bench.cpp measures it). Handle groups of a pose are
+// moved rigidly (pose files and the GUI's widgets give a rotation and a translation), so the
+// motion intended for the tissue a group encloses is known.
+//
+// Which tissue that is is decided through the body, not through space. A group that names body
+// parts (labels of S, which the TM's tets carry) owns exactly their tissue: a vertex's membership
+// is the share of its surrounding tet volume in those parts, so the transition sits on the part
+// boundary (the joint). A group of cage vertices only: each TM surface vertex takes the group
+// membership of the nearest point of the rest cage (barycentric over that face's vertices), and
+// the membership is extended harmonically into the TM (graph Laplacian over its edges), so the
+// body's own connectivity keeps the forearm apart from the hip it nearly touches; the transition
+// is then as wide as the cage faces that straddle the group's border. Where a group's membership is
+// at least kFull the vertex takes the group's rigid motion; between kNone and kFull its Green
+// position blends smoothly into the rigid one; below, Green coordinates alone. The seed's rigidity
+// solver then runs on these targets unchanged.
+#pragma once
+
+#include "repose/cage/TriangleMesh.h"
+#include "repose/mesh/TransferMesh.h"
+
+#include <Eigen/Geometry>
+#include <vector>
+
+namespace repose {
+
+struct RigidHandle {
+  std::vector<int> cageVertices;  // indices into the cage; a vertex belongs to one group at most
+  std::vector<int> parts;         // labels of S the group carries; empty: decided by the cage
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // rest RAS mm -> posed RAS mm
+};
+
+// Per TM vertex: the dominating group and the blend weight; computed once per handle set.
+struct HandleInfluence {
+  static constexpr double kNone = 0.35, kFull = 0.65;
+  std::vector<int> group;      // index into the handle list, or -1
+  std::vector<double> weight;  // 0 (Green coordinates) .. 1 (the group's rigid motion)
+  int rigidVertices() const;   // vertices with weight 1
+};
+
+// Throws repose::Error for a cage index out of range or a cage vertex in two groups.
+HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleMesh& cage,
+                                       const std::vector<RigidHandle>& handles, int threads = 0);
+
+// Blend weight of a membership: 0 below kNone, 1 above kFull, C1-smooth in between.
+double handleBlendWeight(double membership);
+
+// The rest cage with each group's vertices moved by its motion (the others stay): the cage a pose
+// of rigid groups gives before any free vertex is solved for.
+Eigen::MatrixX3d moveHandles(const Eigen::MatrixX3d& restCage,
+                             const std::vector<RigidHandle>& handles);
+
+}  // namespace repose

@@ -1,0 +1,170 @@
+#include "repose/mesh/RigidHandles.h"
+
+#include "TetAdjacency.h"
+#include "cage/TriangleClosestPoint.h"
+#include "numerics/SparseCholesky.h"
+#include "repose/util/Error.h"
+#include "repose/util/Parallel.h"
+
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <string>
+
+namespace repose {
+namespace {
+
+// Cage vertex -> group index (or -1), checking the handle list.
+std::vector<int> cageOwners(Eigen::Index cageVertices, const std::vector<RigidHandle>& handles) {
+  std::vector<int> owner(cageVertices, -1);
+  for (std::size_t g = 0; g < handles.size(); ++g)
+    for (const int v : handles[g].cageVertices) {
+      if (v < 0 || v >= cageVertices)
+        throw Error("handle group " + std::to_string(g) + ": cage vertex " + std::to_string(v) +
+                    " out of range (the cage has " + std::to_string(cageVertices) + ")");
+      if (owner[v] >= 0)
+        throw Error("cage vertex " + std::to_string(v) + " is in handle groups " +
+                    std::to_string(owner[v]) + " and " + std::to_string(g));
+      owner[v] = static_cast<int>(g);
+    }
+  return owner;
+}
+
+// Vertices on faces that belong to one tet only.
+std::vector<char> surfaceVertices(const TransferMesh& mesh) {
+  std::map<std::array<int, 3>, int> faces;
+  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    for (const auto& f : kFace) {
+      std::array<int, 3> key{mesh.tets(t, f[0]), mesh.tets(t, f[1]), mesh.tets(t, f[2])};
+      std::sort(key.begin(), key.end());
+      ++faces[key];
+    }
+  std::vector<char> surface(mesh.vertices.rows(), 0);
+  for (const auto& [key, count] : faces)
+    if (count == 1)
+      for (const int v : key) surface[v] = 1;
+  return surface;
+}
+
+}  // namespace
+
+int HandleInfluence::rigidVertices() const {
+  return int(std::count(weight.begin(), weight.end(), 1.0));
+}
+
+double handleBlendWeight(double membership) {
+  const double t = std::clamp(
+      (membership - HandleInfluence::kNone) / (HandleInfluence::kFull - HandleInfluence::kNone),
+      0.0, 1.0);
+  return t * t * (3 - 2 * t);
+}
+
+HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleMesh& cage,
+                                       const std::vector<RigidHandle>& handles, int threads) {
+  const std::vector<int> owner = cageOwners(cage.vertices.rows(), handles);
+  const Eigen::Index n = mesh.vertices.rows(), groups = Eigen::Index(handles.size());
+  HandleInfluence out;
+  out.group.assign(n, -1);
+  out.weight.assign(n, 0.0);
+  if (groups == 0 || n == 0) return out;
+
+  Eigen::MatrixXd membership = Eigen::MatrixXd::Zero(n, groups);
+  // Groups with body parts: the share of each vertex's surrounding tet volume in those parts.
+  std::vector<char> byParts(groups, 0);
+  {
+    Eigen::VectorXd around = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      const double volume = std::fabs(tetVolume(mesh.vertices, mesh.tets.row(t)));
+      for (int k = 0; k < 4; ++k) around[mesh.tets(t, k)] += volume;
+      for (Eigen::Index g = 0; g < groups; ++g) {
+        const auto& parts = handles[g].parts;
+        if (parts.empty()) continue;
+        byParts[g] = 1;
+        if (std::find(parts.begin(), parts.end(), mesh.labels[t]) != parts.end())
+          for (int k = 0; k < 4; ++k) membership(mesh.tets(t, k), g) += volume;
+      }
+    }
+    for (Eigen::Index v = 0; v < n; ++v)
+      if (around[v] > 0) membership.row(v) /= around[v];
+  }
+  const bool anyByCage = std::count(byParts.begin(), byParts.end(), 0) > 0;
+
+  // Other groups: membership of the nearest rest-cage point on the surface, extended inside.
+  const std::vector<char> surface =
+      anyByCage ? surfaceVertices(mesh) : std::vector<char>(std::size_t(n), 0);
+  if (anyByCage)
+    parallelFor(n, threads, [&](std::int64_t begin, std::int64_t end) {
+      for (std::int64_t v = begin; v < end; ++v) {
+        if (!surface[v]) continue;
+        const Eigen::Vector3d p = mesh.vertices.row(v);
+        double best = std::numeric_limits<double>::max();
+        Eigen::Index face = 0;
+        Eigen::Vector3d weights(1, 0, 0);
+        for (Eigen::Index f = 0; f < cage.faces.rows(); ++f) {
+          const Eigen::Vector3d a = cage.vertices.row(cage.faces(f, 0)),
+                                b = cage.vertices.row(cage.faces(f, 1)),
+                                c = cage.vertices.row(cage.faces(f, 2));
+          const Eigen::Vector3d w = closestPointWeights(p, a, b, c);
+          const double d = (p - (w.x() * a + w.y() * b + w.z() * c)).squaredNorm();
+          if (d < best) best = d, face = f, weights = w;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const int g = owner[cage.faces(face, k)];
+          if (g >= 0 && !byParts[g]) membership(v, g) += weights[k];
+        }
+      }
+    });
+
+  // Harmonic extension inside: L_II m_I = -L_IB m_B with unit edge weights.
+  std::vector<int> slot(n, -1);
+  int unknowns = 0;
+  for (Eigen::Index v = 0; v < n && anyByCage; ++v)
+    if (!surface[v]) slot[v] = unknowns++;
+  if (unknowns > 0) {
+    const TetAdjacency adjacency = TetAdjacency::build(mesh);
+    std::vector<Eigen::Triplet<double>> entries;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(unknowns, groups);
+    for (const auto& [i, j] : adjacency.edges)
+      for (const auto& [a, b] : {std::pair{i, j}, std::pair{j, i}}) {
+        if (slot[a] < 0) continue;
+        entries.emplace_back(slot[a], slot[a], 1.0);
+        if (slot[b] >= 0) {
+          if (slot[b] < slot[a]) entries.emplace_back(slot[a], slot[b], -1.0);  // lower triangle
+        } else {
+          rhs.row(slot[a]) += membership.row(b);
+        }
+      }
+    Eigen::SparseMatrix<double> L(unknowns, unknowns);
+    L.setFromTriplets(entries.begin(), entries.end());
+    SparseCholesky cholesky;
+    cholesky.factorize(L, "handle influence (a part of the transfer mesh has no surface)");
+    const Eigen::MatrixXd inside = cholesky.solve(rhs);
+    for (Eigen::Index v = 0; v < n; ++v)
+      if (slot[v] >= 0)
+        for (Eigen::Index g = 0; g < groups; ++g)
+          if (!byParts[g]) membership(v, g) = inside(slot[v], g);
+  }
+
+  for (Eigen::Index v = 0; v < n; ++v) {
+    Eigen::Index g = 0;
+    const double m = membership.row(v).maxCoeff(&g);
+    if (m > HandleInfluence::kNone) out.group[v] = int(g), out.weight[v] = handleBlendWeight(m);
+  }
+  return out;
+}
+
+Eigen::MatrixX3d moveHandles(const Eigen::MatrixX3d& restCage,
+                             const std::vector<RigidHandle>& handles) {
+  cageOwners(restCage.rows(), handles);  // validates
+  Eigen::MatrixX3d out = restCage;
+  for (const RigidHandle& h : handles)
+    for (const int v : h.cageVertices)
+      out.row(v) = (h.motion * Eigen::Vector3d(restCage.row(v))).transpose();
+  return out;
+}
+
+}  // namespace repose

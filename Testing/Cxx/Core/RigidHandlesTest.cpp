@@ -1,0 +1,125 @@
+// Handle influence (RigidHandles.h): tissue of a rigidly moved group follows it exactly, by body
+// parts or by the cage, with a smooth transition and checked inputs.
+#include "TestMeshes.h"
+#include "TestTetMeshes.h"
+
+#include "repose/mesh/RigidHandles.h"
+#include "repose/mesh/RigiditySolver.h"
+#include "repose/util/Error.h"
+
+#include <gtest/gtest.h>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+// A 100 x 20 x 20 mm bar of tets, label 2 for x > 50 and 1 below, inside a box cage.
+struct Bar {
+  TransferMesh mesh;
+  TriangleMesh cage;
+  Bar() {
+    mesh = tetBox({0, 0, 0}, {100, 20, 20}, {20, 4, 4});
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      double x = 0;
+      for (int k = 0; k < 4; ++k) x += mesh.vertices(mesh.tets(t, k), 0) / 4;
+      mesh.labels[t] = x > 50 ? 2 : 1;
+    }
+    cage = boxMesh({-5, -5, -5}, {105, 25, 25}, 6);
+  }
+  std::vector<int> cageVerticesBeyond(double x) const {
+    std::vector<int> out;
+    for (Eigen::Index v = 0; v < cage.vertices.rows(); ++v)
+      if (cage.vertices(v, 0) > x) out.push_back(int(v));
+    return out;
+  }
+};
+
+}  // namespace
+
+TEST(RigidHandles, BodyPartsOwnExactlyTheirTissueWithTheTransitionOnTheBorder) {
+  const Bar bar;
+  RigidHandle h;
+  h.parts = {2};
+  h.cageVertices = bar.cageVerticesBeyond(50);
+  const HandleInfluence inf = computeHandleInfluence(bar.mesh, bar.cage, {h});
+  double borderSum = 0;
+  int border = 0;
+  for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
+    const double x = bar.mesh.vertices(v, 0);
+    if (x > 50.1) {
+      EXPECT_EQ(inf.group[v], 0);
+      EXPECT_EQ(inf.weight[v], 1.0);
+    } else if (x < 49.9) {
+      EXPECT_EQ(inf.group[v], -1);
+      EXPECT_EQ(inf.weight[v], 0.0);
+    } else {  // on the border: the share of the surrounding volume in part 2
+      EXPECT_GE(inf.weight[v], 0.0);
+      EXPECT_LE(inf.weight[v], 1.0);
+      borderSum += inf.weight[v], ++border;
+    }
+  }
+  ASSERT_EQ(border, 5 * 5);
+  EXPECT_NEAR(borderSum / border, 0.5, 0.2);
+}
+
+TEST(RigidHandles, CageGroupsReachThroughTheBodyWithAWeightBetweenZeroAndOne) {
+  const Bar bar;
+  RigidHandle h;
+  h.cageVertices = bar.cageVerticesBeyond(60);
+  const HandleInfluence inf = computeHandleInfluence(bar.mesh, bar.cage, {h});
+  int rigid = 0, none = 0;
+  for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
+    const double x = bar.mesh.vertices(v, 0), w = inf.weight[v];
+    EXPECT_GE(w, 0.0);
+    EXPECT_LE(w, 1.0);
+    if (x >= 90) EXPECT_EQ(w, 1.0) << x;
+    if (x <= 30) EXPECT_EQ(inf.group[v], -1) << x;
+    rigid += w == 1.0, none += inf.group[v] < 0;
+  }
+  EXPECT_EQ(rigid, inf.rigidVertices());
+  EXPECT_GT(none, 0);
+}
+
+TEST(RigidHandles, DominatedTissueMovesExactlyWhereGreenCoordinatesLag) {
+  const Bar bar;
+  RigidHandle h;
+  h.parts = {2};
+  h.cageVertices = bar.cageVerticesBeyond(50);
+  h.motion = Eigen::Translation3d(0, 0, 30) * Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX());
+  const std::vector<RigidHandle> handles{h};
+  const Eigen::MatrixX3d cage = moveHandles(bar.cage.vertices, handles);
+  for (Eigen::Index v = 0; v < cage.rows(); ++v) {
+    const bool moved = bar.cage.vertices(v, 0) > 50;
+    const Eigen::Vector3d rest = bar.cage.vertices.row(v), want = moved ? h.motion * rest : rest;
+    EXPECT_LT((Eigen::Vector3d(cage.row(v)) - want).norm(), 1e-12);
+  }
+  const CageDeformation deformation(bar.mesh, bar.cage);
+  const HandleInfluence inf = computeHandleInfluence(bar.mesh, bar.cage, handles);
+  const Eigen::MatrixX3d green = deformation.deform(cage),
+                         ours = deformation.deform(cage, inf, handles);
+  double greenWorst = 0;
+  for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
+    if (inf.weight[v] < 1) continue;
+    const Eigen::Vector3d want = h.motion * Eigen::Vector3d(bar.mesh.vertices.row(v));
+    EXPECT_LT((Eigen::Vector3d(ours.row(v)) - want).norm(), 1e-6);
+    greenWorst = std::max(greenWorst, (Eigen::Vector3d(green.row(v)) - want).norm());
+  }
+  EXPECT_GT(greenWorst, 1.0);  // what the influence corrects
+  for (Eigen::Index v = 0; v < ours.rows(); ++v) EXPECT_TRUE(ours.row(v).allFinite());
+}
+
+TEST(RigidHandles, RefusesBadHandleLists) {
+  const Bar bar;
+  RigidHandle a, b;
+  a.cageVertices = {0, 1};
+  b.cageVertices = {1, 2};
+  EXPECT_THROW(computeHandleInfluence(bar.mesh, bar.cage, {a, b}), Error);  // vertex 1 twice
+  b.cageVertices = {int(bar.cage.vertices.rows())};
+  EXPECT_THROW(computeHandleInfluence(bar.mesh, bar.cage, {a, b}), Error);  // out of range
+  EXPECT_THROW(moveHandles(bar.cage.vertices, {a, b}), Error);
+  const CageDeformation deformation(bar.mesh, bar.cage);
+  HandleInfluence wrongSize;
+  EXPECT_THROW(deformation.deform(bar.cage.vertices, wrongSize, {a}), Error);
+  EXPECT_NO_THROW(computeHandleInfluence(bar.mesh, bar.cage, {}));
+}
