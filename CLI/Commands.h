@@ -15,6 +15,7 @@ int runPhantom(const Args& args);
 int runCage(const Args& args);
 int runMesh(const Args& args);
 int runWarp(const Args& args);
+int runPose(const Args& args);
 
 struct Command {
   const char* name;
@@ -31,6 +32,7 @@ inline const Command kCommands[] = {
     {"cage", "build the control cage around the body (optionally separating two parts)", runCage},
     {"mesh", "build the transfer mesh and embed it in the cage", runMesh},
     {"warp", "pose a label map (and image) at full resolution from a posed cage", runWarp},
+    {"pose", "the whole job: label maps + pose file -> posed maps, transform, report", runPose},
 };
 
 }  // namespace repose::cli

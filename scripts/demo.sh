@@ -1,29 +1,50 @@
 #!/usr/bin/env bash
-# `make demo`: the main job on a generated phantom. For now (issue 2) it generates the 2 mm
-# phantom, describes it, converts it to a Slicer segmentation, builds its cage and its transfer
-# mesh; posing comes with later issues.
+# `make demo`: the main job on generated phantoms. Generates the 2 mm phantom (and its
+# arms-touching variant), runs the standard pose suite of bench/poses/ with `repose pose`
+# (the cage and transfer mesh are built once per phantom and reused through a scene folder),
+# plots each report, and prints where everything is and which quality targets were met.
 set -euo pipefail
 BUILD_DIR=${1:-build}
 DEMO_DIR=${2:-$BUILD_DIR/demo}
 REPOSE="$BUILD_DIR/bin/repose"
+POSES="$(dirname "$0")/../bench/poses"
 
-mkdir -p "$DEMO_DIR"
+mkdir -p "$DEMO_DIR/poses"
 echo "== generating the 2 mm phantom in $DEMO_DIR/phantom"
 "$REPOSE" phantom --voxel 2 --out "$DEMO_DIR/phantom"
+"$REPOSE" info "$DEMO_DIR/phantom/G.nii.gz" | head -8
 echo
-echo "== organ map G"
-"$REPOSE" info "$DEMO_DIR/phantom/G.nii.gz"
+echo "== generating the arms-touching 2 mm phantom in $DEMO_DIR/phantom_touching"
+"$REPOSE" phantom --voxel 2 --arms-touching --out "$DEMO_DIR/phantom_touching"
+
+run_pose() {  # phantom-folder pose-name
+  echo
+  echo "== pose $2 on $1"
+  "$REPOSE" pose --input "$DEMO_DIR/$1/G.nii.gz" --parts "$DEMO_DIR/$1/S.nii.gz" \
+    --pose "$POSES/$2.pose.json" --scene "$DEMO_DIR/$1/scene" --out "$DEMO_DIR/poses/$2"
+}
+for pose in elbow90 arm_raise90 leg_step30 walk; do run_pose phantom "$pose"; done
+run_pose phantom_touching hand_from_hip
+
 echo
-echo "== body-part map S"
-"$REPOSE" info "$DEMO_DIR/phantom/S.nii.gz"
+echo "== plots"
+find "$DEMO_DIR/poses" -name report.json | sort | xargs /usr/bin/python3 "$(dirname "$0")/plot-report.py" | sed 's/^/  /'
+
 echo
-echo "== G as a 3D Slicer segmentation"
-"$REPOSE" convert "$DEMO_DIR/phantom/G.nii.gz" "$DEMO_DIR/phantom/G.seg.nrrd"
+echo "== quality targets (docs/QUALITY.md)"
+/usr/bin/python3 - "$DEMO_DIR/poses" <<'PY'
+import json, pathlib, sys
+rows = []
+for p in sorted(pathlib.Path(sys.argv[1]).rglob("report.json")):
+    r = json.load(open(p)); q = r["quality"]
+    rows.append((f"{r['pose']}/{r['frame']}", r["body"]["volume_change_percent"],
+                 q["labels_within_1_percent"]["worst_change_percent"],
+                 q.get("bones_rigid", {}).get("min_dice", float("nan")),
+                 q["no_new_holes"]["new_enclosed_voxels"], r["mesh"]["inverted_tets"], q["all_met"]))
+print(f"  {'frame':28} {'body %':>8} {'worst label %':>14} {'bones Dice':>10} {'new holes':>9} {'inverted':>8}  all met")
+for f, b, w, d, h, i, a in rows:
+    print(f"  {f:28} {b:8.3f} {w:14.3f} {d:10.3f} {h:9d} {i:8d}  {'yes' if a else 'no'}")
+PY
 echo
-echo "== the control cage (300 vertices, 10 mm dilation)"
-"$REPOSE" cage --parts "$DEMO_DIR/phantom/S.nii.gz" --out "$DEMO_DIR/phantom/cage.vtk" --vertices 300
-echo
-echo "== the transfer mesh, embedded in the cage"
-"$REPOSE" mesh --parts "$DEMO_DIR/phantom/S.nii.gz" --cage "$DEMO_DIR/phantom/cage.vtk" --out "$DEMO_DIR/phantom/tm.vtu"
-echo
-echo "Demo outputs are in $DEMO_DIR/phantom: G and S (.nii.gz), skeleton.json, G.seg.nrrd, cage.vtk, tm.vtu."
+echo "Demo outputs are in $DEMO_DIR: phantom*/ (G, S, skeleton, scene/ with cage.vtk and tm.vtu),"
+echo "poses/<pose>[/<frame>]/ (posed_G.nii.gz, posed_S.nii.gz, transform.nrrd, report.json, *.png)."

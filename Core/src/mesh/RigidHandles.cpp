@@ -53,7 +53,43 @@ std::vector<char> surfaceVertices(const TransferMesh& mesh) {
 }  // namespace
 
 int HandleInfluence::rigidVertices() const {
-  return int(std::count(weight.begin(), weight.end(), 1.0));
+  int n = 0;
+  for (Eigen::Index v = 0; v < membership.rows(); ++v)
+    n += membership.cols() > 0 && membership.row(v).maxCoeff() >= 1.0;
+  return n;
+}
+
+int HandleInfluence::dominantGroup(Eigen::Index vertex) const {
+  if (membership.cols() == 0) return -1;
+  Eigen::Index g = 0;
+  return membership.row(vertex).maxCoeff(&g) > 0 ? int(g) : -1;
+}
+
+Eigen::Isometry3d blendMotions(const Eigen::Ref<const Eigen::VectorXd>& weights,
+                               const std::vector<RigidHandle>& handles) {
+  // Unit dual quaternions q = r + e d with d = t r / 2, summed in r's hemisphere of the
+  // heaviest group, normalized (Kavan et al. 2008).
+  Eigen::Index heaviest = 0;
+  const double total = weights.maxCoeff(&heaviest) > 0 ? weights.sum() : 0;
+  if (total <= 0) return Eigen::Isometry3d::Identity();
+  const Eigen::Quaterniond pivot(handles[heaviest].motion.rotation());
+  Eigen::Vector4d real = Eigen::Vector4d::Zero(), dual = Eigen::Vector4d::Zero();
+  for (Eigen::Index g = 0; g < weights.size(); ++g) {
+    if (weights[g] <= 0) continue;
+    const Eigen::Quaterniond r(handles[g].motion.rotation());
+    const Eigen::Vector3d t = handles[g].motion.translation();
+    const double sign = r.coeffs().dot(pivot.coeffs()) < 0 ? -1.0 : 1.0;
+    const Eigen::Quaterniond d = Eigen::Quaterniond(0, t.x(), t.y(), t.z()) * r;
+    real += sign * weights[g] * r.coeffs();
+    dual += sign * weights[g] * 0.5 * d.coeffs();
+  }
+  const double norm = real.norm();
+  const Eigen::Quaterniond r(real / norm), d(dual / norm);
+  const Eigen::Quaterniond t = d * r.conjugate();  // = (0, t/2)
+  Eigen::Isometry3d out = Eigen::Isometry3d::Identity();
+  out.linear() = r.toRotationMatrix();
+  out.translation() = 2 * t.vec();
+  return out;
 }
 
 double handleBlendWeight(double membership) {
@@ -68,7 +104,7 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
   const std::vector<int> owner = cageOwners(cage.vertices.rows(), handles);
   const Eigen::Index n = mesh.vertices.rows(), groups = Eigen::Index(handles.size());
   HandleInfluence out;
-  out.group.assign(n, -1);
+  out.membership = Eigen::MatrixXd::Zero(n, groups);
   out.weight.assign(n, 0.0);
   if (groups == 0 || n == 0) return out;
 
@@ -149,11 +185,17 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
           if (!byParts[g]) membership(v, g) = inside(slot[v], g);
   }
 
+  // Memberships in [0, 1] summing to at most 1 (a part named by two groups counts once).
   for (Eigen::Index v = 0; v < n; ++v) {
-    Eigen::Index g = 0;
-    const double m = membership.row(v).maxCoeff(&g);
-    if (m > HandleInfluence::kNone) out.group[v] = int(g), out.weight[v] = handleBlendWeight(m);
+    auto row = membership.row(v);
+    row = row.cwiseMax(0.0).cwiseMin(1.0);
+    const double sum = row.sum();
+    if (sum > 1) row /= sum;
+    for (Eigen::Index g = 0; g < groups; ++g)
+      if (row[g] > 1 - 1e-9) row.setZero(), row[g] = 1;  // carried by one group alone: exactly
+    out.weight[v] = handleBlendWeight(std::min(1.0, sum));
   }
+  out.membership = membership;
   return out;
 }
 

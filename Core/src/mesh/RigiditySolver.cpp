@@ -361,16 +361,18 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
                                          std::vector<Eigen::Matrix3d>* B,
                                          GreenPrecision precision) const {
   Eigen::MatrixX3d targets = greenPositions(deformedCage, precision);
-  if (influence.group.size() != embedding_.inside.size())
+  if (influence.membership.rows() != Eigen::Index(embedding_.inside.size()))
     throw Error("handle influence computed for another transfer mesh");
+  if (influence.membership.cols() != Eigen::Index(handles.size()))
+    throw Error("handle influence computed for another list of handle groups");
   for (Eigen::Index r = 0; r < targets.rows(); ++r) {
-    const int v = embedding_.cageVertices[r], g = influence.group[v];
-    if (g < 0) continue;
-    if (g >= int(handles.size())) throw Error("handle influence names a group that is not given");
-    const Eigen::Vector3d rigid = handles[g].motion * Eigen::Vector3d(restPositions_.row(r));
+    const int v = embedding_.cageVertices[r];
     const double w = influence.weight[v];
-    targets.row(r) = w == 1 ? rigid.transpose().eval()
-                            : (targets.row(r) + w * (rigid.transpose() - targets.row(r))).eval();
+    if (w <= 0) continue;
+    const Eigen::Vector3d carried = blendMotions(influence.membership.row(v).transpose(), handles) *
+                                    Eigen::Vector3d(restPositions_.row(r));
+    targets.row(r) = w == 1 ? carried.transpose().eval()
+                            : (targets.row(r) + w * (carried.transpose() - targets.row(r))).eval();
   }
   return solver_.solve(targets, B);
 }

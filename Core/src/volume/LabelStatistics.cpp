@@ -33,4 +33,41 @@ std::vector<LabelCount> countLabels(const Volume& volume) {
   return out;
 }
 
+std::int64_t countEnclosedBackground(const Volume& volume) {
+  if (!isIntegerType(volume.scalarType()))
+    throw Error("holes are counted on label maps, not on float volumes");
+  const auto d = volume.dims();
+  const std::int64_t n = d[0] * d[1] * d[2];
+  std::vector<char> reached(n, 0);
+  std::vector<std::int64_t> stack;
+  std::int64_t background = 0;
+  dispatchScalar(volume.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const T* v = volume.data<T>();  // layer 0 comes first
+    auto push = [&](std::int64_t i) {
+      if (v[i] == 0 && !reached[i]) reached[i] = 1, stack.push_back(i);
+    };
+    for (std::int64_t i = 0; i < n; ++i) background += v[i] == 0;
+    for (std::int64_t k = 0; k < d[2]; ++k)
+      for (std::int64_t j = 0; j < d[1]; ++j)
+        for (std::int64_t i = 0; i < d[0]; ++i)
+          if (i == 0 || j == 0 || k == 0 || i == d[0] - 1 || j == d[1] - 1 || k == d[2] - 1)
+            push(i + d[0] * (j + d[1] * k));
+    while (!stack.empty()) {
+      const std::int64_t c = stack.back();
+      stack.pop_back();
+      const std::int64_t i = c % d[0], j = (c / d[0]) % d[1], k = c / (d[0] * d[1]);
+      if (i > 0) push(c - 1);
+      if (i + 1 < d[0]) push(c + 1);
+      if (j > 0) push(c - d[0]);
+      if (j + 1 < d[1]) push(c + d[0]);
+      if (k > 0) push(c - d[0] * d[1]);
+      if (k + 1 < d[2]) push(c + d[0] * d[1]);
+    }
+  });
+  std::int64_t outside = 0;
+  for (const char r : reached) outside += r;
+  return background - outside;
+}
+
 }  // namespace repose

@@ -46,17 +46,19 @@ TEST(RigidHandles, BodyPartsOwnExactlyTheirTissueWithTheTransitionOnTheBorder) {
   double borderSum = 0;
   int border = 0;
   for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
-    const double x = bar.mesh.vertices(v, 0);
+    const double x = bar.mesh.vertices(v, 0), m = inf.membership(v, 0);
     if (x > 50.1) {
-      EXPECT_EQ(inf.group[v], 0);
+      EXPECT_EQ(m, 1.0);
       EXPECT_EQ(inf.weight[v], 1.0);
+      EXPECT_EQ(inf.dominantGroup(v), 0);
     } else if (x < 49.9) {
-      EXPECT_EQ(inf.group[v], -1);
+      EXPECT_EQ(m, 0.0);
       EXPECT_EQ(inf.weight[v], 0.0);
+      EXPECT_EQ(inf.dominantGroup(v), -1);
     } else {  // on the border: the share of the surrounding volume in part 2
-      EXPECT_GE(inf.weight[v], 0.0);
-      EXPECT_LE(inf.weight[v], 1.0);
-      borderSum += inf.weight[v], ++border;
+      EXPECT_GE(m, 0.0);
+      EXPECT_LE(m, 1.0);
+      borderSum += m, ++border;
     }
   }
   ASSERT_EQ(border, 5 * 5);
@@ -70,15 +72,43 @@ TEST(RigidHandles, CageGroupsReachThroughTheBodyWithAWeightBetweenZeroAndOne) {
   const HandleInfluence inf = computeHandleInfluence(bar.mesh, bar.cage, {h});
   int rigid = 0, none = 0;
   for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
-    const double x = bar.mesh.vertices(v, 0), w = inf.weight[v];
-    EXPECT_GE(w, 0.0);
-    EXPECT_LE(w, 1.0);
+    const double x = bar.mesh.vertices(v, 0), m = inf.membership(v, 0), w = inf.weight[v];
+    EXPECT_GE(m, 0.0);
+    EXPECT_LE(m, 1.0);
+    EXPECT_EQ(w, handleBlendWeight(m));
     if (x >= 90) EXPECT_EQ(w, 1.0) << x;
-    if (x <= 30) EXPECT_EQ(inf.group[v], -1) << x;
-    rigid += w == 1.0, none += inf.group[v] < 0;
+    if (x <= 30) EXPECT_EQ(w, 0.0) << x;
+    rigid += m == 1.0, none += w == 0.0;
+    if (x >= 95) EXPECT_GT(m, 0.9) << x;
   }
   EXPECT_EQ(rigid, inf.rigidVertices());
   EXPECT_GT(none, 0);
+}
+
+// Across a joint the blend of a fixed group and a turned one is a partial turn about the joint.
+TEST(RigidHandles, BlendedMotionsTurnAboutTheSameJoint) {
+  RigidHandle fixed, turned;
+  const Eigen::Vector3d joint(10, -20, 30);
+  turned.motion = Eigen::Translation3d(joint) *
+                  Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d(0, 1, 1).normalized()) *
+                  Eigen::Translation3d(-joint);
+  const std::vector<RigidHandle> handles{fixed, turned};
+  const Eigen::Vector3d axis = Eigen::Vector3d(0, 1, 1).normalized();
+  double previous = -1;
+  for (const double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const Eigen::Isometry3d m = blendMotions(Eigen::Vector2d(1 - t, t), handles);
+    // A rotation about the same axis through the joint (normalized linear blending keeps the
+    // screw; the angle is t * 90 degrees exactly at 0, 1/2 and 1 and grows with t).
+    EXPECT_LT((m * joint - joint).norm(), 1e-12) << t;
+    const Eigen::AngleAxisd turn(m.linear());
+    const double angle = turn.angle() * (turn.axis().dot(axis) < 0 ? -1 : 1);
+    if (angle != 0) EXPECT_LT((turn.axis().cwiseAbs() - axis.cwiseAbs()).norm(), 1e-9) << t;
+    if (t == 0 || t == 0.5 || t == 1) EXPECT_NEAR(angle, t * M_PI / 2, 1e-12) << t;
+    EXPECT_GT(angle, previous);
+    previous = angle;
+  }
+  EXPECT_TRUE(blendMotions(Eigen::Vector2d(0, 0), handles).isApprox(Eigen::Isometry3d::Identity()));
+  EXPECT_TRUE(blendMotions(Eigen::Vector2d(0, 3), handles).isApprox(turned.motion, 1e-12));
 }
 
 TEST(RigidHandles, DominatedTissueMovesExactlyWhereGreenCoordinatesLag) {
@@ -100,7 +130,7 @@ TEST(RigidHandles, DominatedTissueMovesExactlyWhereGreenCoordinatesLag) {
                          ours = deformation.deform(cage, inf, handles);
   double greenWorst = 0;
   for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
-    if (inf.weight[v] < 1) continue;
+    if (inf.membership(v, 0) < 1) continue;
     const Eigen::Vector3d want = h.motion * Eigen::Vector3d(bar.mesh.vertices.row(v));
     EXPECT_LT((Eigen::Vector3d(ours.row(v)) - want).norm(), 1e-6);
     greenWorst = std::max(greenWorst, (Eigen::Vector3d(green.row(v)) - want).norm());
@@ -121,5 +151,7 @@ TEST(RigidHandles, RefusesBadHandleLists) {
   const CageDeformation deformation(bar.mesh, bar.cage);
   HandleInfluence wrongSize;
   EXPECT_THROW(deformation.deform(bar.cage.vertices, wrongSize, {a}), Error);
+  const HandleInfluence forA = computeHandleInfluence(bar.mesh, bar.cage, {a});
+  EXPECT_THROW(deformation.deform(bar.cage.vertices, forA, {a, a}), Error);  // other list
   EXPECT_NO_THROW(computeHandleInfluence(bar.mesh, bar.cage, {}));
 }

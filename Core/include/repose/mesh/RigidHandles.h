@@ -34,19 +34,28 @@ struct RigidHandle {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // rest RAS mm -> posed RAS mm
 };
 
-// Per TM vertex: the dominating group and the blend weight; computed once per handle set.
+// Per TM vertex, computed once per handle set: how much each group carries it, and how much the
+// groups' motions (against its Green position) decide where it goes.
 struct HandleInfluence {
   static constexpr double kNone = 0.35, kFull = 0.65;
-  std::vector<int> group;      // index into the handle list, or -1
-  std::vector<double> weight;  // 0 (Green coordinates) .. 1 (the group's rigid motion)
-  int rigidVertices() const;   // vertices with weight 1
+  Eigen::MatrixXd membership;  // #V by #groups, each in [0, 1], each row summing to at most 1
+  std::vector<double> weight;  // smoothstep of the row sum: 0 (Green) .. 1 (the groups' motion)
+  int rigidVertices() const;   // vertices one group carries alone (membership 1)
+  int dominantGroup(Eigen::Index vertex) const;  // the largest membership, -1 if none
 };
+
+// The motion of a vertex carried by several groups: the dual-quaternion blend of their motions
+// with these weights (normalized). Between a fixed group and one turned about a joint it is the
+// turn by the weighted share of the angle about the same joint, so a joint bends instead of
+// shrinking as a blend of positions would.
+Eigen::Isometry3d blendMotions(const Eigen::Ref<const Eigen::VectorXd>& weights,
+                               const std::vector<RigidHandle>& handles);
 
 // Throws repose::Error for a cage index out of range or a cage vertex in two groups.
 HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleMesh& cage,
                                        const std::vector<RigidHandle>& handles, int threads = 0);
 
-// Blend weight of a membership: 0 below kNone, 1 above kFull, C1-smooth in between.
+// Blend weight of a total membership: 0 below kNone, 1 above kFull, C1-smooth in between.
 double handleBlendWeight(double membership);
 
 // The rest cage with each group's vertices moved by its motion (the others stay): the cage a pose

@@ -1,0 +1,280 @@
+// `repose pose --input G --parts S --pose P.pose.json --out DIR`: the whole job. Builds the cage
+// and transfer mesh (with the separations the pose asks for) or reuses them from a scene folder,
+// then for each frame of the pose (one, or one per keyframe): poses the cage (handle groups
+// rigidly, free vertices by ARAP), deforms the mesh (Green coordinates, the handles' influence,
+// the rigidity solver), rasterizes G, S (and the image) at full resolution, exports the
+// displacement field and writes report.json with the quality checks of docs/QUALITY.md.
+#include "ArgParser.h"
+#include "Commands.h"
+#include "MemoryBudget.h"
+#include "PoseReport.h"
+#include "TerminalProgress.h"
+
+#include "repose/io/AtomicOutput.h"
+#include "repose/io/MeshIO.h"
+#include "repose/io/NrrdIO.h"
+#include "repose/io/VolumeIO.h"
+#include "repose/mesh/RigiditySolver.h"
+#include "repose/pose/Pose.h"
+#include "repose/raster/Rasterizer.h"
+#include "repose/util/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace repose::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+void writeJsonAtomically(const json& j, const std::string& path) {
+  AtomicOutput out(path);
+  {
+    std::ofstream f(out.tempPath());
+    f << j.dump(2) << "\n";
+    if (!f.flush()) throw Error(path + ": cannot write");
+  }
+  out.commit();
+}
+
+// The default tissue table applies only to the phantom: every label of G must carry its name.
+std::optional<TissueTable> defaultTissues(const Volume& organs) {
+  const std::string path = std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
+  if (!fs::exists(path)) return std::nullopt;
+  TissueTable t = readTissueTable(path);
+  for (const Label& l : organs.labels().labels()) {
+    const auto it = t.find(l.value);
+    if (it == t.end() || it->second.name != l.name) return std::nullopt;
+  }
+  return t;
+}
+
+// What a scene folder holds: the cage and transfer mesh built once for S with these settings.
+json sceneKey(const std::string& partsPath, const Pose& pose, const CageOptions& co,
+              double meshMm) {
+  json separations = json::parse(poseToJson(pose)).value("separations", json::array());
+  return {{"parts", fs::absolute(partsPath).string()},
+          {"parts_bytes", fs::file_size(partsPath)},
+          {"parts_mtime", fs::last_write_time(partsPath).time_since_epoch().count()},
+          {"cage_vertices", co.targetVertices},
+          {"dilate_mm", co.dilateMm},
+          {"mesh_size_mm", meshMm},
+          {"separations", separations}};
+}
+
+}  // namespace
+
+int runPose(const Args& args) {
+  ArgParser p("pose",
+              "The whole job: pose a label map G (with its body-part map S, and an image) by a\n"
+              "pose file. Writes, per frame (one, or one per keyframe, in DIR/<frame>/):\n"
+              "posed_G.nii.gz, posed_S.nii.gz, posed_image.nii.gz (with --image),\n"
+              "transform.nrrd (displacement field, LPS, output->input) and report.json.");
+  p.option("input", "FILE", "label map G (NIfTI, NRRD, .seg.nrrd)")
+      .option("parts", "FILE", "body-part map S on G's grid (the cage and mesh follow it)")
+      .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
+      .option("background", "VALUE", "image value where no tissue is (with --image)", "0")
+      .option("pose", "FILE", "pose file (*.pose.json, docs/POSES.md)")
+      .option("out", "DIR", "output folder (created if missing; its parent must exist)")
+      .option("scene", "DIR",
+              "reuse the cage and mesh saved here when they match S and the settings, else "
+              "build them and save them here")
+      .option("tissues", "CSV",
+              "label,name,density_kg_m3,rigid (default: the phantom's table when G's labels "
+              "are the phantom's)")
+      .option("cage-vertices", "N", "cage size", "300")
+      .option("dilate-mm", "MM", "cage distance from the body", "10")
+      .option("mesh-mm", "MM", "transfer-mesh tet size (0: 5% of S's diagonal)", "0")
+      .option("threads", "N", "worker threads (0: all cores)", "0")
+      .flag("json", "print the frames' reports as JSON on stdout");
+  declareMemoryOption(p, "a pose that would need more is refused before the work");
+  if (!p.parse(args)) return 0;
+  for (const char* required : {"input", "parts", "pose", "out"})
+    if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
+  const auto start = std::chrono::steady_clock::now();
+  const bool quiet = p.has("json");
+  auto say = [&](const std::string& text) {
+    if (!quiet) std::cout << text << std::endl;
+  };
+
+  // Everything that can be refused is checked before the work.
+  const Pose pose = readPoseFile(p.get("pose"));
+  const std::string outDir = p.get("out");
+  for (const char* in : {"input", "parts", "image", "pose"})
+    if (p.has(in) && fs::exists(p.get(in)) && fs::exists(outDir) &&
+        fs::equivalent(p.get(in), outDir))
+      throw UsageError{"--out names an input"};
+  if (!fs::exists(fs::absolute(outDir).parent_path()))
+    throw Error(outDir + ": its parent folder does not exist");
+  const double budget = parseMemoryBudget(p.get("memory"));
+  const int threads = static_cast<int>(p.getInt("threads"));
+  CageOptions co;
+  co.targetVertices = static_cast<int>(p.getInt("cage-vertices"));
+  co.dilateMm = p.getDouble("dilate-mm");
+  co.threads = threads;
+  const double meshMm = p.getDouble("mesh-mm");
+  if (meshMm < 0) throw UsageError{"--mesh-mm must be >= 0"};
+
+  const Volume organs = readVolume(p.get("input"));
+  const Volume parts = readVolume(p.get("parts"));
+  if (!isIntegerType(organs.scalarType()))
+    throw Error(p.get("input") + ": not a label map (float voxels); pose images with --image");
+  if (parts.dims() != organs.dims() ||
+      !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
+    throw Error(p.get("parts") + ": not on the grid of " + p.get("input"));
+  std::optional<Volume> image;
+  if (p.has("image")) {
+    image = readVolume(p.get("image"));
+    if (image->dims() != organs.dims())
+      throw Error(p.get("image") + ": not on the grid of " + p.get("input"));
+  }
+  std::optional<TissueTable> tissues;
+  if (p.has("tissues"))
+    tissues = readTissueTable(p.get("tissues"));
+  else
+    tissues = defaultTissues(organs);
+
+  // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
+  co.separations = resolveSeparations(pose, parts.labels());
+  const json key = sceneKey(p.get("parts"), pose, co, meshMm);
+  TriangleMesh cage;
+  TransferMesh mesh;
+  bool reused = false;
+  if (p.has("scene")) {
+    const fs::path scene = p.get("scene");
+    std::ifstream f(scene / "scene.json");
+    if (f) {
+      const json saved = json::parse(f, nullptr, false);
+      if (!saved.is_discarded() && saved.value("built_for", json()) == key) {
+        cage = readTriangleMesh((scene / saved["cage"].get<std::string>()).string());
+        mesh = readTransferMesh((scene / saved["transfer_mesh"].get<std::string>()).string());
+        reused = true;
+        say("reusing the cage and transfer mesh of " + scene.string());
+      }
+    }
+  }
+  if (!reused) {
+    say("building the cage (" + std::to_string(co.targetVertices) + " vertices)");
+    co.progress = quiet ? ProgressFn{} : terminalProgress();
+    cage = buildCage(parts, co).mesh;
+    say("building the transfer mesh");
+    TransferMeshOptions to;
+    to.sizeMm = meshMm;
+    to.progress = quiet ? ProgressFn{} : terminalProgress();
+    mesh = buildTransferMesh(parts, to);
+    for (const LimbSeparation& s : co.separations)
+      separateLabels(mesh, s.labelA, s.labelB, s.region);
+    if (p.has("scene")) {
+      const fs::path scene = p.get("scene");
+      fs::create_directories(scene);
+      writeTriangleMesh(cage, (scene / "cage.vtk").string());
+      writeTransferMesh(mesh, (scene / "tm.vtu").string());
+      writeJsonAtomically({{"format", "repose-scene"},
+                           {"version", 1},
+                           {"cage", "cage.vtk"},
+                           {"transfer_mesh", "tm.vtu"},
+                           {"built_for", key}},
+                          (scene / "scene.json").string());
+    }
+  }
+  say("embedding the mesh in the cage");
+  const CageDeformation deformation(mesh, cage, threads);
+  std::vector<RigidHandle> handles = resolveHandles(pose, cage, mesh, parts.labels());
+  const HandleInfluence influence = computeHandleInfluence(mesh, cage, handles, threads);
+  std::vector<std::string> groupNames;
+  for (const PoseGroup& g : pose.groups) groupNames.push_back(g.name);
+
+  const auto frames = pose.frames();
+  const bool oneFrame = frames.size() == 1;
+  fs::create_directories(outDir);
+  json summary = json::array();
+  for (const auto& [frameName, motions] : frames) {
+    setMotions(handles, motions);
+    const Eigen::MatrixX3d posedCage = poseCage(cage, handles);
+    std::vector<Eigen::Matrix3d> B;
+    const Eigen::MatrixX3d deformed = deformation.deform(posedCage, influence, handles, &B);
+    const VolumeGeometry grid = deformedGrid(organs.geometry(), deformed);
+    // Memory: the posed G and S, the image and the field (3 floats per voxel) beside the inputs.
+    const double outVoxels = double(grid.numVoxels());
+    const double need = outVoxels * (double(scalarSize(organs.scalarType())) +
+                                     double(scalarSize(parts.scalarType())) + 12 +
+                                     (image ? double(scalarSize(image->scalarType())) : 0));
+    if (peakResidentBytes() + need > budget)
+      throw Error(outDir + ": frame " + frameName + " needs " + gib(need) + " for " +
+                  std::to_string(grid.numVoxels()) + " output voxels beyond the " +
+                  gib(peakResidentBytes()) + " in use, more than the budget of " + gib(budget) +
+                  " (out-of-core posing: `repose warp`)");
+    const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
+    fs::create_directories(dir);
+    say("frame " + frameName + ": " + std::to_string(grid.dims[0]) + " x " +
+        std::to_string(grid.dims[1]) + " x " + std::to_string(grid.dims[2]) + " voxels");
+    RasterOptions ro;
+    ro.threads = threads;
+    ro.progress = quiet ? ProgressFn{} : terminalProgress();
+    const std::vector<std::uint8_t> outer = outerFaces(mesh);
+    ro.outerFaces = &outer;
+    RasterReport raster;
+    const Volume posedOrgans = rasterizeLabels(organs, mesh, deformed, grid, ro, &raster);
+    ro.progress = {};
+    const Volume posedParts = rasterizeLabels(parts, mesh, deformed, grid, ro);
+    writeVolume(posedOrgans, (dir / "posed_G.nii.gz").string());
+    writeVolume(posedParts, (dir / "posed_S.nii.gz").string());
+    if (image)
+      writeVolume(rasterizeImage(*image, mesh, deformed, grid, p.getDouble("background"), ro),
+                  (dir / "posed_image.nii.gz").string());
+    writeDisplacementFieldNrrd(rasterizeDisplacement(mesh, deformed, organs.geometry(), grid, ro),
+                               grid, (dir / "transform.nrrd").string());
+
+    PoseReportInput ri;
+    ri.organs = &organs, ri.parts = &parts;
+    ri.posedOrgans = &posedOrgans, ri.posedParts = &posedParts;
+    ri.mesh = &mesh, ri.tetMaps = &B, ri.handles = &handles, ri.groupNames = groupNames;
+    ri.tissues = tissues ? &*tissues : nullptr;
+    ri.outlierVertices = deformation.embedding().outliers();
+    ri.rigidVertices = influence.rigidVertices();
+    json report = {{"pose", pose.name},
+                   {"frame", frameName},
+                   {"input", p.get("input")},
+                   {"outputs",
+                    {{"posed_labels", "posed_G.nii.gz"},
+                     {"posed_parts", "posed_S.nii.gz"},
+                     {"transform", "transform.nrrd"}}},
+                   {"grid",
+                    {{"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}},
+                     {"spacing_mm", {grid.spacing()[0], grid.spacing()[1], grid.spacing()[2]}}}},
+                   {"cage_vertices", cage.vertices.rows()},
+                   {"scene_reused", reused},
+                   {"tissue_table",
+                    tissues ? (p.has("tissues") ? p.get("tissues") : "phantom default") : "none"},
+                   {"voxels_in_shell", raster.shellVoxels},
+                   {"raster_inverted_tets", raster.invertedTets}};
+    report.update(makePoseReport(ri));
+    if (image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
+    writeJsonAtomically(report, (dir / "report.json").string());
+    const json& q = report["quality"];
+    say("  body volume " + std::to_string(report["body"]["volume_change_percent"].get<double>()) +
+        " %, worst label " +
+        std::to_string(q["labels_within_1_percent"]["worst_change_percent"].get<double>()) + " %" +
+        (q.contains("bones_rigid")
+             ? ", bones min Dice " + std::to_string(q["bones_rigid"]["min_dice"].get<double>())
+             : std::string()) +
+        "; quality targets " + (q["all_met"].get<bool>() ? "met" : "NOT all met") + " -> " +
+        (dir / "report.json").string());
+    summary.push_back(report);
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (quiet)
+    std::cout << (oneFrame ? summary[0] : json{{"frames", summary}, {"seconds", seconds}}).dump(2)
+              << "\n";
+  else
+    say("done in " + std::to_string(int(seconds)) + " s: " + outDir);
+  return 0;
+}
+
+}  // namespace repose::cli

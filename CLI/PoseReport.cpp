@@ -1,0 +1,234 @@
+#include "PoseReport.h"
+
+#include "repose/volume/LabelStatistics.h"
+
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <type_traits>
+
+namespace repose::cli {
+namespace {
+
+using nlohmann::json;
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const std::size_t k = std::min(v.size() - 1, std::size_t(q * double(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+  return v[k];
+}
+
+struct DiceCounts {
+  std::map<int, std::int64_t> posed, expected, both, rest;
+};
+
+// For one group: per label of G, the voxels inside the group's parts (S) of the posed maps, of
+// the rest maps seen through the group's motion (nearest rest voxel at motion^-1 of each posed
+// voxel centre: the analytically posed copy), of both, and of the rest maps themselves.
+template <class TG, class TS>
+DiceCounts countForGroup(const Volume& G, const Volume& S, const Volume& PG, const Volume& PS,
+                         const RigidHandle& h) {
+  DiceCounts c;
+  std::vector<char> inParts(1 << 16, 0);
+  for (const int p : h.parts)
+    if (p >= 0 && p < (1 << 16)) inParts[p] = 1;
+  auto partOf = [&](auto s) {
+    return s >= 0 && std::int64_t(s) < (1 << 16) && inParts[std::size_t(s)];
+  };
+  const TG *g = G.data<TG>(), *pg = PG.data<TG>();
+  const TS *sp = S.data<TS>(), *ps = PS.data<TS>();
+  for (std::int64_t i = 0; i < G.numVoxels(); ++i)
+    if (partOf(sp[i])) ++c.rest[int(g[i])];
+  const auto d = PG.dims(), rd = G.dims();
+  // Posed voxel (i,j,k) -> rest continuous index, affine: one matrix for the whole grid.
+  const Eigen::Matrix4d toRest =
+      G.geometry().ijkToRas.inverse() * h.motion.inverse().matrix() * PG.geometry().ijkToRas;
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    for (std::int64_t j = 0; j < d[1]; ++j)
+      for (std::int64_t i = 0; i < d[0]; ++i) {
+        const std::int64_t o = PG.index(i, j, k);
+        const int posed = partOf(ps[o]) ? int(pg[o]) : 0;
+        const Eigen::Vector4d r = toRest * Eigen::Vector4d(double(i), double(j), double(k), 1);
+        const double ri = std::floor(r.x() + 0.5), rj = std::floor(r.y() + 0.5),
+                     rk = std::floor(r.z() + 0.5);
+        int expected = 0;
+        if (ri >= 0 && rj >= 0 && rk >= 0 && ri < rd[0] && rj < rd[1] && rk < rd[2]) {
+          const std::int64_t q = G.index(std::int64_t(ri), std::int64_t(rj), std::int64_t(rk));
+          if (partOf(sp[q])) expected = int(g[q]);
+        }
+        if (posed) ++c.posed[posed];
+        if (expected) ++c.expected[expected];
+        if (posed && posed == expected) ++c.both[posed];
+      }
+  return c;
+}
+
+DiceCounts diceCounts(const PoseReportInput& in, const RigidHandle& h) {
+  DiceCounts out;
+  dispatchScalar(in.organs->scalarType(), [&](auto* gt) {
+    using TG = std::remove_pointer_t<decltype(gt)>;
+    dispatchScalar(in.parts->scalarType(), [&](auto* st) {
+      using TS = std::remove_pointer_t<decltype(st)>;
+      if constexpr (std::is_integral_v<TG> && std::is_integral_v<TS>)
+        out = countForGroup<TG, TS>(*in.organs, *in.parts, *in.posedOrgans, *in.posedParts, h);
+    });
+  });
+  return out;
+}
+
+}  // namespace
+
+json makePoseReport(const PoseReportInput& in) {
+  json report;
+  // Per label: volume, and mass where the tissue table knows the label.
+  std::map<int, std::pair<LabelCount, LabelCount>> counts;
+  for (const LabelCount& c : countLabels(*in.organs))
+    if (c.layer == 0) counts[c.value].first = c;
+  for (const LabelCount& c : countLabels(*in.posedOrgans))
+    if (c.layer == 0) counts[c.value].second = c;
+  json labels = json::array();
+  double bodyBefore = 0, bodyAfter = 0, massBefore = 0, massAfter = 0;
+  bool massKnown = in.tissues != nullptr;
+  double worstChange = 0;
+  int worstLabel = 0, lost = 0;
+  for (const auto& [value, c] : counts) {
+    const Label* l = in.organs->labels().find(value);
+    const double before = c.first.volumeMm3, after = c.second.volumeMm3;
+    const double change = before > 0 ? 100 * (after / before - 1) : 0;
+    json row = {{"value", value},
+                {"name", l ? l->name : ""},
+                {"voxels_before", c.first.voxels},
+                {"voxels_after", c.second.voxels},
+                {"volume_before_ml", before / 1000},
+                {"volume_after_ml", after / 1000},
+                {"change_percent", change}};
+    bodyBefore += before, bodyAfter += after;
+    lost += c.first.voxels > 0 && c.second.voxels == 0;
+    if (c.first.voxels >= 1000 && std::fabs(change) > std::fabs(worstChange))
+      worstChange = change, worstLabel = value;
+    if (in.tissues) {
+      const auto t = in.tissues->find(value);
+      if (t == in.tissues->end()) {
+        massKnown = false;
+      } else {
+        const double rho = t->second.densityKgM3 * 1e-6;  // g per mm^3
+        row["mass_before_g"] = before * rho;
+        row["mass_after_g"] = after * rho;
+        massBefore += before * rho, massAfter += after * rho;
+      }
+    }
+    labels.push_back(row);
+  }
+  report["labels"] = labels;
+  report["labels_lost"] = lost;
+  json body = {{"volume_before_ml", bodyBefore / 1000},
+               {"volume_after_ml", bodyAfter / 1000},
+               {"volume_change_percent", bodyBefore > 0 ? 100 * (bodyAfter / bodyBefore - 1) : 0}};
+  if (in.tissues && massKnown) {
+    body["mass_before_kg"] = massBefore / 1000;
+    body["mass_after_kg"] = massAfter / 1000;
+    body["mass_change_percent"] = massBefore > 0 ? 100 * (massAfter / massBefore - 1) : 0;
+  }
+  report["body"] = body;
+
+  // Per tet: conformal distortion (largest over smallest singular value of B_t) and volume
+  // change (det B_t - 1), as distributions.
+  std::vector<double> distortion, volumeChange;
+  int inverted = 0;
+  for (const Eigen::Matrix3d& B : *in.tetMaps) {
+    const Eigen::Vector3d s = Eigen::JacobiSVD<Eigen::Matrix3d>(B).singularValues();
+    const double det = B.determinant();
+    inverted += det <= 0;
+    distortion.push_back(s[2] > 0 ? s[0] / s[2] : std::numeric_limits<double>::infinity());
+    volumeChange.push_back(det - 1);
+  }
+  const std::vector<double> edges{1.0, 1.05, 1.1, 1.25, 1.5, 2.0, 3.0, 5.0};
+  json histogram = json::array();
+  for (std::size_t b = 0; b < edges.size(); ++b) {
+    const double lo = edges[b], hi = b + 1 < edges.size() ? edges[b + 1] : 1e300;
+    const auto n = std::count_if(distortion.begin(), distortion.end(),
+                                 [&](double d) { return d >= lo && d < hi; });
+    histogram.push_back(
+        {{"from", lo}, {"to", b + 1 < edges.size() ? json(hi) : json("inf")}, {"tets", n}});
+  }
+  report["distortion"] = {{"measure", "singular value ratio of B_t (1: conformal)"},
+                          {"median", quantile(distortion, 0.5)},
+                          {"p95", quantile(distortion, 0.95)},
+                          {"p99", quantile(distortion, 0.99)},
+                          {"max", quantile(distortion, 1.0)},
+                          {"histogram", histogram}};
+  report["tet_volume_change"] = {{"measure", "det B_t - 1"},
+                                 {"min", quantile(volumeChange, 0.0)},
+                                 {"p01", quantile(volumeChange, 0.01)},
+                                 {"median", quantile(volumeChange, 0.5)},
+                                 {"p99", quantile(volumeChange, 0.99)},
+                                 {"max", quantile(volumeChange, 1.0)}};
+  report["mesh"] = {{"vertices", in.mesh->vertices.rows()},
+                    {"tets", in.mesh->tets.rows()},
+                    {"outlier_vertices", in.outlierVertices},
+                    {"vertices_moving_rigidly_with_a_group", in.rigidVertices},
+                    {"inverted_tets", inverted}};
+
+  // Rigid tissues: each rigid label within each group's body parts against its posed copy.
+  json rigid = json::array();
+  double minDice = 1;
+  std::vector<DiceCounts> groupCounts;
+  if (in.tissues && in.handles)
+    for (const RigidHandle& h : *in.handles)
+      groupCounts.push_back(h.parts.empty() ? DiceCounts{} : diceCounts(in, h));
+  if (in.tissues && in.handles)
+    for (const auto& [value, tissue] : *in.tissues) {
+      if (!tissue.rigid) continue;
+      for (std::size_t g = 0; g < in.handles->size(); ++g) {
+        if (groupCounts[g].rest.count(value) == 0) continue;
+        DiceCounts& c = groupCounts[g];
+        const std::int64_t restVoxels = c.rest[value];
+        const double dice = double(2 * c.both[value]) / double(c.posed[value] + c.expected[value]);
+        const bool checked = restVoxels >= 1000;
+        if (checked) minDice = std::min(minDice, dice);
+        rigid.push_back({{"label", value},
+                         {"name", tissue.name},
+                         {"group", in.groupNames[g]},
+                         {"voxels", restVoxels},
+                         {"dice", dice},
+                         {"checked", checked}});
+      }
+    }
+  report["rigid_tissues"] = rigid;
+
+  const std::int64_t holesBefore = countEnclosedBackground(*in.organs),
+                     holesAfter = countEnclosedBackground(*in.posedOrgans);
+  report["holes"] = {{"enclosed_background_voxels_before", holesBefore},
+                     {"enclosed_background_voxels_after", holesAfter}};
+
+  const double bodyChange = report["body"]["volume_change_percent"].get<double>();
+  json quality = {{"labels_within_1_percent",
+                   {{"met", std::fabs(worstChange) <= 1.0},
+                    {"worst_label", worstLabel},
+                    {"worst_change_percent", worstChange},
+                    {"rule", "every label with >= 1000 voxels keeps its volume within +-1%"}}},
+                  {"body_within_half_percent",
+                   {{"met", std::fabs(bodyChange) <= 0.5},
+                    {"change_percent", bodyChange},
+                    {"rule", "whole-body volume within +-0.5%"}}},
+                  {"no_new_holes",
+                   {{"met", holesAfter <= holesBefore},
+                    {"new_enclosed_voxels", std::max<std::int64_t>(0, holesAfter - holesBefore)}}},
+                  {"no_label_lost", {{"met", lost == 0}, {"labels_lost", lost}}}};
+  if (in.tissues)
+    quality["bones_rigid"] = {{"met", minDice >= 0.95},
+                              {"min_dice", minDice},
+                              {"rule",
+                               "rigid tissues of >= 1000 voxels: Dice >= 0.95 with "
+                               "their analytically posed copies"}};
+  bool all = true;
+  for (const auto& [name, q] : quality.items()) all = all && q["met"].get<bool>();
+  quality["all_met"] = all;
+  report["quality"] = quality;
+  return report;
+}
+
+}  // namespace repose::cli

@@ -1,0 +1,339 @@
+// Reading and writing pose files. Validation is written out by hand, field by field, so every
+// message names the field as the JSON schema (docs/pose.schema.json) does; the schema and this
+// reader are checked against each other on the pose suite (Testing/Python/test_pose_schema.py).
+#include "repose/io/AtomicOutput.h"
+#include "repose/pose/Pose.h"
+#include "repose/util/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace repose {
+namespace {
+
+using nlohmann::json;
+
+struct Reader {
+  std::string source;
+  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
+    throw Error(source + ": " + field + ": " + problem);
+  }
+  const json& object(const json& j, const std::string& field) const {
+    if (!j.is_object()) fail(field, "expected an object");
+    return j;
+  }
+  void onlyKeys(const json& j, const std::string& field, std::set<std::string> allowed) const {
+    for (const auto& [key, value] : j.items())
+      if (!allowed.count(key)) fail(field.empty() ? key : field + "." + key, "unknown field");
+  }
+  double number(const json& j, const std::string& field) const {
+    if (!j.is_number()) fail(field, "expected a number");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail(field, "not a finite number");
+    return v;
+  }
+  std::string string(const json& j, const std::string& field) const {
+    if (!j.is_string()) fail(field, "expected a string");
+    return j.get<std::string>();
+  }
+  Eigen::Vector3d vector3(const json& j, const std::string& field) const {
+    if (!j.is_array() || j.size() != 3) fail(field, "expected an array of 3 numbers");
+    return {number(j[0], field + "[0]"), number(j[1], field + "[1]"), number(j[2], field + "[2]")};
+  }
+  int integer(const json& j, const std::string& field) const {
+    if (!j.is_number_integer()) fail(field, "expected an integer");
+    return j.get<int>();
+  }
+
+  Region region(const json& j, const std::string& field) const {
+    object(j, field);
+    onlyKeys(j, field, {"box", "sphere"});
+    if (j.size() != 1) fail(field, "expected exactly one of box, sphere");
+    Region r;
+    if (j.contains("box")) {
+      const json& b = j["box"];
+      if (!b.is_array() || b.size() != 6) fail(field + ".box", "expected [x0,y0,z0,x1,y1,z1]");
+      for (int c = 0; c < 3; ++c) {
+        r.a[c] = number(b[c], field + ".box[" + std::to_string(c) + "]");
+        r.b[c] = number(b[c + 3], field + ".box[" + std::to_string(c + 3) + "]");
+        if (r.b[c] < r.a[c]) fail(field + ".box", "max below min");
+      }
+    } else {
+      const json& s = j["sphere"];
+      if (!s.is_array() || s.size() != 4) fail(field + ".sphere", "expected [x,y,z,radius]");
+      r.shape = Region::Shape::Sphere;
+      for (int c = 0; c < 3; ++c)
+        r.a[c] = number(s[c], field + ".sphere[" + std::to_string(c) + "]");
+      r.b.x() = number(s[3], field + ".sphere[3]");
+      if (r.b.x() <= 0) fail(field + ".sphere[3]", "radius must be positive");
+    }
+    return r;
+  }
+
+  PoseSelection selection(const json& j, const std::string& field) const {
+    object(j, field);
+    onlyKeys(j, field, {"cage_vertices", "region", "parts", "rest"});
+    PoseSelection s;
+    if (j.empty()) fail(field, "selects nothing (give cage_vertices, region, parts or rest)");
+    if (j.contains("cage_vertices")) {
+      const json& v = j["cage_vertices"];
+      if (!v.is_array() || v.empty()) fail(field + ".cage_vertices", "expected a non-empty array");
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const int index = integer(v[i], field + ".cage_vertices[" + std::to_string(i) + "]");
+        if (index < 0) fail(field + ".cage_vertices[" + std::to_string(i) + "]", "negative");
+        s.cageVertices.push_back(index);
+      }
+    }
+    if (j.contains("region")) s.region = region(j["region"], field + ".region");
+    if (j.contains("parts")) {
+      const json& v = j["parts"];
+      if (!v.is_array() || v.empty()) fail(field + ".parts", "expected a non-empty array");
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string f = field + ".parts[" + std::to_string(i) + "]";
+        if (v[i].is_string()) {
+          s.partNames.push_back(v[i].get<std::string>());
+        } else {
+          const int label = integer(v[i], f);
+          if (label <= 0) fail(f, "a body part is a positive label of S");
+          s.parts.push_back(label);
+        }
+      }
+    }
+    if (j.contains("rest")) {
+      if (!j["rest"].is_boolean() || !j["rest"].get<bool>()) fail(field + ".rest", "expected true");
+      if (j.size() != 1) fail(field, "rest cannot be combined with another selection");
+      s.rest = true;
+    }
+    return s;
+  }
+
+  // A transform's fields over `base` (keyframes change only what they name).
+  PoseTransform transform(const json& j, const std::string& field, PoseTransform t) const {
+    if (j.contains("rotation")) {
+      const std::string f = field.empty() ? "rotation" : field + ".rotation";
+      const json& r = object(j["rotation"], f);
+      onlyKeys(r, f, {"axis", "angle_deg", "pivot"});
+      if (r.contains("axis")) {
+        const Eigen::Vector3d axis = vector3(r["axis"], f + ".axis");
+        if (axis.norm() < 1e-9) fail(f + ".axis", "zero vector");
+        t.axis = axis.normalized();
+      }
+      if (r.contains("angle_deg")) t.angleDeg = number(r["angle_deg"], f + ".angle_deg");
+      if (r.contains("pivot")) t.pivot = vector3(r["pivot"], f + ".pivot");
+    }
+    if (j.contains("translation"))
+      t.translation =
+          vector3(j["translation"], field.empty() ? "translation" : field + ".translation");
+    return t;
+  }
+};
+
+json vec(const Eigen::Vector3d& v) {
+  return json::array({v.x(), v.y(), v.z()});
+}
+
+json transformJson(const PoseTransform& t) {
+  return {{"rotation", {{"axis", vec(t.axis)}, {"angle_deg", t.angleDeg}, {"pivot", vec(t.pivot)}}},
+          {"translation", vec(t.translation)}};
+}
+
+json regionJson(const Region& r) {
+  if (r.shape == Region::Shape::Box)
+    return {{"box", {r.a.x(), r.a.y(), r.a.z(), r.b.x(), r.b.y(), r.b.z()}}};
+  return {{"sphere", {r.a.x(), r.a.y(), r.a.z(), r.b.x()}}};
+}
+
+}  // namespace
+
+Eigen::Isometry3d PoseTransform::isometry() const {
+  return Eigen::Translation3d(translation + pivot) *
+         Eigen::AngleAxisd(angleDeg * M_PI / 180, axis.normalized()) * Eigen::Translation3d(-pivot);
+}
+
+std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> Pose::frames() const {
+  std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> out;
+  auto base = [&] {
+    std::vector<Eigen::Isometry3d> m;
+    for (const PoseGroup& g : groups)
+      m.push_back(g.fixed ? Eigen::Isometry3d::Identity() : g.transform.isometry());
+    return m;
+  };
+  if (keyframes.empty()) {
+    out.emplace_back(name, base());
+    return out;
+  }
+  for (const PoseKeyframe& k : keyframes) {
+    std::vector<Eigen::Isometry3d> m = base();
+    for (const auto& [group, t] : k.transforms)
+      for (std::size_t g = 0; g < groups.size(); ++g)
+        if (groups[g].name == group) m[g] = t.isometry();
+    out.emplace_back(k.name, m);
+  }
+  return out;
+}
+
+Pose parsePose(const std::string& text, const std::string& source) {
+  const Reader r{source};
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw Error(source + ": not valid JSON (" + std::string(e.what()) + ")");
+  }
+  r.object(j, "(top level)");
+  r.onlyKeys(j, "",
+             {"format", "version", "name", "description", "separations", "groups", "keyframes"});
+  if (!j.contains("format") || j["format"] != "repose-pose")
+    r.fail("format", "expected \"repose-pose\"");
+  if (!j.contains("version") || r.integer(j["version"], "version") != 1)
+    r.fail("version", "expected 1 (the only version so far)");
+  Pose pose;
+  if (j.contains("name")) pose.name = r.string(j["name"], "name");
+  if (j.contains("description")) pose.description = r.string(j["description"], "description");
+  if (j.contains("separations")) {
+    const json& s = j["separations"];
+    if (!s.is_array()) r.fail("separations", "expected an array");
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      const std::string f = "separations[" + std::to_string(i) + "]";
+      r.object(s[i], f);
+      r.onlyKeys(s[i], f, {"parts", "region"});
+      if (!s[i].contains("parts") || !s[i]["parts"].is_array() || s[i]["parts"].size() != 2)
+        r.fail(f + ".parts", "expected two body parts (labels or names of S)");
+      if (!s[i].contains("region")) r.fail(f + ".region", "required");
+      PoseSeparation sep;
+      for (int k = 0; k < 2; ++k) {
+        const json& part = s[i]["parts"][k];
+        const std::string pf = f + ".parts[" + std::to_string(k) + "]";
+        if (part.is_string()) {
+          sep.partNames[k] = part.get<std::string>();
+        } else if ((sep.parts[k] = r.integer(part, pf)) <= 0) {
+          r.fail(pf, "a body part is a positive label of S");
+        }
+      }
+      if (sep.parts[0] == sep.parts[1] && sep.partNames[0] == sep.partNames[1])
+        r.fail(f + ".parts", "two different body parts");
+      sep.region = r.region(s[i]["region"], f + ".region");
+      pose.separations.push_back(sep);
+    }
+  }
+  if (!j.contains("groups") || !j["groups"].is_array() || j["groups"].empty())
+    r.fail("groups", "expected a non-empty array");
+  std::set<std::string> names;
+  int rests = 0;
+  for (std::size_t i = 0; i < j["groups"].size(); ++i) {
+    const std::string f = "groups[" + std::to_string(i) + "]";
+    const json& g = r.object(j["groups"][i], f);
+    r.onlyKeys(g, f, {"name", "select", "fixed", "rotation", "translation"});
+    PoseGroup group;
+    if (!g.contains("name")) r.fail(f + ".name", "required");
+    group.name = r.string(g["name"], f + ".name");
+    if (group.name.empty() || !names.insert(group.name).second)
+      r.fail(f + ".name", "empty or used by another group");
+    if (!g.contains("select")) r.fail(f + ".select", "required");
+    group.select = r.selection(g["select"], f + ".select");
+    rests += group.select.rest;
+    if (g.contains("fixed")) {
+      if (!g["fixed"].is_boolean()) r.fail(f + ".fixed", "expected true or false");
+      group.fixed = g["fixed"].get<bool>();
+    }
+    if (group.fixed && (g.contains("rotation") || g.contains("translation")))
+      r.fail(f, "a fixed group has no rotation or translation");
+    group.transform = r.transform(g, f, {});
+    pose.groups.push_back(group);
+  }
+  if (rests > 1) r.fail("groups", "only one group can select the rest");
+  if (j.contains("keyframes")) {
+    const json& k = j["keyframes"];
+    if (!k.is_array()) r.fail("keyframes", "expected an array");
+    for (std::size_t i = 0; i < k.size(); ++i) {
+      const std::string f = "keyframes[" + std::to_string(i) + "]";
+      r.object(k[i], f);
+      r.onlyKeys(k[i], f, {"name", "groups"});
+      PoseKeyframe frame;
+      frame.name =
+          k[i].contains("name") ? r.string(k[i]["name"], f + ".name") : "frame" + std::to_string(i);
+      if (!k[i].contains("groups")) r.fail(f + ".groups", "required");
+      const json& gs = r.object(k[i]["groups"], f + ".groups");
+      for (const auto& [name, t] : gs.items()) {
+        const std::string gf = f + ".groups." + name;
+        const auto it = std::find_if(pose.groups.begin(), pose.groups.end(),
+                                     [&](const PoseGroup& g) { return g.name == name; });
+        if (it == pose.groups.end()) r.fail(gf, "no group has this name");
+        if (it->fixed) r.fail(gf, "the group is fixed");
+        r.object(t, gf);
+        r.onlyKeys(t, gf, {"rotation", "translation"});
+        frame.transforms.emplace_back(name, r.transform(t, gf, it->transform));
+      }
+      pose.keyframes.push_back(frame);
+    }
+  }
+  return pose;
+}
+
+Pose readPoseFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parsePose(text.str(), path);
+}
+
+std::string poseToJson(const Pose& pose) {
+  json j = {{"format", "repose-pose"}, {"version", 1}, {"name", pose.name}};
+  if (!pose.description.empty()) j["description"] = pose.description;
+  if (!pose.separations.empty()) {
+    j["separations"] = json::array();
+    for (const PoseSeparation& s : pose.separations) {
+      json parts = json::array();
+      for (int k = 0; k < 2; ++k)
+        parts.push_back(s.partNames[k].empty() ? json(s.parts[k]) : json(s.partNames[k]));
+      j["separations"].push_back({{"parts", parts}, {"region", regionJson(s.region)}});
+    }
+  }
+  j["groups"] = json::array();
+  for (const PoseGroup& g : pose.groups) {
+    json select = json::object();
+    if (g.select.rest) select["rest"] = true;
+    if (!g.select.cageVertices.empty()) select["cage_vertices"] = g.select.cageVertices;
+    if (g.select.region) select["region"] = regionJson(*g.select.region);
+    if (!g.select.parts.empty() || !g.select.partNames.empty()) {
+      json parts = json::array();
+      for (const int p : g.select.parts) parts.push_back(p);
+      for (const std::string& p : g.select.partNames) parts.push_back(p);
+      select["parts"] = parts;
+    }
+    json group = {{"name", g.name}, {"select", select}};
+    if (g.fixed) {
+      group["fixed"] = true;
+    } else {
+      group.update(transformJson(g.transform));
+    }
+    j["groups"].push_back(group);
+  }
+  if (!pose.keyframes.empty()) {
+    j["keyframes"] = json::array();
+    for (const PoseKeyframe& k : pose.keyframes) {
+      json groups = json::object();
+      for (const auto& [name, t] : k.transforms) groups[name] = transformJson(t);
+      j["keyframes"].push_back({{"name", k.name}, {"groups", groups}});
+    }
+  }
+  return j.dump(2) + "\n";
+}
+
+void writePoseFile(const Pose& pose, const std::string& path) {
+  AtomicOutput out(path);
+  {
+    std::ofstream f(out.tempPath());
+    f << poseToJson(pose);
+    if (!f.flush()) throw Error(path + ": cannot write");
+  }
+  out.commit();
+}
+
+}  // namespace repose

@@ -1,0 +1,151 @@
+// Pose files: the pose suite parses, a file survives a write/read round trip, keyframes expand
+// into frames, every kind of bad field is refused with a message naming the field, and groups
+// resolve to cage vertices and body parts of the phantom.
+#include "TestPaths.h"
+
+#include "repose/cage/CageBuilder.h"
+#include "repose/mesh/TransferMesh.h"
+#include "repose/phantom/Phantom.h"
+#include "repose/pose/Pose.h"
+#include "repose/util/Error.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+std::string suite(const std::string& name) {
+  return std::string(REPOSE_SOURCE_DIR) + "/bench/poses/" + name + ".pose.json";
+}
+
+// The error message parsePose gives for `text`, or "" if it parses.
+std::string errorOf(const std::string& text) {
+  try {
+    parsePose(text, "p.json");
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+const char* kMinimal = R"({"format":"repose-pose","version":1,"name":"m","groups":[
+  {"name":"arm","select":{"parts":[4]},"rotation":{"axis":[0,0,2],"angle_deg":90,"pivot":[1,2,3]},
+   "translation":[10,0,0]},
+  {"name":"body","select":{"rest":true},"fixed":true}]})";
+
+}  // namespace
+
+TEST(PoseFile, TheSuiteParsesAndSurvivesARoundTrip) {
+  ScratchDir dir;
+  for (const char* name : {"elbow90", "arm_raise90", "hand_from_hip", "leg_step30", "walk"}) {
+    const Pose pose = readPoseFile(suite(name));
+    EXPECT_EQ(pose.name, name);
+    const std::string copy = dir.file(std::string(name) + ".pose.json");
+    writePoseFile(pose, copy);
+    EXPECT_EQ(poseToJson(readPoseFile(copy)), poseToJson(pose)) << name;
+  }
+  const Pose walk = readPoseFile(suite("walk"));
+  EXPECT_EQ(walk.frames().size(), 7u);
+  EXPECT_EQ(readPoseFile(suite("hand_from_hip")).separations.size(), 4u);
+}
+
+TEST(PoseFile, TransformsRotateAboutThePivotThenTranslate) {
+  const Pose pose = parsePose(kMinimal, "m");
+  const auto frames = pose.frames();
+  ASSERT_EQ(frames.size(), 1u);
+  const Eigen::Isometry3d& m = frames[0].second[0];
+  // 90 degrees about z through (1,2,3): (2,2,3) -> (1,3,3), then +10 in x.
+  EXPECT_LT((m * Eigen::Vector3d(2, 2, 3) - Eigen::Vector3d(11, 3, 3)).norm(), 1e-12);
+  EXPECT_TRUE(frames[0].second[1].isApprox(Eigen::Isometry3d::Identity()));  // fixed
+}
+
+TEST(PoseFile, KeyframesChangeOnlyWhatTheyName) {
+  std::string text = kMinimal;
+  text.insert(text.size() - 1,
+              R"(,"keyframes":[{"name":"a","groups":{"arm":{"rotation":{"angle_deg":0}}}},
+    {"name":"b","groups":{}}])");
+  const auto frames = parsePose(text, "k").frames();
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].first, "a");
+  // Angle 0 but the base translation kept.
+  EXPECT_LT((frames[0].second[0] * Eigen::Vector3d(2, 2, 3) - Eigen::Vector3d(12, 2, 3)).norm(),
+            1e-12);
+  EXPECT_LT((frames[1].second[0] * Eigen::Vector3d(2, 2, 3) - Eigen::Vector3d(11, 3, 3)).norm(),
+            1e-12);
+}
+
+TEST(PoseFile, BadFieldsAreRefusedByName) {
+  auto with = [](const std::string& from, const std::string& to) {
+    std::string t = kMinimal;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return t.replace(at, from.size(), to);
+  };
+  const std::pair<std::string, std::string> cases[] = {
+      {"{", "p.json: not valid JSON"},
+      {with("\"version\":1", "\"version\":2"), "p.json: version: expected 1"},
+      {with("repose-pose", "other"), "p.json: format:"},
+      {with("\"angle_deg\":90", "\"angle_deg\":\"90\""),
+       "p.json: groups[0].rotation.angle_deg: expected a number"},
+      {with("\"axis\":[0,0,2]", "\"axis\":[0,0,0]"), "p.json: groups[0].rotation.axis: zero"},
+      {with("\"axis\":[0,0,2]", "\"axis\":[0,0]"), "p.json: groups[0].rotation.axis: expected"},
+      {with("\"parts\":[4]", "\"parts\":[-4]"), "p.json: groups[0].select.parts[0]:"},
+      {with("\"parts\":[4]", "\"cage_vertices\":[1.5]"),
+       "p.json: groups[0].select.cage_vertices[0]: expected an integer"},
+      {with("\"parts\":[4]", "\"region\":{\"box\":[0,0,0,1,1]}"),
+       "p.json: groups[0].select.region.box"},
+      {with("\"name\":\"body\"", "\"name\":\"arm\""), "p.json: groups[1].name: empty or used"},
+      {with("\"fixed\":true", "\"fixed\":true,\"translation\":[1,1,1]"),
+       "p.json: groups[1]: a fixed group"},
+      {with("\"translation\":[10,0,0]", "\"translaton\":[10,0,0]"),
+       "p.json: groups[0].translaton: unknown field"},
+      {with("\"rest\":true", "\"rest\":true,\"parts\":[3]"), "p.json: groups[1].select: rest"},
+  };
+  for (const auto& [text, message] : cases) {
+    const std::string e = errorOf(text);
+    EXPECT_EQ(e.rfind(message, 0), 0u) << "got: " << e << "\nwanted: " << message;
+  }
+  EXPECT_EQ(errorOf(kMinimal), "");
+  EXPECT_THROW(readPoseFile("/nonexistent/x.pose.json"), Error);
+}
+
+TEST(PoseFile, GroupsResolveToCageVerticesAndBodyParts) {
+  PhantomOptions po;
+  po.voxelMm = 8;
+  const Phantom phantom(po);
+  const auto [organs, parts] = phantom.makeVolumes();
+  const TriangleMesh cage = buildCage(parts, {}).mesh;
+  const TransferMesh mesh = buildTransferMesh(parts, {});
+  const Pose pose = readPoseFile(suite("elbow90"));
+  const std::vector<RigidHandle> handles = resolveHandles(pose, cage, mesh, parts.labels());
+  ASSERT_EQ(handles.size(), 2u);
+  EXPECT_EQ(handles[0].parts, (std::vector<int>{kPartForearmLeft, kPartHandLeft}));
+  EXPECT_EQ(handles[0].cageVertices.size() + handles[1].cageVertices.size(),
+            std::size_t(cage.vertices.rows()));  // the rest takes every other vertex
+  for (const int v : handles[0].cageVertices)    // over the left forearm or hand: below the elbow
+    EXPECT_LT(cage.vertices(v, 2), phantom.joint("elbow_left").ras.z() + 60);
+  EXPECT_EQ(std::count(handles[1].parts.begin(), handles[1].parts.end(), kPartForearmLeft), 0);
+  EXPECT_GT(handles[1].parts.size(), 5u);
+
+  Pose unknown = pose;
+  unknown.groups[0].select.partNames = {"tail"};
+  EXPECT_THROW(resolveHandles(unknown, cage, mesh, parts.labels()), Error);
+  Pose twice = pose;
+  twice.groups[1].select = PoseSelection{};
+  twice.groups[1].select.cageVertices = {handles[0].cageVertices[0]};
+  EXPECT_THROW(resolveHandles(twice, cage, mesh, parts.labels()), Error);
+
+  // Posing: the group's vertices move exactly, the fixed rest stays.
+  std::vector<RigidHandle> posed = handles;
+  setMotions(posed, pose.frames()[0].second);
+  const Eigen::MatrixX3d c = poseCage(cage, posed);
+  for (const int v : posed[1].cageVertices) EXPECT_EQ(c.row(v), cage.vertices.row(v));
+  for (const int v : posed[0].cageVertices)
+    EXPECT_LT((Eigen::Vector3d(c.row(v)) - posed[0].motion * Eigen::Vector3d(cage.vertices.row(v)))
+                  .norm(),
+              1e-9);
+}
