@@ -1,0 +1,48 @@
+// vtkMRMLReposeSegmentationNode: the input of a posing job. The organ label map G (with its label
+// table in the image's field data, as the Logic's volume conversion stores it), the optional
+// body-part map S that the cage and transfer mesh follow, and an optional intensity image I posed
+// alongside; each a vtkImageData in RAS mm (origin, spacing, direction) and a file name for the
+// scene folder.
+#pragma once
+
+#include "vtkMRMLReposeNode.h"
+
+#include <vtkImageData.h>
+#include <vtkSmartPointer.h>
+
+class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
+    : public vtkMRMLReposeNode {
+ public:
+  static vtkMRMLReposeSegmentationNode* New();
+  vtkTypeMacro(vtkMRMLReposeSegmentationNode, vtkMRMLReposeNode);
+  const char* GetNodeClassName() const override { return "vtkMRMLReposeSegmentationNode"; }
+
+  vtkImageData* GetLabelMap() const { return this->LabelMap; }
+  void SetLabelMap(vtkImageData* image);
+  vtkImageData* GetBodyPartMap() const { return this->BodyPartMap; }  // null: G's body mask
+  void SetBodyPartMap(vtkImageData* image);
+  vtkImageData* GetImage() const { return this->Image; }  // null: none
+  void SetImage(vtkImageData* image);
+
+  // File names inside the scene folder (e.g. "G.nii.gz"); empty when not saved.
+  const std::string& GetLabelMapFileName() const { return this->LabelMapFileName; }
+  void SetLabelMapFileName(const std::string& name) {
+    this->SetField(this->LabelMapFileName, name);
+  }
+  const std::string& GetBodyPartMapFileName() const { return this->BodyPartMapFileName; }
+  void SetBodyPartMapFileName(const std::string& name) {
+    this->SetField(this->BodyPartMapFileName, name);
+  }
+  const std::string& GetImageFileName() const { return this->ImageFileName; }
+  void SetImageFileName(const std::string& name) { this->SetField(this->ImageFileName, name); }
+
+ protected:
+  vtkMRMLReposeSegmentationNode() = default;
+  void WriteFields(nlohmann::ordered_json& json) const override;
+  bool ReadFields(const nlohmann::json& json, bool apply, std::string& error) override;
+  void CopyContent(vtkMRMLReposeNode* other) override;
+
+ private:
+  vtkSmartPointer<vtkImageData> LabelMap, BodyPartMap, Image;
+  std::string LabelMapFileName, BodyPartMapFileName, ImageFileName;
+};
