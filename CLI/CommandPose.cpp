@@ -16,6 +16,7 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseRig.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 
@@ -55,15 +56,14 @@ std::optional<TissueTable> defaultTissues(const Volume& organs) {
 }
 
 // What a scene folder holds: the cage and transfer mesh built once for S with these settings.
-json sceneKey(const std::string& partsPath, const Pose& pose, const CageOptions& co,
-              double meshMm) {
+json sceneKey(const std::string& partsPath, const Pose& pose, const RigSettings& rs) {
   json separations = json::parse(poseToJson(pose)).value("separations", json::array());
   return {{"parts", fs::absolute(partsPath).string()},
           {"parts_bytes", fs::file_size(partsPath)},
           {"parts_mtime", fs::last_write_time(partsPath).time_since_epoch().count()},
-          {"cage_vertices", co.targetVertices},
-          {"dilate_mm", co.dilateMm},
-          {"mesh_size_mm", meshMm},
+          {"cage_vertices", rs.cageVertices},
+          {"dilate_mm", rs.dilateMm},
+          {"mesh_size_mm", rs.meshMm},
           {"separations", separations}};
 }
 
@@ -113,12 +113,12 @@ int runPose(const Args& args) {
     throw Error(outDir + ": its parent folder does not exist");
   const double budget = parseMemoryBudget(p.get("memory"));
   const int threads = static_cast<int>(p.getInt("threads"));
-  CageOptions co;
-  co.targetVertices = static_cast<int>(p.getInt("cage-vertices"));
-  co.dilateMm = p.getDouble("dilate-mm");
-  co.threads = threads;
-  const double meshMm = p.getDouble("mesh-mm");
-  if (meshMm < 0) throw UsageError{"--mesh-mm must be >= 0"};
+  RigSettings rs;
+  rs.cageVertices = static_cast<int>(p.getInt("cage-vertices"));
+  rs.dilateMm = p.getDouble("dilate-mm");
+  rs.meshMm = p.getDouble("mesh-mm");
+  rs.threads = threads;
+  if (rs.meshMm < 0) throw UsageError{"--mesh-mm must be >= 0"};
 
   const Volume organs = readVolume(p.get("input"));
   const Volume parts = readVolume(p.get("parts"));
@@ -140,10 +140,9 @@ int runPose(const Args& args) {
     tissues = defaultTissues(organs);
 
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
-  co.separations = resolveSeparations(pose, parts.labels());
-  const json key = sceneKey(p.get("parts"), pose, co, meshMm);
-  TriangleMesh cage;
-  TransferMesh mesh;
+  const std::vector<LimbSeparation> separations = resolveSeparations(pose, parts.labels());
+  const json key = sceneKey(p.get("parts"), pose, rs);
+  RigGeometry geometry;
   bool reused = false;
   if (p.has("scene")) {
     const fs::path scene = p.get("scene");
@@ -151,30 +150,23 @@ int runPose(const Args& args) {
     if (f) {
       const json saved = json::parse(f, nullptr, false);
       if (!saved.is_discarded() && saved.value("built_for", json()) == key) {
-        cage = readTriangleMesh((scene / saved["cage"].get<std::string>()).string());
-        mesh = readTransferMesh((scene / saved["transfer_mesh"].get<std::string>()).string());
+        geometry.cage = readTriangleMesh((scene / saved["cage"].get<std::string>()).string());
+        geometry.mesh =
+            readTransferMesh((scene / saved["transfer_mesh"].get<std::string>()).string());
         reused = true;
         say("reusing the cage and transfer mesh of " + scene.string());
       }
     }
   }
   if (!reused) {
-    say("building the cage (" + std::to_string(co.targetVertices) + " vertices)");
-    co.progress = quiet ? ProgressFn{} : terminalProgress();
-    cage = buildCage(parts, co).mesh;
-    say("building the transfer mesh");
-    TransferMeshOptions to;
-    to.sizeMm = meshMm;
-    to.progress = quiet ? ProgressFn{} : terminalProgress();
-    mesh = buildTransferMesh(parts, to);
-    for (const LimbSeparation& s : co.separations)
-      separateLabels(mesh, s.labelA, s.labelB, s.region);
+    say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
+    geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress());
     if (p.has("scene")) {
       const fs::path scene = p.get("scene");
       fs::create_directories(scene);
-      writeTriangleMesh(cage, (scene / "cage.vtk").string());
-      writeTransferMesh(mesh, (scene / "tm.vtu").string());
-      writeJsonAtomically({{"format", "repose-scene"},
+      writeTriangleMesh(geometry.cage, (scene / "cage.vtk").string());
+      writeTransferMesh(geometry.mesh, (scene / "tm.vtu").string());
+      writeJsonAtomically({{"format", "repose-cage-cache"},
                            {"version", 1},
                            {"cage", "cage.vtk"},
                            {"transfer_mesh", "tm.vtu"},
@@ -183,21 +175,19 @@ int runPose(const Args& args) {
     }
   }
   say("embedding the mesh in the cage");
-  const CageDeformation deformation(mesh, cage, threads);
-  std::vector<RigidHandle> handles = resolveHandles(pose, cage, mesh, parts.labels());
-  const HandleInfluence influence = computeHandleInfluence(mesh, cage, handles, threads);
+  const PoseRig rig(std::move(geometry), pose, parts.labels(), threads);
+  const TriangleMesh& cage = rig.cage();
+  const TransferMesh& mesh = rig.mesh();
   std::vector<std::string> groupNames;
   for (const PoseGroup& g : pose.groups) groupNames.push_back(g.name);
 
-  const auto frames = pose.frames();
-  const bool oneFrame = frames.size() == 1;
+  const bool oneFrame = rig.frameCount() == 1;
   fs::create_directories(outDir);
   json summary = json::array();
-  for (const auto& [frameName, motions] : frames) {
-    setMotions(handles, motions);
-    const Eigen::MatrixX3d posedCage = poseCage(cage, handles);
-    std::vector<Eigen::Matrix3d> B;
-    const Eigen::MatrixX3d deformed = deformation.deform(posedCage, influence, handles, &B);
+  for (std::size_t index = 0; index < rig.frameCount(); ++index) {
+    const PoseRig::Frame frame = rig.frame(index);
+    const std::string& frameName = frame.name;
+    const Eigen::MatrixX3d& deformed = frame.deformed;
     const VolumeGeometry grid = deformedGrid(organs.geometry(), deformed);
     // Memory: the posed G and S, the image and the field (3 floats per voxel) beside the inputs.
     const double outVoxels = double(grid.numVoxels());
@@ -233,10 +223,11 @@ int runPose(const Args& args) {
     PoseReportInput ri;
     ri.organs = &organs, ri.parts = &parts;
     ri.posedOrgans = &posedOrgans, ri.posedParts = &posedParts;
-    ri.mesh = &mesh, ri.tetMaps = &B, ri.handles = &handles, ri.groupNames = groupNames;
+    ri.mesh = &mesh, ri.tetMaps = &frame.tetMaps, ri.handles = &frame.handles;
+    ri.groupNames = groupNames;
     ri.tissues = tissues ? &*tissues : nullptr;
-    ri.outlierVertices = deformation.embedding().outliers();
-    ri.rigidVertices = influence.rigidVertices();
+    ri.outlierVertices = rig.deformation().embedding().outliers();
+    ri.rigidVertices = rig.influence().rigidVertices();
     json report = {{"pose", pose.name},
                    {"frame", frameName},
                    {"input", p.get("input")},
