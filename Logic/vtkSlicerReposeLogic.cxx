@@ -3,6 +3,9 @@
 
 #include "vtkMRMLReposeParametersNode.h"
 #include "vtkSlicerReposeVolumeConversion.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkSlicerReposeJob.h"
 
 #include <repose/io/VolumeIO.h>
 #include <repose/util/Error.h>
@@ -23,7 +26,9 @@
 
 vtkStandardNewMacro(vtkSlicerReposeLogic);
 
-vtkSlicerReposeLogic::vtkSlicerReposeLogic() = default;
+vtkSlicerReposeLogic::vtkSlicerReposeLogic()
+    : Scene(vtkSmartPointer<vtkMRMLReposeScene>::New()),
+      Job(std::make_unique<vtkSlicerReposeJob>()) {}
 
 vtkSlicerReposeLogic::~vtkSlicerReposeLogic() {
   this->SetParameterNode(nullptr);

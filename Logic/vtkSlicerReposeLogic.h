@@ -14,7 +14,18 @@
 #include <vtkObject.h>
 #include <vtkSmartPointer.h>
 
+#include <array>
+#include <memory>
 #include <string>
+#include <vector>
+
+class vtkMRMLReposeCageNode;
+class vtkMRMLReposeNode;
+class vtkMRMLReposePoseNode;
+class vtkMRMLReposeScene;
+class vtkMRMLReposeSegmentationNode;
+class vtkMRMLReposeTransferMeshNode;
+class vtkSlicerReposeJob;
 
 class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObject {
  public:
@@ -50,6 +61,57 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // labels present and named. Empty when no volume is loaded.
   std::string GetVolumeSummary() const;
 
+  // ---- The pipeline on the nodes of a scene (vtkSlicerReposeLogicPipeline.cxx) ----
+  // The logic creates an empty scene; a caller may give its own.
+  void SetScene(vtkMRMLReposeScene* scene);
+  vtkMRMLReposeScene* GetScene() const;
+
+  // Reads G, S (optional) and an image (optional) on this thread into a new segmentation node.
+  // Null on failure, with GetLastErrorMessage() naming the file and the problem.
+  vtkMRMLReposeSegmentationNode* AddSegmentation(const std::string& labelsPath,
+                                                 const std::string& partsPath = "",
+                                                 const std::string& imagePath = "");
+  // Reads and validates a pose file into a new pose node (null and a message on failure).
+  vtkMRMLReposePoseNode* AddPose(const std::string& path);
+
+  // Long steps run one at a time on a worker thread; the nodes they make are added to the scene
+  // by WaitForJob/PollJob on the calling thread, and only when the step finished, so a cancelled
+  // or failed job leaves the scene and the output folder as they were.
+  // Cage and transfer mesh of the segmentation's S (separations from the pose, settings from the
+  // parameter node when one is set), referenced by the pose node.
+  bool StartBuildRig(vtkMRMLReposeSegmentationNode* segmentation, vtkMRMLReposePoseNode* pose);
+  // The pose node's current frame at full resolution: a new segmentation node (posed G, S, image)
+  // referring to its source and pose; with an output folder also posed_G.nii.gz, posed_S.nii.gz
+  // (posed_image.nii.gz) and transform.nrrd written there.
+  bool StartApplyPose(vtkMRMLReposePoseNode* pose, const std::string& outputFolder = "");
+  bool IsJobRunning() const;
+  double GetJobProgress() const;
+  std::string GetJobStage() const;
+  void CancelJob();
+  enum JobStatus { JobIdle, JobRunning, JobSucceeded, JobCancelled, JobFailed };
+  int WaitForJob();
+  int PollJob();
+  // The segmentation node the last ApplyPose job made (null before).
+  vtkMRMLReposeSegmentationNode* GetLastPosedSegmentation() const;
+
+  // Pose edits, undoable: the group's transform (rotation about `axis` through `pivot` by
+  // `angleDeg`, then `translation`) in the pose's current keyframe, or in the pose itself when it
+  // has none. False with a message for an unknown group or a fixed one.
+  bool SetPoseGroupTransform(vtkMRMLReposePoseNode* pose, const std::string& group,
+                             const std::array<double, 3>& axis, double angleDeg,
+                             const std::array<double, 3>& pivot,
+                             const std::array<double, 3>& translation);
+  bool Undo();
+  bool Redo();
+  bool CanUndo() const;
+  bool CanRedo() const;
+
+  // A scene folder: scene.json and the data files its nodes name (G, S and image as .nii.gz,
+  // cage .vtk, transfer mesh .vtu, poses .pose.json). Saving writes every file atomically and
+  // scene.json last; loading replaces the scene only if every file read.
+  bool SaveScene(const std::string& folder);
+  bool LoadScene(const std::string& folder);
+
  protected:
   vtkSlicerReposeLogic();
   ~vtkSlicerReposeLogic() override;
@@ -68,4 +130,12 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   int VolumeLabelsPresent = -1;
   std::string VolumePath;
   std::string LastErrorMessage;
+
+  vtkSmartPointer<vtkMRMLReposeScene> Scene;
+  std::unique_ptr<vtkSlicerReposeJob> Job;
+  vtkSmartPointer<vtkMRMLReposeSegmentationNode> LastPosedSegmentation;
+  struct PoseEdit {
+    std::string nodeID, before, after;
+  };
+  std::vector<PoseEdit> UndoStack, RedoStack;
 };

@@ -1,0 +1,489 @@
+// vtkSlicerReposeLogic, the pipeline half: segmentation and pose nodes from files, the rig (cage
+// and transfer mesh) and posed volumes made by jobs on a worker thread, undoable pose edits, and
+// scene folders. Node data is converted to Core types on the calling thread before a job starts
+// and back when it is committed, so the worker never touches a VTK object the caller owns.
+#include "vtkMRMLReposeCageNode.h"
+#include "vtkMRMLReposeParametersNode.h"
+#include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkMRMLReposeTransferMeshNode.h"
+#include "vtkSlicerReposeJob.h"
+#include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeMeshConversion.h"
+#include "vtkSlicerReposeVolumeConversion.h"
+
+#include <repose/io/AtomicOutput.h>
+#include <repose/io/MeshIO.h>
+#include <repose/io/NrrdIO.h>
+#include <repose/io/VolumeIO.h>
+#include <repose/pose/PoseRig.h>
+#include <repose/raster/Rasterizer.h>
+#include <repose/util/Error.h>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using Conversion = vtkSlicerReposeVolumeConversion;
+
+namespace {
+
+std::string stemOf(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  for (const char* ext : {".nii.gz", ".seg.nrrd", ".pose.json", ".nii", ".nrrd", ".nhdr"})
+    if (name.size() > std::strlen(ext) &&
+        name.compare(name.size() - std::strlen(ext), std::strlen(ext), ext) == 0)
+      return name.substr(0, name.size() - std::strlen(ext));
+  return name;
+}
+
+// S of a segmentation node, or the body mask of G (label 1 where G is not 0) when it has none.
+repose::Volume partsOf(vtkMRMLReposeSegmentationNode* seg) {
+  if (seg->GetBodyPartMap()) return Conversion::FromImageData(seg->GetBodyPartMap());
+  const repose::Volume G = Conversion::FromImageData(seg->GetLabelMap());
+  repose::Volume mask(G.geometry(), repose::ScalarType::UInt8);
+  repose::dispatchScalar(G.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    for (std::int64_t v = 0; v < G.numVoxels(); ++v)
+      mask.data<std::uint8_t>()[v] = G.data<T>()[v] != 0;
+  });
+  repose::LabelTable t;
+  t.set({1, "body"});
+  mask.labels() = t;
+  mask.setLabelMap(true);
+  return mask;
+}
+
+void writeTextAtomically(const std::string& text, const std::string& path) {
+  repose::AtomicOutput out(path);
+  {
+    std::ofstream f(out.tempPath());
+    f << text;
+    if (!f.flush()) throw repose::Error(path + ": cannot write");
+  }
+  out.commit();
+}
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw repose::Error(path + ": cannot open");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+void vtkSlicerReposeLogic::SetScene(vtkMRMLReposeScene* scene) {
+  if (!scene || scene == this->Scene) return;
+  this->Scene = scene;
+  this->UndoStack.clear();
+  this->RedoStack.clear();
+  this->Modified();
+}
+vtkMRMLReposeScene* vtkSlicerReposeLogic::GetScene() const {
+  return this->Scene;
+}
+
+vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::string& labels,
+                                                                     const std::string& parts,
+                                                                     const std::string& image) {
+  this->LastErrorMessage.clear();
+  try {
+    const repose::Volume G = repose::readVolume(labels);
+    if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
+    auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
+    node->SetName(stemOf(labels));
+    node->SetLabelMap(Conversion::ToImageData(G));
+    for (const auto& [path, setter] :
+         {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
+          std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
+      if (path.empty()) continue;
+      const repose::Volume v = repose::readVolume(path);
+      if (v.dims() != G.dims() || !v.geometry().ijkToRas.isApprox(G.geometry().ijkToRas, 1e-6))
+        throw repose::Error(path + ": not on the grid of " + labels);
+      (node->*setter)(Conversion::ToImageData(v));
+    }
+    this->Scene->AddNode(node);
+    return node;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return nullptr;
+  }
+}
+
+vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {
+  this->LastErrorMessage.clear();
+  try {
+    const repose::Pose pose = repose::readPoseFile(path);
+    auto node = vtkSmartPointer<vtkMRMLReposePoseNode>::New();
+    node->SetName(pose.name.empty() ? stemOf(path) : pose.name);
+    node->SetPoseJSON(repose::poseToJson(pose));
+    this->Scene->AddNode(node);
+    return node;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return nullptr;
+  }
+}
+
+bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
+                                         vtkMRMLReposePoseNode* poseNode) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!seg || !seg->GetLabelMap() || !poseNode)
+      throw repose::Error("building the rig needs a segmentation with a label map and a pose");
+    if (this->Job->IsRunning()) throw repose::Error("another job is running");
+    auto parts = std::make_shared<repose::Volume>(partsOf(seg));
+    const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    const std::vector<repose::LimbSeparation> separations =
+        repose::resolveSeparations(pose, parts->labels());
+    repose::RigSettings settings;
+    if (this->ParameterNode) {
+      settings.cageVertices = this->ParameterNode->GetCageVertexCount();
+      settings.dilateMm = this->ParameterNode->GetCageDilationMm();
+      settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
+    }
+    vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
+    vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
+    this->Job->Start("rig", [=](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
+      auto geometry = std::make_shared<repose::RigGeometry>(
+          repose::buildRigGeometry(*parts, separations, settings, progress));
+      auto handles = std::make_shared<std::vector<repose::RigidHandle>>(
+          repose::resolveHandles(pose, geometry->cage, geometry->mesh, parts->labels()));
+      return [=] {
+        auto cage = vtkSmartPointer<vtkMRMLReposeCageNode>::New();
+        cage->SetName(segRef->GetName() + " cage");
+        cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(geometry->cage));
+        cage->SetTargetVertexCount(settings.cageVertices);
+        cage->SetDilationMm(settings.dilateMm);
+        std::vector<vtkMRMLReposeCageNode::HandleGroup> groups;
+        for (std::size_t g = 0; g < handles->size(); ++g)
+          groups.push_back({pose.groups[g].name, (*handles)[g].cageVertices});
+        cage->SetHandleGroups(groups);
+        cage->SetNodeReferenceID("segmentation", segRef->GetID());
+        auto mesh = vtkSmartPointer<vtkMRMLReposeTransferMeshNode>::New();
+        mesh->SetName(segRef->GetName() + " transfer mesh");
+        mesh->SetMesh(vtkSlicerReposeMeshConversion::ToUnstructuredGrid(geometry->mesh));
+        mesh->SetSizeMm(settings.meshMm);
+        this->Scene->AddNode(cage);
+        mesh->SetNodeReferenceID("segmentation", segRef->GetID());
+        mesh->SetNodeReferenceID("cage", cage->GetID());
+        this->Scene->AddNode(mesh);
+        const int state = poseRef->StartModify();
+        poseRef->SetNodeReferenceID("segmentation", segRef->GetID());
+        poseRef->SetNodeReferenceID("cage", cage->GetID());
+        poseRef->SetNodeReferenceID("transfer_mesh", mesh->GetID());
+        poseRef->EndModify(state);
+      };
+    });
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
+                                          const std::string& outputFolder) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!poseNode) throw repose::Error("no pose");
+    if (this->Job->IsRunning()) throw repose::Error("another job is running");
+    auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
+        this->Scene->GetReferencedNode(poseNode, "segmentation"));
+    auto* cageNode =
+        vtkMRMLReposeCageNode::SafeDownCast(this->Scene->GetReferencedNode(poseNode, "cage"));
+    auto* meshNode = vtkMRMLReposeTransferMeshNode::SafeDownCast(
+        this->Scene->GetReferencedNode(poseNode, "transfer_mesh"));
+    if (!seg || !cageNode || !meshNode)
+      throw repose::Error("pose " + poseNode->GetName() +
+                          " has no segmentation, cage and transfer mesh yet (build the rig)");
+    if (!outputFolder.empty() && !fs::is_directory(fs::absolute(outputFolder).parent_path()))
+      throw repose::Error(outputFolder + ": its parent folder does not exist");
+    auto G = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
+    auto S = std::make_shared<repose::Volume>(partsOf(seg));
+    std::shared_ptr<repose::Volume> I;
+    if (seg->GetImage())
+      I = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetImage()));
+    repose::RigGeometry geometry{
+        vtkSlicerReposeMeshConversion::FromPolyData(cageNode->GetMesh()),
+        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
+    const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
+    vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
+    vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
+    this->Job->Start(
+        "pose",
+        [=, geometry = std::move(geometry)](
+            const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
+          repose::reportProgress(progress, 0, "embedding");
+          const repose::PoseRig rig(std::move(geometry), pose, S->labels());
+          const repose::PoseRig::Frame f = rig.frame(std::min(frame, rig.frameCount() - 1));
+          const repose::VolumeGeometry grid = repose::deformedGrid(G->geometry(), f.deformed);
+          repose::RasterOptions ro;
+          const std::vector<std::uint8_t> outer = repose::outerFaces(rig.mesh());
+          ro.outerFaces = &outer;
+          ro.progress = [&](double x, const std::string& stage) {
+            return progress(0.1 + 0.6 * x, stage);
+          };
+          auto posedG = std::make_shared<repose::Volume>(
+              repose::rasterizeLabels(*G, rig.mesh(), f.deformed, grid, ro));
+          ro.progress = [&](double x, const std::string& stage) {
+            return progress(0.7 + 0.1 * x, stage);
+          };
+          auto posedS = std::make_shared<repose::Volume>(
+              repose::rasterizeLabels(*S, rig.mesh(), f.deformed, grid, ro));
+          std::shared_ptr<repose::Volume> posedI;
+          if (I)
+            posedI = std::make_shared<repose::Volume>(
+                repose::rasterizeImage(*I, rig.mesh(), f.deformed, grid, 0, ro));
+          auto field = std::make_shared<std::vector<float>>();
+          if (!outputFolder.empty())
+            *field = repose::rasterizeDisplacement(rig.mesh(), f.deformed, G->geometry(), grid, ro);
+          repose::reportProgress(progress, 1, "posed");
+          return [=] {
+            if (!outputFolder.empty()) {
+              fs::create_directories(outputFolder);
+              const fs::path out = outputFolder;
+              repose::writeVolume(*posedG, (out / "posed_G.nii.gz").string());
+              repose::writeVolume(*posedS, (out / "posed_S.nii.gz").string());
+              if (posedI) repose::writeVolume(*posedI, (out / "posed_image.nii.gz").string());
+              repose::writeDisplacementFieldNrrd(*field, grid, (out / "transform.nrrd").string());
+            }
+            auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
+            node->SetName(segRef->GetName() + " " + f.name);
+            node->SetLabelMap(Conversion::ToImageData(*posedG));
+            node->SetBodyPartMap(Conversion::ToImageData(*posedS));
+            if (posedI) node->SetImage(Conversion::ToImageData(*posedI));
+            node->SetNodeReferenceID("source", segRef->GetID());
+            node->SetNodeReferenceID("pose", poseRef->GetID());
+            this->Scene->AddNode(node);
+            this->LastPosedSegmentation = node;
+          };
+        });
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::IsJobRunning() const {
+  return this->Job->IsRunning();
+}
+double vtkSlicerReposeLogic::GetJobProgress() const {
+  return this->Job->GetProgress();
+}
+std::string vtkSlicerReposeLogic::GetJobStage() const {
+  return this->Job->GetStage();
+}
+void vtkSlicerReposeLogic::CancelJob() {
+  this->Job->Cancel();
+}
+
+namespace {
+int toStatus(vtkSlicerReposeJob::Status s) {
+  switch (s) {
+    case vtkSlicerReposeJob::Running:
+      return vtkSlicerReposeLogic::JobRunning;
+    case vtkSlicerReposeJob::Succeeded:
+      return vtkSlicerReposeLogic::JobSucceeded;
+    case vtkSlicerReposeJob::Cancelled:
+      return vtkSlicerReposeLogic::JobCancelled;
+    case vtkSlicerReposeJob::Failed:
+      return vtkSlicerReposeLogic::JobFailed;
+    default:
+      return vtkSlicerReposeLogic::JobIdle;
+  }
+}
+}  // namespace
+
+int vtkSlicerReposeLogic::WaitForJob() {
+  const int status = toStatus(this->Job->Wait());
+  if (status == JobFailed) this->LastErrorMessage = this->Job->GetLastError();
+  if (status == JobSucceeded) this->Modified();
+  return status;
+}
+
+int vtkSlicerReposeLogic::PollJob() {
+  const int status = toStatus(this->Job->Poll());
+  if (status == JobFailed) this->LastErrorMessage = this->Job->GetLastError();
+  if (status == JobSucceeded) this->Modified();
+  return status;
+}
+
+vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::GetLastPosedSegmentation() const {
+  return this->LastPosedSegmentation;
+}
+
+bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
+                                                 const std::string& group,
+                                                 const std::array<double, 3>& axis, double angleDeg,
+                                                 const std::array<double, 3>& pivot,
+                                                 const std::array<double, 3>& translation) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!node) throw repose::Error("no pose");
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    const auto it = std::find_if(pose.groups.begin(), pose.groups.end(),
+                                 [&](const repose::PoseGroup& g) { return g.name == group; });
+    if (it == pose.groups.end())
+      throw repose::Error("pose " + node->GetName() + ": no group \"" + group + "\"");
+    if (it->fixed)
+      throw repose::Error("pose " + node->GetName() + ": group \"" + group + "\" is fixed");
+    repose::PoseTransform t;
+    t.axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
+    if (t.axis.norm() == 0) throw repose::Error("the rotation axis is zero");
+    t.axis.normalize();
+    t.angleDeg = angleDeg;
+    t.pivot = Eigen::Vector3d(pivot[0], pivot[1], pivot[2]);
+    t.translation = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+    if (pose.keyframes.empty()) {
+      it->transform = t;
+    } else {
+      auto& k =
+          pose.keyframes[std::min<std::size_t>(node->GetCurrentFrame(), pose.keyframes.size() - 1)];
+      auto entry = std::find_if(k.transforms.begin(), k.transforms.end(),
+                                [&](const auto& e) { return e.first == group; });
+      if (entry == k.transforms.end())
+        k.transforms.emplace_back(group, t);
+      else
+        entry->second = t;
+    }
+    const std::string before = node->GetPoseJSON(), after = repose::poseToJson(pose);
+    if (after == before) return true;
+    this->UndoStack.push_back({node->GetID(), before, after});
+    this->RedoStack.clear();
+    node->SetPoseJSON(after);
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::CanUndo() const {
+  return !this->UndoStack.empty();
+}
+bool vtkSlicerReposeLogic::CanRedo() const {
+  return !this->RedoStack.empty();
+}
+
+bool vtkSlicerReposeLogic::Undo() {
+  if (this->UndoStack.empty()) return false;
+  const PoseEdit edit = this->UndoStack.back();
+  this->UndoStack.pop_back();
+  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(edit.nodeID)))
+    node->SetPoseJSON(edit.before);
+  this->RedoStack.push_back(edit);
+  return true;
+}
+
+bool vtkSlicerReposeLogic::Redo() {
+  if (this->RedoStack.empty()) return false;
+  const PoseEdit edit = this->RedoStack.back();
+  this->RedoStack.pop_back();
+  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(edit.nodeID)))
+    node->SetPoseJSON(edit.after);
+  this->UndoStack.push_back(edit);
+  return true;
+}
+
+bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!fs::is_directory(fs::absolute(folder).parent_path()))
+      throw repose::Error(folder + ": its parent folder does not exist");
+    fs::create_directories(folder);
+    const fs::path dir = folder;
+    for (int n = 0; n < this->Scene->GetNumberOfNodes(); ++n) {
+      vtkMRMLReposeNode* node = this->Scene->GetNthNode(n);
+      const std::string id = node->GetID();
+      if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
+        const int state = seg->StartModify();
+        for (auto [image, setter, suffix] :
+             {std::tuple{seg->GetLabelMap(), &vtkMRMLReposeSegmentationNode::SetLabelMapFileName,
+                         "_G"},
+              std::tuple{seg->GetBodyPartMap(),
+                         &vtkMRMLReposeSegmentationNode::SetBodyPartMapFileName, "_S"},
+              std::tuple{seg->GetImage(), &vtkMRMLReposeSegmentationNode::SetImageFileName,
+                         "_image"}}) {
+          const std::string name = image ? id + suffix + ".nii.gz" : "";
+          if (image) repose::writeVolume(Conversion::FromImageData(image), (dir / name).string());
+          (seg->*setter)(name);
+        }
+        seg->EndModify(state);
+      } else if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node)) {
+        cage->SetFileName(id + ".vtk");
+        repose::writeTriangleMesh(vtkSlicerReposeMeshConversion::FromPolyData(cage->GetMesh()),
+                                  (dir / cage->GetFileName()).string());
+      } else if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node)) {
+        tm->SetFileName(id + ".vtu");
+        repose::writeTransferMesh(
+            vtkSlicerReposeMeshConversion::FromUnstructuredGrid(tm->GetMesh()),
+            (dir / tm->GetFileName()).string());
+      } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
+        pose->SetFileName(id + ".pose.json");
+        writeTextAtomically(pose->GetPoseJSON(), (dir / pose->GetFileName()).string());
+      }
+    }
+    writeTextAtomically(this->Scene->WriteJSON() + "\n", (dir / "scene.json").string());
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
+  this->LastErrorMessage.clear();
+  try {
+    const fs::path dir = folder;
+    vtkNew<vtkMRMLReposeScene> loaded;
+    std::string error;
+    if (!loaded->ReadJSON(readText((dir / "scene.json").string()), &error))
+      throw repose::Error((dir / "scene.json").string() + ": " + error);
+    auto need = [&](const std::string& name, vtkMRMLReposeNode* node) {
+      if (name.empty())
+        throw repose::Error(folder + ": node " + node->GetID() + " names no data file");
+      return (dir / name).string();
+    };
+    for (int n = 0; n < loaded->GetNumberOfNodes(); ++n) {
+      vtkMRMLReposeNode* node = loaded->GetNthNode(n);
+      if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
+        seg->SetLabelMap(
+            Conversion::ToImageData(repose::readVolume(need(seg->GetLabelMapFileName(), seg))));
+        if (!seg->GetBodyPartMapFileName().empty())
+          seg->SetBodyPartMap(Conversion::ToImageData(
+              repose::readVolume((dir / seg->GetBodyPartMapFileName()).string())));
+        if (!seg->GetImageFileName().empty())
+          seg->SetImage(Conversion::ToImageData(
+              repose::readVolume((dir / seg->GetImageFileName()).string())));
+      } else if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node)) {
+        cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(
+            repose::readTriangleMesh(need(cage->GetFileName(), cage))));
+      } else if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node)) {
+        tm->SetMesh(vtkSlicerReposeMeshConversion::ToUnstructuredGrid(
+            repose::readTransferMesh(need(tm->GetFileName(), tm))));
+      } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
+        const std::string path = need(pose->GetFileName(), pose);
+        pose->SetPoseJSON(repose::poseToJson(repose::readPoseFile(path)));
+      }
+    }
+    this->Scene->Clear();
+    for (int n = 0; n < loaded->GetNumberOfNodes(); ++n)
+      this->Scene->AddNode(loaded->GetNthNode(n));
+    this->UndoStack.clear();
+    this->RedoStack.clear();
+    this->LastPosedSegmentation = nullptr;
+    this->Modified();
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}

@@ -1,0 +1,159 @@
+// The Logic's pipeline on nodes, on the 8 mm phantom: rig and pose jobs on a worker with progress,
+// their nodes committed on this thread; a cancelled job leaves the scene and the output folder as
+// they were; pose edits undo and redo; a saved scene folder loaded into a new logic poses the
+// body bit for bit as the original did.
+#include "vtkMRMLReposeCageNode.h"
+#include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkMRMLReposeTransferMeshNode.h"
+#include "vtkSlicerReposeLogic.h"
+
+#include "TestPaths.h"
+
+#include <repose/io/VolumeIO.h>
+#include <repose/phantom/Phantom.h>
+
+#include <gtest/gtest.h>
+
+#include <vtkNew.h>
+#include <vtkPointData.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <thread>
+
+using namespace repose::test;
+
+namespace {
+
+std::string suite(const std::string& name) {
+  return std::string(REPOSE_SOURCE_DIR) + "/bench/poses/" + name + ".pose.json";
+}
+
+struct PhantomFiles {
+  ScratchDir dir{"logic"};
+  std::string G, S;
+  PhantomFiles() {
+    repose::PhantomOptions po;
+    po.voxelMm = 8;
+    const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+    G = dir.file("G.nii.gz"), S = dir.file("S.nii.gz");
+    repose::writeVolume(organs, G);
+    repose::writeVolume(parts, S);
+  }
+};
+
+bool sameVoxels(vtkImageData* a, vtkImageData* b) {
+  if (!a || !b) return false;
+  int da[3], db[3];
+  a->GetDimensions(da);
+  b->GetDimensions(db);
+  if (!std::equal(da, da + 3, db)) return false;
+  vtkDataArray *x = a->GetPointData()->GetScalars(), *y = b->GetPointData()->GetScalars();
+  return x->GetDataType() == y->GetDataType() && x->GetDataSize() == y->GetDataSize() &&
+         std::memcmp(x->GetVoidPointer(0), y->GetVoidPointer(0),
+                     std::size_t(x->GetDataSize()) * std::size_t(x->GetDataTypeSize())) == 0;
+}
+
+}  // namespace
+
+TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
+  PhantomFiles files;
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkMRMLReposeScene* scene = logic->GetScene();
+  auto* seg = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
+  auto* pose = logic->AddPose(suite("elbow90"));
+  ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
+  EXPECT_EQ(scene->GetNumberOfNodes(), 2);
+
+  // Posing before the rig exists is refused with a message, nothing starts.
+  EXPECT_FALSE(logic->StartApplyPose(pose));
+  EXPECT_NE(logic->GetLastErrorMessage().find("build the rig"), std::string::npos);
+
+  // The rig on the worker; progress is visible while it runs; nodes appear only at commit.
+  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  EXPECT_FALSE(logic->StartBuildRig(seg, pose));  // one job at a time
+  double last = 0;
+  while (logic->IsJobRunning() && logic->PollJob() == vtkSlicerReposeLogic::JobRunning) {
+    EXPECT_EQ(scene->GetNumberOfNodes(), 2);
+    last = std::max(last, logic->GetJobProgress());
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_EQ(scene->GetNodesByClass("vtkMRMLReposeCageNode").size(), 1u);
+  EXPECT_EQ(scene->GetNodesByClass("vtkMRMLReposeTransferMeshNode").size(), 1u);
+  auto* cage = vtkMRMLReposeCageNode::SafeDownCast(scene->GetReferencedNode(pose, "cage"));
+  ASSERT_TRUE(cage);
+  ASSERT_EQ(cage->GetHandleGroups().size(), 2u);
+  EXPECT_EQ(cage->GetHandleGroups()[0].name, "left forearm and hand");
+  EXPECT_EQ(
+      std::size_t(cage->GetMesh()->GetNumberOfPoints()),
+      cage->GetHandleGroups()[0].vertices.size() + cage->GetHandleGroups()[1].vertices.size());
+
+  // A cancelled pose job: no new node, no output folder.
+  const std::string cancelledOut = files.dir.file("cancelled");
+  ASSERT_TRUE(logic->StartApplyPose(pose, cancelledOut));
+  logic->CancelJob();
+  EXPECT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobCancelled);
+  EXPECT_EQ(scene->GetNumberOfNodes(), 4);
+  EXPECT_FALSE(std::filesystem::exists(cancelledOut));
+  EXPECT_EQ(logic->GetLastPosedSegmentation(), nullptr);
+
+  // The pose: a posed segmentation node and the files.
+  const std::string out = files.dir.file("posed");
+  ASSERT_TRUE(logic->StartApplyPose(pose, out));
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  vtkMRMLReposeSegmentationNode* posed = logic->GetLastPosedSegmentation();
+  ASSERT_TRUE(posed);
+  EXPECT_EQ(scene->GetReferencedNode(posed, "source"), seg);
+  for (const char* f : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd"})
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + f)) << f;
+  const repose::Volume written = repose::readVolume(out + "/posed_G.nii.gz");
+  EXPECT_EQ(written.dims()[0], posed->GetLabelMap()->GetDimensions()[0]);
+
+  // Undo and redo of a pose edit.
+  const std::string original = pose->GetPoseJSON();
+  EXPECT_FALSE(logic->CanUndo());
+  ASSERT_TRUE(logic->SetPoseGroupTransform(pose, "left forearm and hand", {1, 0, 0}, 45,
+                                           {-176, -14, 806}, {0, 0, 0}));
+  const std::string edited = pose->GetPoseJSON();
+  EXPECT_NE(edited, original);
+  EXPECT_NE(edited.find("45"), std::string::npos);
+  EXPECT_TRUE(logic->Undo());
+  EXPECT_EQ(pose->GetPoseJSON(), original);
+  EXPECT_TRUE(logic->CanRedo());
+  EXPECT_TRUE(logic->Redo());
+  EXPECT_EQ(pose->GetPoseJSON(), edited);
+  EXPECT_TRUE(logic->Undo());
+  EXPECT_FALSE(logic->SetPoseGroupTransform(pose, "body", {1, 0, 0}, 10, {0, 0, 0}, {0, 0, 0}));
+  EXPECT_NE(logic->GetLastErrorMessage().find("fixed"), std::string::npos);
+  EXPECT_FALSE(logic->SetPoseGroupTransform(pose, "tail", {1, 0, 0}, 10, {0, 0, 0}, {0, 0, 0}));
+  EXPECT_EQ(pose->GetPoseJSON(), original);
+
+  // Save, load into a new logic, pose again: bit-identical.
+  const std::string sceneDir = files.dir.file("scene");
+  ASSERT_TRUE(logic->SaveScene(sceneDir)) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(std::filesystem::exists(sceneDir + "/scene.json"));
+  vtkNew<vtkSlicerReposeLogic> other;
+  ASSERT_TRUE(other->LoadScene(sceneDir)) << other->GetLastErrorMessage();
+  EXPECT_EQ(other->GetScene()->GetNumberOfNodes(), scene->GetNumberOfNodes());
+  auto* loadedPose =
+      vtkMRMLReposePoseNode::SafeDownCast(other->GetScene()->GetNodeByID(pose->GetID()));
+  ASSERT_TRUE(loadedPose);
+  ASSERT_TRUE(other->StartApplyPose(loadedPose));
+  ASSERT_EQ(other->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << other->GetLastErrorMessage();
+  EXPECT_TRUE(sameVoxels(other->GetLastPosedSegmentation()->GetLabelMap(), posed->GetLabelMap()));
+  EXPECT_TRUE(
+      sameVoxels(other->GetLastPosedSegmentation()->GetBodyPartMap(), posed->GetBodyPartMap()));
+
+  // A scene folder with a missing data file is refused and the scene kept.
+  const int nodesBefore = other->GetScene()->GetNumberOfNodes();
+  std::filesystem::remove(sceneDir + "/" + cage->GetFileName());
+  EXPECT_FALSE(other->LoadScene(sceneDir));
+  EXPECT_NE(other->GetLastErrorMessage().find(cage->GetFileName()), std::string::npos);
+  EXPECT_EQ(other->GetScene()->GetNumberOfNodes(), nodesBefore);
+}
