@@ -67,6 +67,57 @@ json sceneKey(const std::string& partsPath, const Pose& pose, const RigSettings&
           {"separations", separations}};
 }
 
+// The scene folder of the module (docs/FORMATS.md, "Scene folders"): scene.json in the MRML
+// scene format, which the Logic and the workbench load, naming the input volumes where they are
+// (absolute paths: nothing large is copied), the cage, transfer mesh and pose written beside it,
+// and what the rig was built for, so the next run reuses it only for the same S and settings.
+void writeSceneFolder(const fs::path& scene, const PoseRig& rig, const json& key,
+                      const std::string& input, const std::string& parts, const std::string& image,
+                      const RigSettings& rs) {
+  fs::create_directories(scene);
+  writeTriangleMesh(rig.cage(), (scene / "cage.vtk").string());
+  writeTransferMesh(rig.mesh(), (scene / "tm.vtu").string());
+  const std::string poseFile = (rig.pose().name.empty() ? "pose" : rig.pose().name) + ".pose.json";
+  writePoseFile(rig.pose(), (scene / poseFile).string());
+  json groups = json::array();
+  for (std::size_t g = 0; g < rig.handles().size(); ++g)
+    groups.push_back(
+        {{"name", rig.pose().groups[g].name}, {"vertices", rig.handles()[g].cageVertices}});
+  const std::string seg = "vtkMRMLReposeSegmentationNode1", cage = "vtkMRMLReposeCageNode1",
+                    mesh = "vtkMRMLReposeTransferMeshNode1";
+  const json nodes = json::array(
+      {{{"class", "vtkMRMLReposeSegmentationNode"},
+        {"id", seg},
+        {"name", fs::path(input).filename().string()},
+        {"references", json::object()},
+        {"LabelMapFileName", fs::absolute(input).string()},
+        {"BodyPartMapFileName", fs::absolute(parts).string()},
+        {"ImageFileName", image.empty() ? "" : fs::absolute(image).string()}},
+       {{"class", "vtkMRMLReposeCageNode"},
+        {"id", cage},
+        {"name", "cage"},
+        {"references", {{"segmentation", seg}}},
+        {"FileName", "cage.vtk"},
+        {"TargetVertexCount", rs.cageVertices},
+        {"DilationMm", rs.dilateMm},
+        {"HandleGroups", groups}},
+       {{"class", "vtkMRMLReposeTransferMeshNode"},
+        {"id", mesh},
+        {"name", "transfer mesh"},
+        {"references", {{"cage", cage}, {"segmentation", seg}}},
+        {"FileName", "tm.vtu"},
+        {"SizeMm", rs.meshMm}},
+       {{"class", "vtkMRMLReposePoseNode"},
+        {"id", "vtkMRMLReposePoseNode1"},
+        {"name", rig.pose().name},
+        {"references", {{"cage", cage}, {"segmentation", seg}, {"transfer_mesh", mesh}}},
+        {"FileName", poseFile},
+        {"CurrentFrame", 0}}});
+  writeJsonAtomically(
+      {{"format", "repose-scene"}, {"version", 2}, {"nodes", nodes}, {"built_for", key}},
+      (scene / "scene.json").string());
+}
+
 }  // namespace
 
 int runPose(const Args& args) {
@@ -150,32 +201,31 @@ int runPose(const Args& args) {
     if (f) {
       const json saved = json::parse(f, nullptr, false);
       if (!saved.is_discarded() && saved.value("built_for", json()) == key) {
-        geometry.cage = readTriangleMesh((scene / saved["cage"].get<std::string>()).string());
-        geometry.mesh =
-            readTransferMesh((scene / saved["transfer_mesh"].get<std::string>()).string());
-        reused = true;
-        say("reusing the cage and transfer mesh of " + scene.string());
+        std::string cageFile, meshFile;
+        for (const json& node : saved.value("nodes", json::array())) {
+          if (node.value("class", "") == "vtkMRMLReposeCageNode")
+            cageFile = node.value("FileName", "");
+          if (node.value("class", "") == "vtkMRMLReposeTransferMeshNode")
+            meshFile = node.value("FileName", "");
+        }
+        if (!cageFile.empty() && !meshFile.empty()) {
+          geometry.cage = readTriangleMesh((scene / cageFile).string());
+          geometry.mesh = readTransferMesh((scene / meshFile).string());
+          reused = true;
+          say("reusing the cage and transfer mesh of " + scene.string());
+        }
       }
     }
   }
   if (!reused) {
     say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
     geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress());
-    if (p.has("scene")) {
-      const fs::path scene = p.get("scene");
-      fs::create_directories(scene);
-      writeTriangleMesh(geometry.cage, (scene / "cage.vtk").string());
-      writeTransferMesh(geometry.mesh, (scene / "tm.vtu").string());
-      writeJsonAtomically({{"format", "repose-cage-cache"},
-                           {"version", 1},
-                           {"cage", "cage.vtk"},
-                           {"transfer_mesh", "tm.vtu"},
-                           {"built_for", key}},
-                          (scene / "scene.json").string());
-    }
   }
   say("embedding the mesh in the cage");
   const PoseRig rig(std::move(geometry), pose, parts.labels(), threads);
+  if (p.has("scene") && !reused)
+    writeSceneFolder(p.get("scene"), rig, key, p.get("input"), p.get("parts"),
+                     p.has("image") ? p.get("image") : "", rs);
   const TriangleMesh& cage = rig.cage();
   const TransferMesh& mesh = rig.mesh();
   std::vector<std::string> groupNames;

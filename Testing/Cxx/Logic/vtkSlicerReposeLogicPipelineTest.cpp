@@ -9,6 +9,7 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
 
+#include "CommandRunner.h"
 #include "TestPaths.h"
 
 #include <repose/io/VolumeIO.h>
@@ -156,4 +157,34 @@ TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
   EXPECT_FALSE(other->LoadScene(sceneDir));
   EXPECT_NE(other->GetLastErrorMessage().find(cage->GetFileName()), std::string::npos);
   EXPECT_EQ(other->GetScene()->GetNumberOfNodes(), nodesBefore);
+}
+
+// A scene folder written by `repose pose --scene` is a module scene: the Logic loads it (the
+// inputs named where they are) and poses the body exactly as the command line did.
+TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
+  PhantomFiles files;
+  const std::string scene = files.dir.file("scene"), out = files.dir.file("cli");
+  const CommandResult cli = runCommand(
+      "repose", "pose --input " + shellQuote(files.G) + " --parts " + shellQuote(files.S) +
+                    " --pose " + shellQuote(suite("elbow90")) + " --scene " + shellQuote(scene) +
+                    " --out " + shellQuote(out) + " --json");
+  ASSERT_EQ(cli.exitCode, 0) << cli.err;
+  vtkNew<vtkSlicerReposeLogic> logic;
+  ASSERT_TRUE(logic->LoadScene(scene)) << logic->GetLastErrorMessage();
+  const auto poses = logic->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode");
+  ASSERT_EQ(poses.size(), 1u);
+  auto* cage = vtkMRMLReposeCageNode::SafeDownCast(
+      logic->GetScene()->GetNodesByClass("vtkMRMLReposeCageNode").at(0));
+  EXPECT_EQ(cage->GetHandleGroups().size(), 2u);
+  ASSERT_TRUE(logic->StartApplyPose(vtkMRMLReposePoseNode::SafeDownCast(poses[0])));
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  const repose::Volume expected = repose::readVolume(out + "/posed_G.nii.gz");
+  vtkImageData* got = logic->GetLastPosedSegmentation()->GetLabelMap();
+  int dims[3];
+  got->GetDimensions(dims);
+  ASSERT_EQ(dims[0], expected.dims()[0]);
+  ASSERT_EQ(dims[2], expected.dims()[2]);
+  EXPECT_EQ(0, std::memcmp(got->GetScalarPointer(), expected.data<std::uint8_t>(),
+                           std::size_t(expected.numVoxels())));
 }
