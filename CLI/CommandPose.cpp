@@ -17,6 +17,7 @@
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
 #include "repose/pose/PoseRig.h"
+#include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 
@@ -142,6 +143,9 @@ int runPose(const Args& args) {
       .option("dilate-mm", "MM", "cage distance from the body", "10")
       .option("mesh-mm", "MM", "transfer-mesh tet size (0: 5% of S's diagonal)", "0")
       .option("threads", "N", "worker threads (0: all cores)", "0")
+      .flag("keep-pockets",
+            "keep the background pockets a bent joint traps inside the body (by default they "
+            "are filled from their neighbours; docs/QUALITY.md)")
       .flag("json", "print the frames' reports as JSON on stdout");
   declareMemoryOption(p, "a pose that would need more is refused before the work");
   if (!p.parse(args)) return 0;
@@ -259,16 +263,19 @@ int runPose(const Args& args) {
     const std::vector<std::uint8_t> outer = outerFaces(mesh);
     ro.outerFaces = &outer;
     RasterReport raster;
-    const Volume posedOrgans = rasterizeLabels(organs, mesh, deformed, grid, ro, &raster);
+    Volume posedOrgans = rasterizeLabels(organs, mesh, deformed, grid, ro, &raster);
     ro.progress = {};
-    const Volume posedParts = rasterizeLabels(parts, mesh, deformed, grid, ro);
+    Volume posedParts = rasterizeLabels(parts, mesh, deformed, grid, ro);
+    const std::vector<float> field =
+        rasterizeDisplacement(mesh, deformed, organs.geometry(), grid, ro);
+    PocketReport pockets;
+    if (!p.has("keep-pockets")) pockets = fillPosePockets(posedOrgans, organs, field, &posedParts);
     writeVolume(posedOrgans, (dir / "posed_G.nii.gz").string());
     writeVolume(posedParts, (dir / "posed_S.nii.gz").string());
     if (image)
       writeVolume(rasterizeImage(*image, mesh, deformed, grid, p.getDouble("background"), ro),
                   (dir / "posed_image.nii.gz").string());
-    writeDisplacementFieldNrrd(rasterizeDisplacement(mesh, deformed, organs.geometry(), grid, ro),
-                               grid, (dir / "transform.nrrd").string());
+    writeDisplacementFieldNrrd(field, grid, (dir / "transform.nrrd").string());
 
     PoseReportInput ri;
     ri.organs = &organs, ri.parts = &parts;
@@ -293,7 +300,11 @@ int runPose(const Args& args) {
                    {"tissue_table",
                     tissues ? (p.has("tissues") ? p.get("tissues") : "phantom default") : "none"},
                    {"voxels_in_shell", raster.shellVoxels},
-                   {"raster_inverted_tets", raster.invertedTets}};
+                   {"raster_inverted_tets", raster.invertedTets},
+                   {"pockets",
+                    {{"filled_voxels", pockets.filled},
+                     {"kept_cavity_voxels", pockets.keptCavities},
+                     {"filled", !p.has("keep-pockets")}}}};
     report.update(makePoseReport(ri));
     if (image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
     writeJsonAtomically(report, (dir / "report.json").string());

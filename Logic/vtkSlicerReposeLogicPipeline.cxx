@@ -18,6 +18,7 @@
 #include <repose/io/NrrdIO.h>
 #include <repose/io/VolumeIO.h>
 #include <repose/pose/PoseRig.h>
+#include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/util/Error.h>
 
@@ -241,9 +242,10 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           if (I)
             posedI = std::make_shared<repose::Volume>(
                 repose::rasterizeImage(*I, rig.mesh(), f.deformed, grid, 0, ro));
-          auto field = std::make_shared<std::vector<float>>();
-          if (!outputFolder.empty())
-            *field = repose::rasterizeDisplacement(rig.mesh(), f.deformed, G->geometry(), grid, ro);
+          auto field = std::make_shared<std::vector<float>>(
+              repose::rasterizeDisplacement(rig.mesh(), f.deformed, G->geometry(), grid, ro));
+          // As `repose pose` does: pockets a bent joint traps inside the body are filled.
+          repose::fillPosePockets(*posedG, *G, *field, posedS.get());
           repose::reportProgress(progress, 1, "posed");
           return [=] {
             if (!outputFolder.empty()) {

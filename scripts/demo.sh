@@ -40,10 +40,11 @@ for p in sorted(pathlib.Path(sys.argv[1]).rglob("report.json")):
     rows.append((f"{r['pose']}/{r['frame']}", r["body"]["volume_change_percent"],
                  q["labels_within_1_percent"]["worst_change_percent"],
                  q.get("bones_rigid", {}).get("min_dice", float("nan")),
-                 q["no_new_holes"]["new_enclosed_voxels"], r["mesh"]["inverted_tets"], q["all_met"]))
-print(f"  {'frame':28} {'body %':>8} {'worst label %':>14} {'bones Dice':>10} {'new holes':>9} {'inverted':>8}  all met")
-for f, b, w, d, h, i, a in rows:
-    print(f"  {f:28} {b:8.3f} {w:14.3f} {d:10.3f} {h:9d} {i:8d}  {'yes' if a else 'no'}")
+                 q["no_new_holes"]["new_enclosed_voxels"], r["pockets"]["filled_voxels"],
+                 r["mesh"]["inverted_tets"], q["all_met"]))
+print(f"  {'frame':28} {'body %':>8} {'worst label %':>14} {'bones Dice':>10} {'new holes':>9} {'filled':>7} {'inverted':>8}  all met")
+for f, b, w, d, h, p, i, a in rows:
+    print(f"  {f:28} {b:8.3f} {w:14.3f} {d:10.3f} {h:9d} {p:7d} {i:8d}  {'yes' if a else 'no'}")
 PY
 echo
 echo "Demo outputs are in $DEMO_DIR: phantom*/ (G, S, skeleton, scene/ with cage.vtk and tm.vtu),"

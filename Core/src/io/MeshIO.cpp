@@ -108,7 +108,7 @@ void writeTriangleMesh(const TriangleMesh& mesh, const std::string& path) {
   {
     std::ofstream out(output.tempPath());
     if (!out) throwFileError(path, "cannot create the file");
-    out << std::setprecision(10);
+    out << std::setprecision(17);
     if (obj) {
       out << "# Repose cage, RAS millimetres, outward faces\n";
       for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i)
