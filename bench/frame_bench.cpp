@@ -6,6 +6,7 @@
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
 #include "repose/phantom/Phantom.h"
+#include "repose/pose/PoseRig.h"
 
 #include <benchmark/benchmark.h>
 
@@ -22,6 +23,9 @@ struct Scene {
   TransferMesh mesh;
   std::unique_ptr<CageDeformation> deformation;
   Eigen::MatrixX3d deformedCage;
+  // The suite's arm raised 90 degrees as rigid handle groups (RigidHandles.h) on the same mesh.
+  std::vector<RigidHandle> handles;
+  HandleInfluence influence;
 };
 
 // TM size in mm giving about 36K vertices on the 2 mm phantom (REPOSE_FRAME_TM_MM overrides).
@@ -45,6 +49,11 @@ const Scene& scene() {
     s.deformation = std::make_unique<CageDeformation>(s.mesh, s.cage);
     // Raise the right arm 60 degrees about the shoulder with ARAP: a realistic drag.
     s.deformedCage = bench::raiseRightArm60(s.cage);
+    const Pose pose =
+        readPoseFile(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/arm_raise90.pose.json");
+    s.handles = resolveHandles(pose, s.cage, s.mesh, parts.labels());
+    setMotions(s.handles, pose.frames()[0].second);
+    s.influence = computeHandleInfluence(s.mesh, s.cage, s.handles);
     std::cout << "frame scene: cage " << s.cage.vertices.rows() << " vertices / "
               << s.cage.faces.rows() << " faces, TM " << s.mesh.vertices.rows() << " vertices / "
               << s.mesh.tets.rows() << " tets, V_c "
@@ -63,6 +72,20 @@ void BM_Frame(benchmark::State& state, GreenPrecision precision) {
     benchmark::DoNotOptimize(s.deformation->deform(s.deformedCage, nullptr, precision));
   state.counters["TM_vertices"] = double(s.mesh.vertices.rows());
   state.counters["coefficient_MB"] = double(s.deformation->coefficientBytes()) / 1e6;
+  state.counters["FPS"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+// A frame of a pose of rigid handle groups: the posed cage, Green coordinates, the groups'
+// dual-quaternion blend on every V_c vertex they carry, the rigidity solves.
+void BM_FrameWithHandles(benchmark::State& state, GreenPrecision precision) {
+  const Scene& s = scene();
+  for (auto _ : state) {
+    const Eigen::MatrixX3d cage = poseCage(s.cage, s.handles);
+    benchmark::DoNotOptimize(
+        s.deformation->deform(cage, s.influence, s.handles, nullptr, precision));
+  }
+  state.counters["rigid_vertices"] = double(s.influence.rigidVertices());
   state.counters["FPS"] =
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
@@ -86,6 +109,12 @@ BENCHMARK_CAPTURE(BM_Frame, preview, GreenPrecision::Preview)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Frame, exact, GreenPrecision::Exact)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FrameWithHandles, preview, GreenPrecision::Preview)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FrameWithHandles, exact, GreenPrecision::Exact)
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_FrameGreenProduct, preview, GreenPrecision::Preview)

@@ -29,10 +29,14 @@ float fromHalf(std::uint16_t h) {
 }
 
 // Portable kernel for CPUs without F16C: the same arithmetic, one coefficient at a time.
+// Kernels compute output rows [begin, end): of the whole matrix, or of the matrix rows listed in
+// `rows` when it is not null.
 void multiplyRowsScalar(const std::uint16_t* high, const std::uint16_t* low, Eigen::Index stride,
                         Eigen::Index cols, const double* x0, const double* x1, const double* x2,
-                        std::int64_t begin, std::int64_t end, double* out) {
-  for (std::int64_t r = begin; r < end; ++r) {
+                        const std::int64_t* rows, std::int64_t begin, std::int64_t end,
+                        double* out) {
+  for (std::int64_t o = begin; o < end; ++o) {
+    const std::int64_t r = rows ? rows[o] : o;
     const std::uint16_t* h = high + r * stride;
     const std::uint16_t* l = low ? low + r * stride : nullptr;
     double y0 = 0, y1 = 0, y2 = 0;
@@ -41,7 +45,7 @@ void multiplyRowsScalar(const std::uint16_t* high, const std::uint16_t* low, Eig
           l ? double(fromHalf(h[j]) + kLowUnscale * fromHalf(l[j])) : double(fromHalf(h[j]));
       y0 += c * x0[j], y1 += c * x1[j], y2 += c * x2[j];
     }
-    out[3 * r] = y0, out[3 * r + 1] = y1, out[3 * r + 2] = y2;
+    out[3 * o] = y0, out[3 * o + 1] = y1, out[3 * o + 2] = y2;
   }
 }
 
@@ -68,8 +72,9 @@ __attribute__((target("avx2,fma,f16c"))) double horizontalSum(__m256d v) {
 // Preview: high halves only, float lanes (the displacements are small, so float sums suffice).
 __attribute__((target("avx2,fma,f16c"))) void multiplyRowsPreview(
     const std::uint16_t* high, Eigen::Index stride, const float* x0, const float* x1,
-    const float* x2, std::int64_t begin, std::int64_t end, double* out) {
-  for (std::int64_t r = begin; r < end; ++r) {
+    const float* x2, const std::int64_t* rows, std::int64_t begin, std::int64_t end, double* out) {
+  for (std::int64_t o = begin; o < end; ++o) {
+    const std::int64_t r = rows ? rows[o] : o;
     const std::uint16_t* h = high + r * stride;
     __m256 a0 = _mm256_setzero_ps(), a1 = a0, a2 = a0, b0 = a0, b1 = a0, b2 = a0;
     for (Eigen::Index i = 0; i < stride; i += kLanes) {
@@ -83,17 +88,19 @@ __attribute__((target("avx2,fma,f16c"))) void multiplyRowsPreview(
       b1 = _mm256_fmadd_ps(d, _mm256_loadu_ps(x1 + i + 8), b1);
       b2 = _mm256_fmadd_ps(d, _mm256_loadu_ps(x2 + i + 8), b2);
     }
-    out[3 * r] = horizontalSum(_mm256_add_ps(a0, b0));
-    out[3 * r + 1] = horizontalSum(_mm256_add_ps(a1, b1));
-    out[3 * r + 2] = horizontalSum(_mm256_add_ps(a2, b2));
+    out[3 * o] = horizontalSum(_mm256_add_ps(a0, b0));
+    out[3 * o + 1] = horizontalSum(_mm256_add_ps(a1, b1));
+    out[3 * o + 2] = horizontalSum(_mm256_add_ps(a2, b2));
   }
 }
 
 // Exact: c = high + low / 2^11 in float, accumulated in double lanes.
 __attribute__((target("avx2,fma,f16c"))) void multiplyRowsExact(
     const std::uint16_t* high, const std::uint16_t* low, Eigen::Index stride, const double* x0,
-    const double* x1, const double* x2, std::int64_t begin, std::int64_t end, double* out) {
-  for (std::int64_t r = begin; r < end; ++r) {
+    const double* x1, const double* x2, const std::int64_t* rows, std::int64_t begin,
+    std::int64_t end, double* out) {
+  for (std::int64_t o = begin; o < end; ++o) {
+    const std::int64_t r = rows ? rows[o] : o;
     const std::uint16_t* h = high + r * stride;
     const std::uint16_t* l = low + r * stride;
     const __m256 unscale = _mm256_set1_ps(kLowUnscale);
@@ -111,8 +118,8 @@ __attribute__((target("avx2,fma,f16c"))) void multiplyRowsExact(
       a2 = _mm256_fmadd_pd(lo, _mm256_loadu_pd(x2 + i), a2);
       a2 = _mm256_fmadd_pd(hi, _mm256_loadu_pd(x2 + i + 4), a2);
     }
-    out[3 * r] = horizontalSum(a0), out[3 * r + 1] = horizontalSum(a1);
-    out[3 * r + 2] = horizontalSum(a2);
+    out[3 * o] = horizontalSum(a0), out[3 * o + 1] = horizontalSum(a1);
+    out[3 * o + 2] = horizontalSum(a2);
   }
 }
 #endif
@@ -161,7 +168,16 @@ void CompactGreenMatrix::setRows(Eigen::Index first, const Eigen::MatrixXd& phi,
 
 Eigen::MatrixX3d CompactGreenMatrix::multiply(const Eigen::MatrixX3d& x, bool preview,
                                               int threads) const {
+  return multiplyRows(x, preview, threads, nullptr);
+}
+
+Eigen::MatrixX3d CompactGreenMatrix::multiplyRows(const Eigen::MatrixX3d& x, bool preview,
+                                                  int threads,
+                                                  const std::vector<std::int64_t>* rows) const {
   if (x.rows() != cols_) throw Error("Green coordinates: wrong number of cage values");
+  if (rows)
+    for (const std::int64_t r : *rows)
+      if (r < 0 || r >= rows_) throw Error("Green coordinates: a row out of range");
   // Columns of x, padded with zeros to the stride (the padding coefficients are zero too).
   std::vector<double> xd(static_cast<std::size_t>(3 * stride_), 0.0);
   std::vector<float> xf(xd.size(), 0.0f);
@@ -170,25 +186,29 @@ Eigen::MatrixX3d CompactGreenMatrix::multiply(const Eigen::MatrixX3d& x, bool pr
       xd[k * stride_ + j] = x(j, k);
       xf[k * stride_ + j] = static_cast<float>(x(j, k));
     }
-  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> out(rows_, 3);
+  const std::int64_t n = rows ? std::int64_t(rows->size()) : rows_;
+  const std::int64_t* list = rows ? rows->data() : nullptr;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> out(n, 3);
   const double* d = xd.data();
   const float* f = xf.data();
-  parallelFor(rows_, threads, [&](std::int64_t begin, std::int64_t end) {
+  parallelFor(n, threads, [&](std::int64_t begin, std::int64_t end) {
 #ifdef REPOSE_HAVE_X86
     if (cpuHasF16c()) {
       if (preview)
-        multiplyRowsPreview(high_.data(), stride_, f, f + stride_, f + 2 * stride_, begin, end,
-                            out.data());
+        multiplyRowsPreview(high_.data(), stride_, f, f + stride_, f + 2 * stride_, list, begin,
+                            end, out.data());
       else
-        multiplyRowsExact(high_.data(), low_.data(), stride_, d, d + stride_, d + 2 * stride_,
+        multiplyRowsExact(high_.data(), low_.data(), stride_, d, d + stride_, d + 2 * stride_, list,
                           begin, end, out.data());
       return;
     }
 #endif
     multiplyRowsScalar(high_.data(), preview ? nullptr : low_.data(), stride_, cols_, d,
-                       d + stride_, d + 2 * stride_, begin, end, out.data());
+                       d + stride_, d + 2 * stride_, list, begin, end, out.data());
   });
-  return rowScale_.cwiseInverse().asDiagonal() * out;
+  Eigen::VectorXd inverseScale(n);
+  for (std::int64_t o = 0; o < n; ++o) inverseScale[o] = 1.0 / rowScale_[list ? list[o] : o];
+  return inverseScale.asDiagonal() * out;
 }
 
 }  // namespace repose

@@ -33,6 +33,10 @@ class CompactGreenMatrix {
 
   // y = C x for x (cols by 3); preview reads the high halves only. Rows run on `threads`.
   Eigen::MatrixX3d multiply(const Eigen::MatrixX3d& x, bool preview, int threads) const;
+  // The same for the listed rows only (all when null), in list order; each row's value is
+  // bit-identical to multiply's.
+  Eigen::MatrixX3d multiplyRows(const Eigen::MatrixX3d& x, bool preview, int threads,
+                                const std::vector<std::int64_t>* rows) const;
 
  private:
   Eigen::Index rows_ = 0, cols_ = 0, vertexCols_ = 0, stride_ = 0;  // stride_: cols_ padded to 16

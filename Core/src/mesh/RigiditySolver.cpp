@@ -360,20 +360,41 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
                                          const std::vector<RigidHandle>& handles,
                                          std::vector<Eigen::Matrix3d>* B,
                                          GreenPrecision precision) const {
-  Eigen::MatrixX3d targets = greenPositions(deformedCage, precision);
   if (influence.membership.rows() != Eigen::Index(embedding_.inside.size()))
     throw Error("handle influence computed for another transfer mesh");
   if (influence.membership.cols() != Eigen::Index(handles.size()))
     throw Error("handle influence computed for another list of handle groups");
-  for (Eigen::Index r = 0; r < targets.rows(); ++r) {
-    const int v = embedding_.cageVertices[r];
-    const double w = influence.weight[v];
-    if (w <= 0) continue;
-    const Eigen::Vector3d carried = blendMotions(influence.membership.row(v).transpose(), handles) *
-                                    Eigen::Vector3d(restPositions_.row(r));
-    targets.row(r) = w == 1 ? carried.transpose().eval()
-                            : (targets.row(r) + w * (carried.transpose() - targets.row(r))).eval();
-  }
+  if (deformedCage.rows() != cage_.vertices.rows())
+    throw Error("deformed cage has the wrong number of vertices");
+  // Green positions only where the groups do not carry a vertex alone: in a pose of rigid
+  // groups that is the joints' few rows, so the frame skips most of the dense product.
+  const Eigen::Index n = Eigen::Index(embedding_.cageVertices.size());
+  std::vector<std::int64_t> greenRows;
+  for (Eigen::Index r = 0; r < n; ++r)
+    if (influence.weight[embedding_.cageVertices[r]] < 1) greenRows.push_back(r);
+  const Eigen::MatrixX3d delta = greenCageValues(cage_, deformedCage) - restCageValues_;
+  const Eigen::MatrixX3d green = coefficients_->multiplyRows(
+      delta, precision == GreenPrecision::Preview, threads_, &greenRows);
+  Eigen::MatrixX3d targets(n, 3);
+  std::vector<std::int64_t> greenIndex(n, -1);
+  for (std::size_t k = 0; k < greenRows.size(); ++k) greenIndex[greenRows[k]] = std::int64_t(k);
+  parallelFor(n, threads_, [&](std::int64_t begin, std::int64_t end) {
+    for (std::int64_t r = begin; r < end; ++r) {
+      const int v = embedding_.cageVertices[r];
+      const double w = influence.weight[v];
+      Eigen::RowVector3d g = Eigen::RowVector3d::Zero();
+      if (greenIndex[r] >= 0) g = restPositions_.row(r) + green.row(greenIndex[r]);
+      if (w <= 0) {
+        targets.row(r) = g;
+        continue;
+      }
+      const Eigen::RowVector3d carried =
+          (blendMotions(influence.membership.row(v).transpose(), handles) *
+           Eigen::Vector3d(restPositions_.row(r)))
+              .transpose();
+      targets.row(r) = w == 1 ? carried : (g + w * (carried - g)).eval();
+    }
+  });
   return solver_.solve(targets, B);
 }
 
