@@ -142,6 +142,10 @@ int runPose(const Args& args) {
       .option("cage-vertices", "N", "cage size", "300")
       .option("dilate-mm", "MM", "cage distance from the body", "10")
       .option("mesh-mm", "MM", "transfer-mesh tet size (0: 5% of S's diagonal)", "0")
+      .option("joint-rings", "N",
+              "widen each joint's transition by N rings of mesh vertices (-1: the pose file's "
+              "joint_rings; docs/QUALITY.md)",
+              "-1")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("keep-pockets",
             "keep the background pockets a bent joint traps inside the body (by default they "
@@ -159,6 +163,9 @@ int runPose(const Args& args) {
 
   // Everything that can be refused is checked before the work.
   const Pose pose = readPoseFile(p.get("pose"));
+  const int jointRings = static_cast<int>(p.getInt("joint-rings")) >= 0
+                             ? static_cast<int>(p.getInt("joint-rings"))
+                             : pose.jointRings;
   const std::string outDir = p.get("out");
   for (const char* in : {"input", "parts", "image", "pose"})
     if (p.has(in) && fs::exists(p.get(in)) && fs::exists(outDir) &&
@@ -174,6 +181,8 @@ int runPose(const Args& args) {
   rs.meshMm = p.getDouble("mesh-mm");
   rs.threads = threads;
   if (rs.meshMm < 0) throw UsageError{"--mesh-mm must be >= 0"};
+  if (p.getInt("joint-rings") < -1 || p.getInt("joint-rings") > 8)
+    throw UsageError{"--joint-rings must be -1..8"};
 
   const Volume organs = readVolume(p.get("input"));
   const Volume parts = readVolume(p.get("parts"));
@@ -226,7 +235,7 @@ int runPose(const Args& args) {
     geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress());
   }
   say("embedding the mesh in the cage");
-  const PoseRig rig(std::move(geometry), pose, parts.labels(), threads);
+  const PoseRig rig(std::move(geometry), pose, parts.labels(), threads, jointRings);
   if (p.has("scene") && !reused)
     writeSceneFolder(p.get("scene"), rig, key, p.get("input"), p.get("parts"),
                      p.has("image") ? p.get("image") : "", rs);
@@ -297,6 +306,7 @@ int runPose(const Args& args) {
                      {"spacing_mm", {grid.spacing()[0], grid.spacing()[1], grid.spacing()[2]}}}},
                    {"cage_vertices", cage.vertices.rows()},
                    {"scene_reused", reused},
+                   {"joint_rings", jointRings},
                    {"tissue_table",
                     tissues ? (p.has("tissues") ? p.get("tissues") : "phantom default") : "none"},
                    {"voxels_in_shell", raster.shellVoxels},

@@ -100,7 +100,9 @@ double handleBlendWeight(double membership) {
 }
 
 HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleMesh& cage,
-                                       const std::vector<RigidHandle>& handles, int threads) {
+                                       const std::vector<RigidHandle>& handles, int threads,
+                                       int jointRings) {
+  if (jointRings < 0) throw Error("joint rings must be >= 0");
   const std::vector<int> owner = cageOwners(cage.vertices.rows(), handles);
   const Eigen::Index n = mesh.vertices.rows(), groups = Eigen::Index(handles.size());
   HandleInfluence out;
@@ -185,6 +187,20 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
           if (!byParts[g]) membership(v, g) = inside(slot[v], g);
   }
 
+  // Optional widening of the joints: each ring averages every vertex's memberships with its
+  // edge neighbours', spreading the bend over one more ring of tets on both sides.
+  if (jointRings > 0) {
+    const TetAdjacency adjacency = TetAdjacency::build(mesh);
+    for (int ring = 0; ring < jointRings; ++ring) {
+      Eigen::MatrixXd sum = membership;
+      Eigen::VectorXd count = Eigen::VectorXd::Ones(n);
+      for (const auto& [i, j] : adjacency.edges) {
+        sum.row(i) += membership.row(j), sum.row(j) += membership.row(i);
+        count[i] += 1, count[j] += 1;
+      }
+      membership = count.cwiseInverse().asDiagonal() * sum;
+    }
+  }
   // Memberships in [0, 1] summing to at most 1 (a part named by two groups counts once).
   for (Eigen::Index v = 0; v < n; ++v) {
     auto row = membership.row(v);

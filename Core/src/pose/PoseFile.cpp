@@ -187,7 +187,8 @@ Pose parsePose(const std::string& text, const std::string& source) {
   }
   r.object(j, "(top level)");
   r.onlyKeys(j, "",
-             {"format", "version", "name", "description", "separations", "groups", "keyframes"});
+             {"format", "version", "name", "description", "joint_rings", "separations", "groups",
+              "keyframes"});
   if (!j.contains("format") || j["format"] != "repose-pose")
     r.fail("format", "expected \"repose-pose\"");
   if (!j.contains("version") || r.integer(j["version"], "version") != 1)
@@ -195,6 +196,10 @@ Pose parsePose(const std::string& text, const std::string& source) {
   Pose pose;
   if (j.contains("name")) pose.name = r.string(j["name"], "name");
   if (j.contains("description")) pose.description = r.string(j["description"], "description");
+  if (j.contains("joint_rings")) {
+    pose.jointRings = r.integer(j["joint_rings"], "joint_rings");
+    if (pose.jointRings < 0 || pose.jointRings > 8) r.fail("joint_rings", "expected 0 to 8");
+  }
   if (j.contains("separations")) {
     const json& s = j["separations"];
     if (!s.is_array()) r.fail("separations", "expected an array");
@@ -286,6 +291,7 @@ Pose readPoseFile(const std::string& path) {
 std::string poseToJson(const Pose& pose) {
   json j = {{"format", "repose-pose"}, {"version", 1}, {"name", pose.name}};
   if (!pose.description.empty()) j["description"] = pose.description;
+  if (pose.jointRings != 0) j["joint_rings"] = pose.jointRings;
   if (!pose.separations.empty()) {
     j["separations"] = json::array();
     for (const PoseSeparation& s : pose.separations) {

@@ -28,11 +28,13 @@ RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparati
   return g;
 }
 
-PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads)
+PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads,
+                 int jointRings)
     : geometry_(std::move(geometry)), pose_(pose) {
   deformation_ = std::make_unique<CageDeformation>(geometry_.mesh, geometry_.cage, threads);
   handles_ = resolveHandles(pose_, geometry_.cage, geometry_.mesh, partLabels);
-  influence_ = computeHandleInfluence(geometry_.mesh, geometry_.cage, handles_, threads);
+  influence_ = computeHandleInfluence(geometry_.mesh, geometry_.cage, handles_, threads,
+                                      jointRings >= 0 ? jointRings : pose_.jointRings);
   frames_ = pose_.frames();
 }
 

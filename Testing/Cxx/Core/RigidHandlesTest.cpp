@@ -155,3 +155,27 @@ TEST(RigidHandles, RefusesBadHandleLists) {
   EXPECT_THROW(deformation.deform(bar.cage.vertices, forA, {a, a}), Error);  // other list
   EXPECT_NO_THROW(computeHandleInfluence(bar.mesh, bar.cage, {}));
 }
+
+// Widening the joint: each ring spreads the transition one ring of vertices further on both
+// sides, keeps memberships in [0, 1], and leaves the tissue beyond it carried exactly.
+TEST(RigidHandles, JointRingsWidenTheTransitionOnly) {
+  const Bar bar;  // vertices every 5 mm along x, border at x = 50
+  RigidHandle h;
+  h.parts = {2};
+  h.cageVertices = bar.cageVerticesBeyond(50);
+  for (const int rings : {0, 1, 2}) {
+    const HandleInfluence inf = computeHandleInfluence(bar.mesh, bar.cage, {h}, 0, rings);
+    double lo = 1e9, hi = -1e9;  // x extent of the fractional memberships
+    for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v) {
+      const double m = inf.membership(v, 0), x = bar.mesh.vertices(v, 0);
+      EXPECT_GE(m, 0.0);
+      EXPECT_LE(m, 1.0);
+      if (m > 0 && m < 1) lo = std::min(lo, x), hi = std::max(hi, x);
+      if (x >= 50 + 5 * (rings + 1)) EXPECT_EQ(m, 1.0) << rings << " " << x;
+      if (x <= 50 - 5 * (rings + 1)) EXPECT_EQ(m, 0.0) << rings << " " << x;
+    }
+    EXPECT_NEAR(lo, 50 - 5 * rings, 1e-9) << rings;
+    EXPECT_NEAR(hi, 50 + 5 * rings, 1e-9) << rings;
+  }
+  EXPECT_THROW(computeHandleInfluence(bar.mesh, bar.cage, {h}, 0, -1), Error);
+}

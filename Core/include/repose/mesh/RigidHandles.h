@@ -52,8 +52,12 @@ Eigen::Isometry3d blendMotions(const Eigen::Ref<const Eigen::VectorXd>& weights,
                                const std::vector<RigidHandle>& handles);
 
 // Throws repose::Error for a cage index out of range or a cage vertex in two groups.
+// jointRings > 0 widens each transition by that many rings of TM vertices on both sides
+// (memberships averaged with their edge neighbours): a gentler bend, less of the crease folding
+// over itself, but bone ends near the joint bend with it (docs/QUALITY.md).
 HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleMesh& cage,
-                                       const std::vector<RigidHandle>& handles, int threads = 0);
+                                       const std::vector<RigidHandle>& handles, int threads = 0,
+                                       int jointRings = 0);
 
 // Blend weight of a total membership: 0 below kNone, 1 above kFull, C1-smooth in between.
 double handleBlendWeight(double membership);

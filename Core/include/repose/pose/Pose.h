@@ -56,6 +56,7 @@ struct PoseSeparation {
 
 struct Pose {
   std::string name, description;
+  int jointRings = 0;  // widening of the joints' transitions (computeHandleInfluence), 0..8
   std::vector<PoseSeparation> separations;
   std::vector<PoseGroup> groups;
   std::vector<PoseKeyframe> keyframes;

@@ -33,7 +33,9 @@ RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparati
 class PoseRig {
  public:
   // Embeds the mesh in the cage and resolves the pose's groups (part names through partLabels).
-  PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads = 0);
+  // jointRings: the widening of the joints (computeHandleInfluence); -1 takes the pose's own.
+  PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads = 0,
+          int jointRings = -1);
   ~PoseRig();
 
   struct Frame {
