@@ -35,13 +35,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 void writeJsonAtomically(const json& j, const std::string& path) {
-  AtomicOutput out(path);
-  {
-    std::ofstream f(out.tempPath());
-    f << j.dump(2) << "\n";
-    if (!f.flush()) throw Error(path + ": cannot write");
-  }
-  out.commit();
+  writeTextFileAtomically(path, j.dump(2) + "\n");
 }
 
 // The default tissue table applies only to the phantom: every label of G must carry its name.

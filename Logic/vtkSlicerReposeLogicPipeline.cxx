@@ -52,20 +52,13 @@ repose::Volume partsOf(vtkMRMLReposeSegmentationNode* seg) {
       mask.data<std::uint8_t>()[v] = G.data<T>()[v] != 0;
   });
   repose::LabelTable t;
-  t.set({1, "body"});
+  repose::Label body;
+  body.value = 1;
+  body.name = "body";
+  t.set(body);
   mask.labels() = t;
   mask.setLabelMap(true);
   return mask;
-}
-
-void writeTextAtomically(const std::string& text, const std::string& path) {
-  repose::AtomicOutput out(path);
-  {
-    std::ofstream f(out.tempPath());
-    f << text;
-    if (!f.flush()) throw repose::Error(path + ": cannot write");
-  }
-  out.commit();
 }
 
 std::string readText(const std::string& path) {
@@ -430,10 +423,10 @@ bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
             (dir / tm->GetFileName()).string());
       } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
         pose->SetFileName(id + ".pose.json");
-        writeTextAtomically(pose->GetPoseJSON(), (dir / pose->GetFileName()).string());
+        repose::writeTextFileAtomically((dir / pose->GetFileName()).string(), pose->GetPoseJSON());
       }
     }
-    writeTextAtomically(this->Scene->WriteJSON() + "\n", (dir / "scene.json").string());
+    repose::writeTextFileAtomically((dir / "scene.json").string(), this->Scene->WriteJSON() + "\n");
     return true;
   } catch (const std::exception& e) {
     this->LastErrorMessage = e.what();

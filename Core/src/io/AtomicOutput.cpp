@@ -1,6 +1,8 @@
 // Temporary folder beside the target, renamed into place on commit; see AtomicOutput.h.
 #include "repose/io/AtomicOutput.h"
 
+#include <fstream>
+
 #include "repose/util/Error.h"
 
 #include <unistd.h>
@@ -55,6 +57,16 @@ void AtomicOutput::commit() {
     if (ec) throwFileError(finalPath_, "cannot move the output into place: " + ec.message());
   }
   committed_ = true;
+}
+
+void writeTextFileAtomically(const std::string& path, const std::string& text) {
+  AtomicOutput out(path);
+  {
+    std::ofstream f(out.tempPath(), std::ios::binary);
+    f << text;
+    if (!f.flush()) throwFileError(path, "cannot write");
+  }
+  out.commit();
 }
 
 void refuseOverwritingInput(const std::string& input, const std::string& output) {

@@ -33,23 +33,6 @@ std::vector<int> cageOwners(Eigen::Index cageVertices, const std::vector<RigidHa
   return owner;
 }
 
-// Vertices on faces that belong to one tet only.
-std::vector<char> surfaceVertices(const TransferMesh& mesh) {
-  std::map<std::array<int, 3>, int> faces;
-  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
-    for (const auto& f : kFace) {
-      std::array<int, 3> key{mesh.tets(t, f[0]), mesh.tets(t, f[1]), mesh.tets(t, f[2])};
-      std::sort(key.begin(), key.end());
-      ++faces[key];
-    }
-  std::vector<char> surface(mesh.vertices.rows(), 0);
-  for (const auto& [key, count] : faces)
-    if (count == 1)
-      for (const int v : key) surface[v] = 1;
-  return surface;
-}
-
 }  // namespace
 
 int HandleInfluence::rigidVertices() const {

@@ -2,6 +2,7 @@
 #include "TetAdjacency.h"
 
 #include <algorithm>
+#include <array>
 #include <tuple>
 
 namespace repose {
@@ -45,6 +46,29 @@ TetAdjacency TetAdjacency::build(const TransferMesh& mesh) {
     a.edgeTets.back().push_back(t);
   }
   return a;
+}
+
+std::vector<char> surfaceVertices(const TransferMesh& mesh) {
+  // Sorted face keys: a key that appears once is on the surface.
+  std::vector<std::array<int, 3>> faces;
+  faces.reserve(4 * static_cast<std::size_t>(mesh.tets.rows()));
+  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    for (const auto& f : kFace) {
+      std::array<int, 3> key{mesh.tets(t, f[0]), mesh.tets(t, f[1]), mesh.tets(t, f[2])};
+      std::sort(key.begin(), key.end());
+      faces.push_back(key);
+    }
+  std::sort(faces.begin(), faces.end());
+  std::vector<char> surface(static_cast<std::size_t>(mesh.vertices.rows()), 0);
+  for (std::size_t i = 0; i < faces.size();) {
+    std::size_t j = i + 1;
+    while (j < faces.size() && faces[j] == faces[i]) ++j;
+    if (j - i == 1)
+      for (const int v : faces[i]) surface[v] = 1;
+    i = j;
+  }
+  return surface;
 }
 
 }  // namespace repose

@@ -17,4 +17,7 @@ struct TetAdjacency {
   static TetAdjacency build(const TransferMesh& mesh);
 };
 
+// Per vertex: 1 on the mesh's surface (a face that belongs to one tet only), else 0.
+std::vector<char> surfaceVertices(const TransferMesh& mesh);
+
 }  // namespace repose

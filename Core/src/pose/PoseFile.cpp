@@ -333,13 +333,7 @@ std::string poseToJson(const Pose& pose) {
 }
 
 void writePoseFile(const Pose& pose, const std::string& path) {
-  AtomicOutput out(path);
-  {
-    std::ofstream f(out.tempPath());
-    f << poseToJson(pose);
-    if (!f.flush()) throw Error(path + ": cannot write");
-  }
-  out.commit();
+  writeTextFileAtomically(path, poseToJson(pose));
 }
 
 }  // namespace repose

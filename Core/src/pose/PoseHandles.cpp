@@ -1,4 +1,5 @@
 // From a pose file's groups to rigid handles of one cage and transfer mesh, and the posed cage.
+#include "mesh/TetAdjacency.h"
 #include "repose/cage/ArapDeformer.h"
 #include "repose/pose/Pose.h"
 #include "repose/util/Error.h"
@@ -15,18 +16,7 @@ namespace {
 // Per cage vertex: the body part of the nearest TM surface vertex (the most common label of
 // the tets around it), so "select the forearm's cage vertices" means the cage over the forearm.
 std::vector<int> cageVertexParts(const TriangleMesh& cage, const TransferMesh& mesh) {
-  std::map<std::array<int, 3>, int> faces;
-  static constexpr int kFace[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
-    for (const auto& f : kFace) {
-      std::array<int, 3> key{mesh.tets(t, f[0]), mesh.tets(t, f[1]), mesh.tets(t, f[2])};
-      std::sort(key.begin(), key.end());
-      ++faces[key];
-    }
-  std::vector<char> surface(mesh.vertices.rows(), 0);
-  for (const auto& [key, count] : faces)
-    if (count == 1)
-      for (const int v : key) surface[v] = 1;
+  const std::vector<char> surface = surfaceVertices(mesh);
   std::vector<std::map<int, int>> labelsAround(mesh.vertices.rows());
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
     for (int k = 0; k < 4; ++k)

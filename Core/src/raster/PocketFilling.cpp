@@ -1,6 +1,7 @@
 #include "repose/raster/PocketFilling.h"
 
 #include "repose/util/Error.h"
+#include "repose/volume/LabelStatistics.h"
 
 #include <Eigen/LU>
 
@@ -10,34 +11,6 @@
 
 namespace repose {
 namespace {
-
-// Per voxel of layer 0: 1 where the value is 0 and a 6-connected path of zeros reaches the border.
-template <class T>
-std::vector<char> outsideBackground(const T* v, const std::array<std::int64_t, 3>& d) {
-  const std::int64_t n = d[0] * d[1] * d[2];
-  std::vector<char> reached(n, 0);
-  std::vector<std::int64_t> stack;
-  auto push = [&](std::int64_t i) {
-    if (v[i] == 0 && !reached[i]) reached[i] = 1, stack.push_back(i);
-  };
-  for (std::int64_t k = 0; k < d[2]; ++k)
-    for (std::int64_t j = 0; j < d[1]; ++j)
-      for (std::int64_t i = 0; i < d[0]; ++i)
-        if (i == 0 || j == 0 || k == 0 || i == d[0] - 1 || j == d[1] - 1 || k == d[2] - 1)
-          push(i + d[0] * (j + d[1] * k));
-  while (!stack.empty()) {
-    const std::int64_t c = stack.back();
-    stack.pop_back();
-    const std::int64_t i = c % d[0], j = (c / d[0]) % d[1], k = c / (d[0] * d[1]);
-    if (i > 0) push(c - 1);
-    if (i + 1 < d[0]) push(c + 1);
-    if (j > 0) push(c - d[0]);
-    if (j + 1 < d[1]) push(c + d[0]);
-    if (k > 0) push(c - d[0] * d[1]);
-    if (k + 1 < d[2]) push(c + d[0] * d[1]);
-  }
-  return reached;
-}
 
 // Fills the voxels listed in `fill` (flags per voxel) layer by layer with the most common
 // non-zero label among their 6 neighbours not waiting to be filled.
@@ -85,11 +58,8 @@ PocketReport fillPosePockets(Volume& posed, const Volume& rest, const std::vecto
     throw Error("the displacement field does not match the posed grid");
   if (posedParts && posedParts->dims() != d) throw Error("the posed parts map is on another grid");
   PocketReport report;
-  std::vector<char> restOutside;
-  dispatchScalar(rest.scalarType(), [&](auto* tag) {
-    using T = std::remove_pointer_t<decltype(tag)>;
-    if constexpr (std::is_integral_v<T>) restOutside = outsideBackground(rest.data<T>(), rd);
-  });
+  const std::vector<char> restOutside = outsideBackground(rest);
+  const std::vector<char> outside = outsideBackground(posed);
   auto restIsBackground = [&](std::int64_t q) {
     bool zero = false;
     dispatchScalar(rest.scalarType(), [&](auto* tag) {
@@ -104,7 +74,6 @@ PocketReport fillPosePockets(Volume& posed, const Volume& rest, const std::vecto
     using T = std::remove_pointer_t<decltype(tag)>;
     if constexpr (std::is_integral_v<T>) {
       const T* v = posed.data<T>();
-      const std::vector<char> outside = outsideBackground(v, d);
       const Eigen::Matrix4d toRestIjk = rest.geometry().ijkToRas.inverse();
       for (std::int64_t k = 0; k < d[2]; ++k)
         for (std::int64_t j = 0; j < d[1]; ++j)

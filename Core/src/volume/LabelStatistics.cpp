@@ -2,6 +2,7 @@
 #include "repose/volume/LabelStatistics.h"
 
 #include <map>
+#include <vector>
 
 namespace repose {
 
@@ -33,21 +34,18 @@ std::vector<LabelCount> countLabels(const Volume& volume) {
   return out;
 }
 
-std::int64_t countEnclosedBackground(const Volume& volume) {
+std::vector<char> outsideBackground(const Volume& volume) {
   if (!isIntegerType(volume.scalarType()))
-    throw Error("holes are counted on label maps, not on float volumes");
+    throw Error("background is traced in label maps, not in float volumes");
   const auto d = volume.dims();
-  const std::int64_t n = d[0] * d[1] * d[2];
-  std::vector<char> reached(n, 0);
+  std::vector<char> reached(static_cast<std::size_t>(volume.numVoxels()), 0);
   std::vector<std::int64_t> stack;
-  std::int64_t background = 0;
   dispatchScalar(volume.scalarType(), [&](auto* tag) {
     using T = std::remove_pointer_t<decltype(tag)>;
     const T* v = volume.data<T>();  // layer 0 comes first
     auto push = [&](std::int64_t i) {
       if (v[i] == 0 && !reached[i]) reached[i] = 1, stack.push_back(i);
     };
-    for (std::int64_t i = 0; i < n; ++i) background += v[i] == 0;
     for (std::int64_t k = 0; k < d[2]; ++k)
       for (std::int64_t j = 0; j < d[1]; ++j)
         for (std::int64_t i = 0; i < d[0]; ++i)
@@ -65,9 +63,18 @@ std::int64_t countEnclosedBackground(const Volume& volume) {
       if (k + 1 < d[2]) push(c + d[0] * d[1]);
     }
   });
-  std::int64_t outside = 0;
-  for (const char r : reached) outside += r;
-  return background - outside;
+  return reached;
+}
+
+std::int64_t countEnclosedBackground(const Volume& volume) {
+  const std::vector<char> outside = outsideBackground(volume);
+  std::int64_t enclosed = 0;
+  dispatchScalar(volume.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const T* v = volume.data<T>();
+    for (std::int64_t i = 0; i < volume.numVoxels(); ++i) enclosed += v[i] == 0 && !outside[i];
+  });
+  return enclosed;
 }
 
 }  // namespace repose

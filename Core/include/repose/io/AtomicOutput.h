@@ -29,6 +29,9 @@ class AtomicOutput {
   bool committed_ = false;
 };
 
+// Writes `text` to `path` through an AtomicOutput: the whole file or nothing. Throws repose::Error.
+void writeTextFileAtomically(const std::string& path, const std::string& text);
+
 // Throws repose::Error if output names the same file as input (an input is never overwritten).
 void refuseOverwritingInput(const std::string& input, const std::string& output);
 

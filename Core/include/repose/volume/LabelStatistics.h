@@ -18,6 +18,10 @@ struct LabelCount {
 // Every non-zero value present, sorted by (layer, value). Throws for float volumes.
 std::vector<LabelCount> countLabels(const Volume& volume);
 
+// Per voxel of layer 0: 1 where the value is 0 and a 6-connected path of zeros reaches the
+// grid's border (the outside), else 0. Throws for float volumes.
+std::vector<char> outsideBackground(const Volume& volume);
+
 // Background (0) voxels of layer 0 that no 6-connected path of background joins to the grid's
 // border: holes inside the body. A pose must not create new ones. Throws for float volumes.
 std::int64_t countEnclosedBackground(const Volume& volume);
