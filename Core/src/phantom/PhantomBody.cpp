@@ -205,7 +205,7 @@ void addTorsoStructures(Builder& b) {
   b.cone(kSternum, kPartTorso, RoundCone::make({0, 64, 905}, {0, 40, 1020}, 11, 10, Y, 0.5, 1));
   Structure& ribs = b.structure(StructureKind::Ribs, kRibs, kPartTorso);
   ribs.zmin = 905;
-  ribs.zmax = 1035;
+  ribs.zmax = 1000;  // the first rib leaves T1 (t1 above), below the shoulder joints
   ribs.depthMin = b.m.skinMm + b.m.fatMm[kPartTorso] + 3;
   ribs.depthMax = ribs.depthMin + 8;
   ribs.period = 22;
