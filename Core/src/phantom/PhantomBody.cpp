@@ -164,7 +164,11 @@ void addLeg(Builder& b, const SideJoints& j, bool left) {
   const V h = P(j.hip), k = P(j.knee), a = P(j.ankle), t = P(j.toe);
   const V ut = (k - h).normalized(), us = (a - k).normalized(), uf = (t - a).normalized();
   const V Z = V::UnitZ();
-  b.cutSegment(thigh, RoundCone::make(h, k, 68, 44), h, ut, kPartTorso);
+  // The groin runs obliquely, lower towards the crotch than at the hip's side (30 degrees), so
+  // the pelvic organs above the crotch stay in the torso, clear of the thigh's border.
+  const V medial = P(V(-1, 0, 0));
+  const V groin = (std::cos(M_PI / 6) * ut - std::sin(M_PI / 6) * medial).normalized();
+  b.cutSegment(thigh, RoundCone::make(h, k, 68, 44), h, groin, kPartTorso);
   // The heel below the ankle belongs to the foot, whose bones start there.
   b.cutSegment(shank, RoundCone::make(k, a, 44, 27), a, -us, foot);
   const V heel(a.x(), -18, 28), toeCentre = t - V(0, 24, 0);
