@@ -112,8 +112,7 @@ void vtkMRMLReposeNode::Modified() {
 void vtkMRMLReposeNode::PrintSelf(ostream& os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
   const nlohmann::ordered_json json = this->ToJSON();  // kept alive for the loop
-  for (const auto& [key, value] : json.items())
-    os << indent << key << ": " << value.dump() << "\n";
+  for (const auto& [key, value] : json.items()) os << indent << key << ": " << value.dump() << "\n";
 }
 
 bool vtkMRMLReposeNode::CheckString(const nlohmann::json& json, const char* key,
