@@ -7,7 +7,6 @@
 #include "ArgParser.h"
 #include "Commands.h"
 #include "MemoryBudget.h"
-#include "PoseReport.h"
 #include "TerminalProgress.h"
 
 #include "repose/io/AtomicOutput.h"
@@ -16,6 +15,7 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRig.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
@@ -43,10 +43,7 @@ std::optional<TissueTable> defaultTissues(const Volume& organs) {
   const std::string path = std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
   if (!fs::exists(path)) return std::nullopt;
   TissueTable t = readTissueTable(path);
-  for (const Label& l : organs.labels().labels()) {
-    const auto it = t.find(l.value);
-    if (it == t.end() || it->second.name != l.name) return std::nullopt;
-  }
+  if (!tissueTableCovers(t, organs.labels())) return std::nullopt;
   return t;
 }
 
@@ -309,7 +306,7 @@ int runPose(const Args& args) {
                     {{"filled_voxels", pockets.filled},
                      {"kept_cavity_voxels", pockets.keptCavities},
                      {"filled", !p.has("keep-pockets")}}}};
-    report.update(makePoseReport(ri));
+    report.update(json::parse(poseReportJson(ri)));
     if (image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
     writeJsonAtomically(report, (dir / "report.json").string());
     const json& q = report["quality"];

@@ -82,7 +82,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   bool StartBuildRig(vtkMRMLReposeSegmentationNode* segmentation, vtkMRMLReposePoseNode* pose);
   // The pose node's current frame at full resolution: a new segmentation node (posed G, S, image)
   // referring to its source and pose; with an output folder also posed_G.nii.gz, posed_S.nii.gz
-  // (posed_image.nii.gz) and transform.nrrd written there.
+  // (posed_image.nii.gz), transform.nrrd and report.json written there.
   bool StartApplyPose(vtkMRMLReposePoseNode* pose, const std::string& outputFolder = "");
   bool IsJobRunning() const;
   double GetJobProgress() const;
@@ -91,6 +91,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   enum JobStatus { JobIdle, JobRunning, JobSucceeded, JobCancelled, JobFailed };
   int WaitForJob();
   int PollJob();
+  // Tissue table (CSV, docs/FORMATS.md) for the reports of pose jobs; empty: the phantom's table
+  // when G's labels are the phantom's, else none (no masses, no bone check).
+  void SetTissueTablePath(const std::string& path);
   // The segmentation node the last ApplyPose job made (null before).
   vtkMRMLReposeSegmentationNode* GetLastPosedSegmentation() const;
 
@@ -132,6 +135,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::string LastErrorMessage;
 
   vtkSmartPointer<vtkMRMLReposeScene> Scene;
+  std::string TissueTablePath;
   std::unique_ptr<vtkSlicerReposeJob> Job;
   vtkSmartPointer<vtkMRMLReposeSegmentationNode> LastPosedSegmentation;
   struct PoseEdit {

@@ -17,10 +17,13 @@
 #include <repose/io/MeshIO.h>
 #include <repose/io/NrrdIO.h>
 #include <repose/io/VolumeIO.h>
+#include <repose/pose/PoseReport.h>
 #include <repose/pose/PoseRig.h>
 #include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/util/Error.h>
+
+#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -208,6 +211,15 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
+    // Densities and rigid tissues: the table set, else the phantom's when G is the phantom.
+    std::shared_ptr<repose::TissueTable> tissues;
+    const std::string table = !this->TissueTablePath.empty()
+                                  ? this->TissueTablePath
+                                  : std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
+    if (fs::exists(table)) {
+      auto t = std::make_shared<repose::TissueTable>(repose::readTissueTable(table));
+      if (!this->TissueTablePath.empty() || repose::tissueTableCovers(*t, G->labels())) tissues = t;
+    }
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(
@@ -238,7 +250,28 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           auto field = std::make_shared<std::vector<float>>(
               repose::rasterizeDisplacement(rig.mesh(), f.deformed, G->geometry(), grid, ro));
           // As `repose pose` does: pockets a bent joint traps inside the body are filled.
-          repose::fillPosePockets(*posedG, *G, *field, posedS.get());
+          const repose::PocketReport pockets =
+              repose::fillPosePockets(*posedG, *G, *field, posedS.get());
+          // The report `repose pose` writes, for the same frame.
+          auto report = std::make_shared<std::string>();
+          if (!outputFolder.empty()) {
+            repose::PoseReportInput ri;
+            ri.organs = G.get(), ri.parts = S.get();
+            ri.posedOrgans = posedG.get(), ri.posedParts = posedS.get();
+            ri.mesh = &rig.mesh(), ri.tetMaps = &f.tetMaps, ri.handles = &f.handles;
+            for (const repose::PoseGroup& g : pose.groups) ri.groupNames.push_back(g.name);
+            ri.tissues = tissues ? tissues.get() : nullptr;
+            ri.outlierVertices = rig.deformation().embedding().outliers();
+            ri.rigidVertices = rig.influence().rigidVertices();
+            nlohmann::json j = {{"pose", pose.name},
+                                {"frame", f.name},
+                                {"grid", {{"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}}}},
+                                {"pockets",
+                                 {{"filled_voxels", pockets.filled},
+                                  {"kept_cavity_voxels", pockets.keptCavities}}}};
+            j.update(nlohmann::json::parse(repose::poseReportJson(ri)));
+            *report = j.dump(2) + "\n";
+          }
           repose::reportProgress(progress, 1, "posed");
           return [=] {
             if (!outputFolder.empty()) {
@@ -248,6 +281,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
               repose::writeVolume(*posedS, (out / "posed_S.nii.gz").string());
               if (posedI) repose::writeVolume(*posedI, (out / "posed_image.nii.gz").string());
               repose::writeDisplacementFieldNrrd(*field, grid, (out / "transform.nrrd").string());
+              repose::writeTextFileAtomically((out / "report.json").string(), *report);
             }
             auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
             node->SetName(segRef->GetName() + " " + f.name);
@@ -309,6 +343,10 @@ int vtkSlicerReposeLogic::PollJob() {
   if (status == JobFailed) this->LastErrorMessage = this->Job->GetLastError();
   if (status == JobSucceeded) this->Modified();
   return status;
+}
+
+void vtkSlicerReposeLogic::SetTissueTablePath(const std::string& path) {
+  this->TissueTablePath = path;
 }
 
 vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::GetLastPosedSegmentation() const {

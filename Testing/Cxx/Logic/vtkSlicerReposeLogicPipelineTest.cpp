@@ -16,6 +16,7 @@
 #include <repose/phantom/Phantom.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <vtkNew.h>
 #include <vtkPointData.h>
@@ -23,6 +24,7 @@
 #include <chrono>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 using namespace repose::test;
@@ -176,7 +178,8 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
   auto* cage = vtkMRMLReposeCageNode::SafeDownCast(
       logic->GetScene()->GetNodesByClass("vtkMRMLReposeCageNode").at(0));
   EXPECT_EQ(cage->GetHandleGroups().size(), 2u);
-  ASSERT_TRUE(logic->StartApplyPose(vtkMRMLReposePoseNode::SafeDownCast(poses[0])));
+  const std::string logicOut = files.dir.file("logic");
+  ASSERT_TRUE(logic->StartApplyPose(vtkMRMLReposePoseNode::SafeDownCast(poses[0]), logicOut));
   ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   const repose::Volume expected = repose::readVolume(out + "/posed_G.nii.gz");
@@ -192,4 +195,11 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
     different += a != b;
   }
   EXPECT_EQ(different, 0);
+  // The same report as the command line's: volumes, masses, distortion, bones, quality.
+  std::ifstream cliReport(out + "/report.json"), logicReport(logicOut + "/report.json");
+  ASSERT_TRUE(logicReport.good());
+  const nlohmann::json a = nlohmann::json::parse(cliReport), b = nlohmann::json::parse(logicReport);
+  for (const char* key : {"labels", "body", "distortion", "tet_volume_change", "mesh",
+                          "rigid_tissues", "holes", "quality"})
+    EXPECT_EQ(a[key], b[key]) << key;
 }

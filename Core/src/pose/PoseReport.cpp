@@ -1,4 +1,6 @@
-#include "PoseReport.h"
+#include "repose/pose/PoseReport.h"
+
+#include <nlohmann/json.hpp>
 
 #include "repose/volume/LabelStatistics.h"
 
@@ -9,7 +11,7 @@
 #include <map>
 #include <type_traits>
 
-namespace repose::cli {
+namespace repose {
 namespace {
 
 using nlohmann::json;
@@ -81,7 +83,7 @@ DiceCounts diceCounts(const PoseReportInput& in, const RigidHandle& h) {
 
 }  // namespace
 
-json makePoseReport(const PoseReportInput& in) {
+static json makePoseReport(const PoseReportInput& in) {
   json report;
   // Per label: volume, and mass where the tissue table knows the label.
   std::map<int, std::pair<LabelCount, LabelCount>> counts;
@@ -231,4 +233,16 @@ json makePoseReport(const PoseReportInput& in) {
   return report;
 }
 
-}  // namespace repose::cli
+std::string poseReportJson(const PoseReportInput& in) {
+  return makePoseReport(in).dump();
+}
+
+bool tissueTableCovers(const TissueTable& table, const LabelTable& labels) {
+  for (const Label& l : labels.labels()) {
+    const auto it = table.find(l.value);
+    if (it == table.end() || it->second.name != l.name) return false;
+  }
+  return true;
+}
+
+}  // namespace repose
