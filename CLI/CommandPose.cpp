@@ -236,6 +236,7 @@ int runPose(const Args& args) {
   for (const PoseGroup& g : pose.groups) groupNames.push_back(g.name);
 
   const bool oneFrame = rig.frameCount() == 1;
+  const std::vector<std::uint8_t> outer = outerFaces(mesh);  // the rest mesh's: once per job
   fs::create_directories(outDir);
   json summary = json::array();
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {
@@ -260,7 +261,6 @@ int runPose(const Args& args) {
     RasterOptions ro;
     ro.threads = threads;
     ro.progress = quiet ? ProgressFn{} : terminalProgress();
-    const std::vector<std::uint8_t> outer = outerFaces(mesh);
     ro.outerFaces = &outer;
     RasterReport raster;
     Volume posedOrgans = rasterizeLabels(organs, mesh, deformed, grid, ro, &raster);
