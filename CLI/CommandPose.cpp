@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <set>
 
 namespace repose::cli {
 namespace {
@@ -56,6 +57,8 @@ json sceneKey(const std::string& partsPath, const Pose& pose, const RigSettings&
           {"cage_vertices", rs.cageVertices},
           {"dilate_mm", rs.dilateMm},
           {"mesh_size_mm", rs.meshMm},
+          {"rigid_labels", rs.rigidLabels},
+          {"whole_organs", rs.wholeOrgans},
           {"separations", separations}};
 }
 
@@ -138,6 +141,10 @@ int runPose(const Args& args) {
               "joint_rings; docs/QUALITY.md)",
               "-1")
       .option("threads", "N", "worker threads (0: all cores)", "0")
+      .flag("bend-organs",
+            "mesh the organs with the soft tissue around them, so a joint's bend may reach them "
+            "(by default bones and organs that lie in one body part move as whole pieces; "
+            "docs/QUALITY.md)")
       .flag("keep-pockets",
             "keep the background pockets a bent joint traps inside the body (by default they "
             "are filled from their neighbours; docs/QUALITY.md)")
@@ -171,6 +178,7 @@ int runPose(const Args& args) {
   rs.dilateMm = p.getDouble("dilate-mm");
   rs.meshMm = p.getDouble("mesh-mm");
   rs.threads = threads;
+  rs.wholeOrgans = !p.has("bend-organs");
   if (rs.meshMm < 0) throw UsageError{"--mesh-mm must be >= 0"};
   if (p.getInt("joint-rings") < -1 || p.getInt("joint-rings") > 8)
     throw UsageError{"--joint-rings must be -1..8"};
@@ -194,6 +202,10 @@ int runPose(const Args& args) {
   else
     tissues = defaultTissues(organs);
 
+  // Bones are meshed as rigid pieces when the tissue table says which labels they are.
+  if (tissues)
+    for (const auto& [label, tissue] : *tissues)
+      if (tissue.rigid) rs.rigidLabels.push_back(label);
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
   const std::vector<LimbSeparation> separations = resolveSeparations(pose, parts.labels());
   const json key = sceneKey(p.get("parts"), pose, rs);
@@ -223,7 +235,8 @@ int runPose(const Args& args) {
   }
   if (!reused) {
     say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
-    geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress());
+    geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress(),
+                                &organs);
   }
   say("embedding the mesh in the cage");
   const PoseRig rig(std::move(geometry), pose, parts.labels(), threads, jointRings);
@@ -235,6 +248,11 @@ int runPose(const Args& args) {
   std::vector<std::string> groupNames;
   for (const PoseGroup& g : pose.groups) groupNames.push_back(g.name);
 
+  // The whole pieces of the mesh (bones, organs), for the report.
+  std::set<int> pieceLabels;
+  std::int64_t pieceTets = 0;
+  for (const int label : mesh.rigid)
+    if (label != 0) pieceLabels.insert(label), ++pieceTets;
   const bool oneFrame = rig.frameCount() == 1;
   const std::vector<std::uint8_t> outer = outerFaces(mesh);  // the rest mesh's: once per job
   fs::create_directories(outDir);
@@ -298,6 +316,7 @@ int runPose(const Args& args) {
                    {"cage_vertices", cage.vertices.rows()},
                    {"scene_reused", reused},
                    {"joint_rings", jointRings},
+                   {"whole_pieces", {{"labels", pieceLabels}, {"tets", pieceTets}}},
                    {"tissue_table",
                     tissues ? (p.has("tissues") ? p.get("tissues") : "phantom default") : "none"},
                    {"voxels_in_shell", raster.shellVoxels},

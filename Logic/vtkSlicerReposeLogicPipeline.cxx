@@ -44,6 +44,17 @@ std::string stemOf(const std::string& path) {
   return name;
 }
 
+// Densities and rigid tissues: the table set, else the phantom's when G's labels are the
+// phantom's (as `repose pose` does); null when neither applies.
+std::shared_ptr<repose::TissueTable> tissuesFor(const std::string& path, const repose::Volume& G) {
+  const std::string table =
+      !path.empty() ? path : std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
+  if (!fs::exists(table)) return nullptr;
+  auto t = std::make_shared<repose::TissueTable>(repose::readTissueTable(table));
+  if (!path.empty() || repose::tissueTableCovers(*t, G.labels())) return t;
+  return nullptr;
+}
+
 // S of a segmentation node, or the body mask of G (label 1 where G is not 0) when it has none.
 repose::Volume partsOf(vtkMRMLReposeSegmentationNode* seg) {
   if (seg->GetBodyPartMap()) return Conversion::FromImageData(seg->GetBodyPartMap());
@@ -135,6 +146,7 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
       throw repose::Error("building the rig needs a segmentation with a label map and a pose");
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
     auto parts = std::make_shared<repose::Volume>(partsOf(seg));
+    auto G = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::vector<repose::LimbSeparation> separations =
         repose::resolveSeparations(pose, parts->labels());
@@ -144,11 +156,15 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
       settings.dilateMm = this->ParameterNode->GetCageDilationMm();
       settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
     }
+    // Bones (the tissue table's rigid labels) and organs move as whole pieces, as in `repose pose`.
+    if (const auto tissues = tissuesFor(this->TissueTablePath, *G))
+      for (const auto& [label, tissue] : *tissues)
+        if (tissue.rigid) settings.rigidLabels.push_back(label);
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start("rig", [=](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
       auto geometry = std::make_shared<repose::RigGeometry>(
-          repose::buildRigGeometry(*parts, separations, settings, progress));
+          repose::buildRigGeometry(*parts, separations, settings, progress, G.get()));
       auto handles = std::make_shared<std::vector<repose::RigidHandle>>(
           repose::resolveHandles(pose, geometry->cage, geometry->mesh, parts->labels()));
       return [=] {
@@ -211,15 +227,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
-    // Densities and rigid tissues: the table set, else the phantom's when G is the phantom.
-    std::shared_ptr<repose::TissueTable> tissues;
-    const std::string table = !this->TissueTablePath.empty()
-                                  ? this->TissueTablePath
-                                  : std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
-    if (fs::exists(table)) {
-      auto t = std::make_shared<repose::TissueTable>(repose::readTissueTable(table));
-      if (!this->TissueTablePath.empty() || repose::tissueTableCovers(*t, G->labels())) tissues = t;
-    }
+    const std::shared_ptr<repose::TissueTable> tissues = tissuesFor(this->TissueTablePath, *G);
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(

@@ -74,6 +74,14 @@ vtkSmartPointer<vtkUnstructuredGrid> vtkSlicerReposeMeshConversion::ToUnstructur
   labels->SetNumberOfValues(mesh.labels.size());
   for (Eigen::Index t = 0; t < mesh.labels.size(); ++t) labels->SetValue(t, mesh.labels[t]);
   grid->GetCellData()->SetScalars(labels);
+  if (!mesh.rigid.empty()) {  // whole pieces (bones, organs): their label of G, else 0
+    vtkNew<vtkIntArray> rigid;
+    rigid->SetName("rigid");
+    rigid->SetNumberOfValues(vtkIdType(mesh.rigid.size()));
+    for (std::size_t t = 0; t < mesh.rigid.size(); ++t)
+      rigid->SetValue(vtkIdType(t), mesh.rigid[t]);
+    grid->GetCellData()->AddArray(rigid);
+  }
   vtkNew<vtkDoubleArray> spacing;
   spacing->SetName("source_spacing_mm");
   spacing->InsertNextValue(mesh.sourceSpacingMm);
@@ -99,6 +107,12 @@ repose::TransferMesh vtkSlicerReposeMeshConversion::FromUnstructuredGrid(
     grid->GetCellPoints(t, ids);
     for (int k = 0; k < 4; ++k) mesh.tets(t, k) = int(ids->GetId(k));
     mesh.labels[t] = int(labels->GetTuple1(t));
+  }
+  if (vtkDataArray* rigid = grid->GetCellData()->GetArray("rigid")) {
+    if (rigid->GetNumberOfTuples() != n)
+      throw repose::Error("the transfer mesh's cell array 'rigid' does not match its cells");
+    mesh.rigid.resize(std::size_t(n));
+    for (vtkIdType t = 0; t < n; ++t) mesh.rigid[std::size_t(t)] = int(rigid->GetTuple1(t));
   }
   if (vtkDataArray* s = grid->GetFieldData()->GetArray("source_spacing_mm"))
     if (s->GetNumberOfTuples() > 0) mesh.sourceSpacingMm = s->GetTuple1(0);

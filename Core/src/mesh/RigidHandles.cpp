@@ -33,6 +33,52 @@ std::vector<int> cageOwners(Eigen::Index cageVertices, const std::vector<RigidHa
   return owner;
 }
 
+// Bones move as whole pieces. Each piece of rigid tissue (tets of one bone label connected
+// through faces: a humerus, not the humerus and the scapula it touches) is given to the
+// group that carries most of it (tet volume times the mean membership of the tet's vertices), and
+// every vertex of the piece takes that group alone. A vertex shared by pieces given to different
+// groups (where two bones touch across a joint) splits evenly between them. The bend of a joint
+// then happens in the soft tissue around the bones, never through a bone end.
+void lockRigidTissue(const TransferMesh& mesh, Eigen::MatrixXd& membership) {
+  const Eigen::Index nt = mesh.tets.rows(), groups = membership.cols();
+  const TetAdjacency adjacency = TetAdjacency::build(mesh);
+  std::vector<int> piece(std::size_t(nt), -1);
+  int pieces = 0;
+  for (Eigen::Index seed = 0; seed < nt; ++seed) {
+    if (!mesh.rigid[seed] || piece[seed] >= 0) continue;
+    std::vector<int> stack{int(seed)};
+    piece[seed] = pieces;
+    while (!stack.empty()) {
+      const int t = stack.back();
+      stack.pop_back();
+      for (const int u : adjacency.faceNeighbours[t])
+        if (mesh.rigid[u] == mesh.rigid[t] && piece[u] < 0) piece[u] = pieces, stack.push_back(u);
+    }
+    ++pieces;
+  }
+  if (pieces == 0) return;
+  Eigen::MatrixXd vote = Eigen::MatrixXd::Zero(pieces, groups);
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    if (piece[t] < 0) continue;
+    Eigen::RowVectorXd mean = Eigen::RowVectorXd::Zero(groups);
+    for (int k = 0; k < 4; ++k) mean += membership.row(mesh.tets(t, k));
+    vote.row(piece[t]) += std::fabs(tetVolume(mesh.vertices, mesh.tets.row(t))) * mean / 4;
+  }
+  std::vector<int> carrier(std::size_t(pieces), -1);
+  for (int b = 0; b < pieces; ++b) {
+    Eigen::Index g = 0;
+    if (vote.row(b).maxCoeff(&g) > 0) carrier[b] = int(g);
+  }
+  Eigen::MatrixXd locked = Eigen::MatrixXd::Zero(membership.rows(), groups);
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (piece[t] >= 0 && carrier[piece[t]] >= 0)
+      for (int k = 0; k < 4; ++k) locked(mesh.tets(t, k), carrier[piece[t]]) = 1;
+  for (Eigen::Index v = 0; v < membership.rows(); ++v) {
+    const double n = locked.row(v).sum();
+    if (n > 0) membership.row(v) = locked.row(v) / n;
+  }
+}
+
 }  // namespace
 
 int HandleInfluence::rigidVertices() const {
@@ -184,6 +230,7 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
       membership = count.cwiseInverse().asDiagonal() * sum;
     }
   }
+  if (!mesh.rigid.empty()) lockRigidTissue(mesh, membership);
   // Memberships in [0, 1] summing to at most 1 (a part named by two groups counts once).
   for (Eigen::Index v = 0; v < n; ++v) {
     auto row = membership.row(v);

@@ -307,28 +307,55 @@ Eigen::MatrixX3d greenCageValues(const TriangleMesh& rest, const Eigen::MatrixX3
 }  // namespace
 
 CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads)
-    : cage_(cage),
-      embedding_(embedInCage(mesh, cage, threads, false)),
-      solver_(mesh, embedding_.cageVertices, embedding_.cageTets),
-      threads_(threads) {
+    : cage_(cage), embedding_(embedInCage(mesh, cage, threads, false)), threads_(threads) {
   // Green coordinates of V_c in blocks of rows, each compacted at once, so the double matrix
   // (12 bytes more per coefficient) never exists for the whole mesh: at the seed's sizes it would
   // be ~430 MB, more than the rest of a posing job.
   constexpr Eigen::Index kBlock = 1024;
-  const Eigen::Index n = static_cast<Eigen::Index>(embedding_.cageVertices.size());
   restCageValues_ = greenCageValues(cage_, cage_.vertices);
-  restPositions_.resize(n, 3);
-  coefficients_ =
-      std::make_unique<CompactGreenMatrix>(n, cage_.vertices.rows(), cage_.faces.rows());
-  for (Eigen::Index first = 0; first < n; first += kBlock) {
-    const Eigen::Index rows = std::min(kBlock, n - first);
-    Eigen::MatrixX3d points(rows, 3);
-    for (Eigen::Index r = 0; r < rows; ++r)
-      points.row(r) = mesh.vertices.row(embedding_.cageVertices[first + r]);
-    const GreenCoordinates gc = computeGreenCoordinates(cage_, points, threads);
-    restPositions_.middleRows(first, rows) = applyGreenCoordinates(gc, cage_, cage_.vertices);
-    coefficients_->setRows(first, gc.phi, gc.psi);
+  // Green coordinates reproduce every point inside the cage; a vertex they miss by more than
+  // this (1e-5 of the cage's size; good vertices are within ~1e-6 mm) is treated as outside.
+  const double tolerance =
+      1e-5 * (cage_.vertices.colwise().maxCoeff() - cage_.vertices.colwise().minCoeff()).norm();
+  for (int pass = 0; pass < 2; ++pass) {
+    const Eigen::Index n = static_cast<Eigen::Index>(embedding_.cageVertices.size());
+    restPositions_.resize(n, 3);
+    restVertices_.resize(n, 3);
+    coefficients_ =
+        std::make_unique<CompactGreenMatrix>(n, cage_.vertices.rows(), cage_.faces.rows());
+    std::vector<int> missed;
+    for (Eigen::Index first = 0; first < n; first += kBlock) {
+      const Eigen::Index rows = std::min(kBlock, n - first);
+      Eigen::MatrixX3d points(rows, 3);
+      for (Eigen::Index r = 0; r < rows; ++r)
+        points.row(r) = mesh.vertices.row(embedding_.cageVertices[first + r]);
+      const GreenCoordinates gc = computeGreenCoordinates(cage_, points, threads);
+      restPositions_.middleRows(first, rows) = applyGreenCoordinates(gc, cage_, cage_.vertices);
+      restVertices_.middleRows(first, rows) = points;
+      coefficients_->setRows(first, gc.phi, gc.psi);
+      for (Eigen::Index r = 0; r < rows; ++r)
+        if (!((restPositions_.row(first + r) - points.row(r)).norm() <= tolerance))
+          missed.push_back(embedding_.cageVertices[first + r]);
+    }
+    if (missed.empty() || pass == 1) break;
+    // Once: drop them from V_c (and their tets from T_c) and compute the rows again.
+    unreproduced_ = static_cast<int>(missed.size());
+    for (const int v : missed) embedding_.inside[v] = 0;
+    std::vector<int> kept;
+    for (const int v : embedding_.cageVertices)
+      if (embedding_.inside[v]) kept.push_back(v);
+    embedding_.cageVertices = std::move(kept);
+    if (embedding_.cageVertices.empty())
+      throw Error("no transfer-mesh vertex has usable Green coordinates in this cage");
+    std::vector<int> tets;
+    for (const int t : embedding_.cageTets) {
+      bool all = true;
+      for (int c = 0; c < 4; ++c) all &= embedding_.inside[mesh.tets(t, c)] != 0;
+      if (all) tets.push_back(t);
+    }
+    embedding_.cageTets = std::move(tets);
   }
+  solver_ = std::make_unique<RigiditySolver>(mesh, embedding_.cageVertices, embedding_.cageTets);
 }
 
 CageDeformation::~CageDeformation() = default;
@@ -352,7 +379,7 @@ Eigen::MatrixX3d CageDeformation::greenPositions(const Eigen::MatrixX3d& deforme
 Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
                                          std::vector<Eigen::Matrix3d>* B,
                                          GreenPrecision precision) const {
-  return solver_.solve(greenPositions(deformedCage, precision), B);
+  return solver_->solve(greenPositions(deformedCage, precision), B);
 }
 
 Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
@@ -390,12 +417,12 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
       }
       const Eigen::RowVector3d carried =
           (blendMotions(influence.membership.row(v).transpose(), handles) *
-           Eigen::Vector3d(restPositions_.row(r)))
+           Eigen::Vector3d(restVertices_.row(r)))
               .transpose();
       targets.row(r) = w == 1 ? carried : (g + w * (carried - g)).eval();
     }
   });
-  return solver_.solve(targets, B);
+  return solver_->solve(targets, B);
 }
 
 }  // namespace repose

@@ -72,10 +72,12 @@ void cleanTransferMesh(TransferMesh& mesh, double frameSign, TransferMeshReport&
     if (vol < 0) std::swap(tet[2], tet[3]);
     for (int c = 0; c < 4; ++c) used[tet[c]] = 1;
     mesh.tets.row(kept) = tet;
+    if (!mesh.rigid.empty()) mesh.rigid[kept] = mesh.rigid[t];
     mesh.labels[kept++] = mesh.labels[t];
   }
   mesh.tets.conservativeResize(kept, 4);
   mesh.labels.conservativeResize(kept);
+  if (!mesh.rigid.empty()) mesh.rigid.resize(static_cast<std::size_t>(kept));
   // Renumber the vertices that are still used, keeping their order.
   std::vector<int> newIndex(used.size(), -1);
   int nv = 0;

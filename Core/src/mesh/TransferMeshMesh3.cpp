@@ -67,6 +67,14 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
   if (!img) throw Error("cannot allocate the meshing image");
   auto* data = static_cast<std::uint16_t*>(img->data);
   std::memset(data, 0, static_cast<std::size_t>(nx * ny * nz) * 2);
+  // With rigid tissue every (body part, bone label) pair present is a subdomain of its own.
+  const Volume* rigid = options.rigidTissue;
+  if (rigid && rigid->dims() != parts.dims()) {
+    _freeImage(img);
+    throw Error("the rigid-tissue map is not on the grid of the body-part map");
+  }
+  std::map<std::pair<int, int>, std::uint16_t> subdomainOf;
+  std::vector<std::pair<int, int>> subdomains{{0, 0}};  // index -> (part, bone)
   std::int64_t body = 0;
   for (std::int64_t k = 0; k < g.dims[2]; ++k)
     for (std::int64_t j = 0; j < g.dims[1]; ++j)
@@ -76,8 +84,20 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
           _freeImage(img);
           throw Error("labels must be in 0..65535 to be meshed");
         }
-        data[(i + frame.pad) + nx * ((j + frame.pad) + ny * (k + frame.pad))] =
-            static_cast<std::uint16_t>(v);
+        std::uint16_t word = static_cast<std::uint16_t>(v);
+        if (rigid && word != 0) {
+          const std::pair<int, int> key{int(v), int(rigid->valueAsDouble(parts.index(i, j, k)))};
+          auto [it, fresh] = subdomainOf.try_emplace(key, std::uint16_t(subdomains.size()));
+          if (fresh) {
+            if (subdomains.size() > 65535) {
+              _freeImage(img);
+              throw Error("too many (body part, bone) pairs to mesh");
+            }
+            subdomains.push_back(key);
+          }
+          word = it->second;
+        }
+        data[(i + frame.pad) + nx * ((j + frame.pad) + ny * (k + frame.pad))] = word;
         body += v != 0;
       }
   if (body == 0) {
@@ -123,6 +143,7 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::RowVector4i> tets;
   std::vector<int> labels;
+  std::vector<int> rigidTets;
   TransferMeshReport r;
   for (auto c = c3t3.cells_in_complex_begin(); c != c3t3.cells_in_complex_end(); ++c) {
     Eigen::RowVector4i t;
@@ -136,7 +157,9 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
       t[v] = it->second;
     }
     tets.push_back(t);
-    labels.push_back(static_cast<int>(c3t3.subdomain_index(c)));
+    const int subdomain = static_cast<int>(c3t3.subdomain_index(c));
+    labels.push_back(rigid ? subdomains.at(std::size_t(subdomain)).first : subdomain);
+    if (rigid) rigidTets.push_back(subdomains.at(std::size_t(subdomain)).second);
   }
   if (tets.empty())
     throw Error("meshing produced no tetrahedron (is the segmentation thinner than a voxel?)");
@@ -146,6 +169,7 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
   mesh.labels.resize(static_cast<Eigen::Index>(tets.size()));
   for (std::size_t i = 0; i < tets.size(); ++i)
     mesh.tets.row(i) = tets[i], mesh.labels[i] = labels[i];
+  mesh.rigid = std::move(rigidTets);
   // CGAL's cells are positively oriented in the image frame; a mirrored IJK->RAS (LPS-like grids)
   // flips them all, which is not an inversion.
   mesh.sourceSpacingMm = g.spacing().maxCoeff();

@@ -42,8 +42,8 @@ void writeTransferMesh(const TransferMesh& mesh, const std::string& path) {
     std::ofstream out(output.tempPath());
     if (!out) throwFileError(path, "cannot create the file");
     out << std::setprecision(17);
-    out << "<?xml version=\"1.0\"?>\n<!-- Repose transfer mesh: RAS millimetres, cell array "
-           "'label' -->\n"
+    out << "<?xml version=\"1.0\"?>\n<!-- Repose transfer mesh: RAS millimetres, cell arrays "
+           "'label' (body part) and 'rigid' (bone label or 0) -->\n"
         << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
            "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
         << "<FieldData>\n<DataArray type=\"Float64\" Name=\"source_spacing_mm\" "
@@ -68,6 +68,10 @@ void writeTransferMesh(const TransferMesh& mesh, const std::string& path) {
     out << "</DataArray>\n</Cells>\n<CellData Scalars=\"label\">\n<DataArray type=\"Int32\" "
            "Name=\"label\" format=\"ascii\">\n";
     for (Eigen::Index t = 0; t < mesh.labels.size(); ++t) out << mesh.labels[t] << "\n";
+    if (!mesh.rigid.empty()) {
+      out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"rigid\" format=\"ascii\">\n";
+      for (const int r : mesh.rigid) out << r << "\n";
+    }
     out << "</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
     if (!out.flush()) throwFileError(path, "write failed (disk full?)");
   }
@@ -106,6 +110,14 @@ TransferMesh readTransferMesh(const std::string& path) {
   auto l = dataArray(xml, "label", path);
   for (long t = 0; t < cells; ++t)
     if (!(l >> mesh.labels[t])) throwFileError(path, "truncated label array");
+  if (xml.find("Name=\"rigid\"") != std::string::npos) {  // optional: meshes with bone subdomains
+    mesh.rigid.resize(static_cast<std::size_t>(cells));
+    auto r = dataArray(xml, "rigid", path);
+    for (long t = 0; t < cells; ++t) {
+      if (!(r >> mesh.rigid[static_cast<std::size_t>(t)]) || mesh.rigid[std::size_t(t)] < 0)
+        throwFileError(path, "truncated or negative rigid array");
+    }
+  }
   if (xml.find("Name=\"source_spacing_mm\"") != std::string::npos) {  // optional (older files)
     auto f = dataArray(xml, "source_spacing_mm", path);
     if (!(f >> mesh.sourceSpacingMm) || !(mesh.sourceSpacingMm >= 0))

@@ -2,10 +2,106 @@
 
 #include "repose/util/Error.h"
 
+#include <map>
+#include <optional>
+#include <set>
+
 namespace repose {
 
+std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
+                                   const RigSettings& settings) {
+  if (organs.dims() != parts.dims())
+    throw Error("the label map is not on the grid of the body-part map");
+  std::set<int> whole(settings.rigidLabels.begin(), settings.rigidLabels.end());
+  if (settings.wholeOrgans) {
+    // Voxels of each label of G per body part of S.
+    std::map<int, std::map<int, std::int64_t>> counts;
+    for (std::int64_t i = 0; i < organs.numVoxels(); ++i) {
+      const double label = organs.valueAsDouble(i), part = parts.valueAsDouble(i);
+      if (label > 0 && part > 0) ++counts[int(label)][int(part)];
+    }
+    for (const auto& [label, perPart] : counts) {
+      std::int64_t total = 0, most = 0;
+      for (const auto& [part, n] : perPart) total += n, most = std::max(most, n);
+      if (double(most) >= kWholeOrganShare * double(total)) whole.insert(label);
+    }
+  }
+  std::vector<int> out;
+  for (const int label : whole)
+    if (label > 0 && label <= 65535) out.push_back(label);
+  return out;
+}
+
+namespace {
+// Seam half-width in voxels. Mesh_3 follows subdomain borders only to within a voxel, so a mesh
+// vertex can still land on both pieces' surfaces; demotePiecesAcrossJoints catches those.
+constexpr int kSeamVoxels = 1;
+}  // namespace
+
+int demotePiecesAcrossJoints(TransferMesh& mesh) {
+  if (mesh.rigid.empty()) return 0;
+  // The body part of the pieces at each vertex; -2 where pieces of two parts meet.
+  std::vector<int> partAt(std::size_t(mesh.vertices.rows()), -1);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (!mesh.rigid[std::size_t(t)]) continue;
+    for (int c = 0; c < 4; ++c) {
+      int& p = partAt[std::size_t(mesh.tets(t, c))];
+      p = p == -1 ? mesh.labels[t] : (p == mesh.labels[t] ? p : -2);
+    }
+  }
+  int demoted = 0;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (!mesh.rigid[std::size_t(t)]) continue;
+    bool joint = false;
+    for (int c = 0; c < 4; ++c) joint |= partAt[std::size_t(mesh.tets(t, c))] == -2;
+    if (joint) mesh.rigid[std::size_t(t)] = 0, ++demoted;
+  }
+  return demoted;
+}
+
+Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSettings& settings) {
+  const std::vector<int> whole = labelsMovingWhole(organs, parts, settings);
+  if (whole.empty()) return Volume();
+  Volume pieces(parts.geometry(), ScalarType::UInt16);
+  std::vector<char> isWhole(65536, 0);
+  for (const int label : whole) isWhole[std::size_t(label)] = 1;
+  std::uint16_t* piece = pieces.data<std::uint16_t>();
+  for (std::int64_t i = 0; i < parts.numVoxels(); ++i) {
+    const double label = organs.valueAsDouble(i);
+    if (label > 0 && label <= 65535 && isWhole[std::size_t(label)])
+      piece[i] = static_cast<std::uint16_t>(label);
+  }
+  // Where pieces of two body parts touch (bones at a joint) a seam of soft tissue is left between
+  // them, so no mesh vertex belongs to both: each moves whole with its own part's group and the
+  // seam takes the bend, as a joint's cartilage and capsule do.
+  const auto& d = parts.dims();
+  std::vector<std::int64_t> seam;
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    for (std::int64_t j = 0; j < d[1]; ++j)
+      for (std::int64_t i = 0; i < d[0]; ++i) {
+        const std::int64_t at = parts.index(i, j, k);
+        const std::uint16_t own = piece[at];
+        if (own == 0) continue;
+        const double part = parts.valueAsDouble(at);
+        auto other = [&](std::int64_t di, std::int64_t dj, std::int64_t dk) {
+          const std::int64_t a = i + di, b = j + dj, c = k + dk;
+          if (a < 0 || b < 0 || c < 0 || a >= d[0] || b >= d[1] || c >= d[2]) return false;
+          const std::int64_t n = parts.index(a, b, c);
+          return piece[n] != 0 && piece[n] != own && parts.valueAsDouble(n) != part;
+        };
+        bool near = false;
+        for (int s = 1; s <= kSeamVoxels && !near; ++s)
+          near = other(-s, 0, 0) || other(s, 0, 0) || other(0, -s, 0) || other(0, s, 0) ||
+                 other(0, 0, -s) || other(0, 0, s);
+        if (near) seam.push_back(at);
+      }
+  for (const std::int64_t at : seam) piece[at] = 0;
+  return pieces;
+}
+
 RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparation>& separations,
-                             const RigSettings& settings, const ProgressFn& progress) {
+                             const RigSettings& settings, const ProgressFn& progress,
+                             const Volume* organs) {
   auto scaled = [&](double from, double to) -> ProgressFn {
     if (!progress) return {};
     return
@@ -22,7 +118,13 @@ RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparati
   TransferMeshOptions to;
   to.sizeMm = settings.meshMm;
   to.progress = scaled(0.5, 1);
+  std::optional<Volume> pieces;
+  if (organs) {
+    pieces = wholePieceMap(*organs, parts, settings);
+    if (pieces->numVoxels() > 0) to.rigidTissue = &*pieces;
+  }
   g.mesh = buildTransferMesh(parts, to);
+  demotePiecesAcrossJoints(g.mesh);
   for (const LimbSeparation& s : separations) separateLabels(g.mesh, s.labelA, s.labelB, s.region);
   reportProgress(progress, 1, "rig built");
   return g;

@@ -121,13 +121,19 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
         }
       },
       1);
+  // Tets of whole pieces (bones, organs) go last, so where a fold of soft tissue overlaps a bone
+  // the bone keeps its voxels: soft tissue is what a bend squeezes.
   std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax;
-  for (const Candidates& c : parts) {
-    candidates.insert(candidates.end(), c.tet.begin(), c.tet.end());
-    jmin.insert(jmin.end(), c.jmin.begin(), c.jmin.end());
-    jmax.insert(jmax.end(), c.jmax.begin(), c.jmax.end());
-    kmin.insert(kmin.end(), c.kmin.begin(), c.kmin.end());
-    kmax.insert(kmax.end(), c.kmax.begin(), c.kmax.end());
+  const bool withPieces = in.pieces && !in.pieces->empty();
+  for (const int pass : {0, 1}) {
+    if (pass == 1 && !withPieces) break;
+    for (const Candidates& c : parts)
+      for (std::size_t n = 0; n < c.tet.size(); ++n) {
+        if (withPieces && ((*in.pieces)[std::size_t(c.tet[n])] != 0) != (pass == 1)) continue;
+        candidates.push_back(c.tet[n]);
+        jmin.push_back(c.jmin[n]), jmax.push_back(c.jmax[n]);
+        kmin.push_back(c.kmin[n]), kmax.push_back(c.kmax[n]);
+      }
   }
   // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
   // bands of j-rows across all slices, so every core has work either way.

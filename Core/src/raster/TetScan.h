@@ -37,6 +37,7 @@ namespace repose::raster {
 // Vertex positions mapped once into the grids the scan works in.
 struct ScanInput {
   const Eigen::MatrixX4i* tets = nullptr;
+  const std::vector<int>* pieces = nullptr;   // TransferMesh::rigid (may be empty)
   std::vector<Eigen::Vector3d> out;           // deformed positions in output IJK
   std::vector<Eigen::Vector3d> rest;          // rest positions in input IJK
   std::array<std::int64_t, 3> dims{0, 0, 0};  // output grid
@@ -46,6 +47,7 @@ inline ScanInput makeScanInput(const TransferMesh& mesh, const Eigen::MatrixX3d&
                                const VolumeGeometry& input, const VolumeGeometry& output) {
   ScanInput s;
   s.tets = &mesh.tets;
+  s.pieces = &mesh.rigid;
   s.dims = output.dims;
   const Eigen::Matrix4d toOut = output.ijkToRas.inverse(), toIn = input.ijkToRas.inverse();
   s.out.resize(static_cast<std::size_t>(deformed.rows()));

@@ -447,3 +447,29 @@ TEST(Rasterizer, OutOfCoreEqualsInCoreVoxelForVoxel) {
   }
   EXPECT_THROW(SliceCache(dir.file("G.nii"), 10), Error);  // cannot hold two slices
 }
+
+// Two boxes of tets from different rest places (label 1 and label 2 of G) deformed onto the same
+// place: the later box wins, unless the earlier one is a whole piece (a bone), which always does.
+TEST(Rasterizer, AWholePieceKeepsItsVoxelsWhereSoftTissueFoldsOverIt) {
+  const TransferMesh bone = tetBox({2, 2, 2}, {8, 8, 8}, {3, 3, 3});
+  const TransferMesh soft = tetBox({12, 2, 2}, {18, 8, 8}, {3, 3, 3});
+  TransferMesh mesh = concatenate(bone, soft);
+  Eigen::MatrixX3d deformed = mesh.vertices;
+  deformed.bottomRows(soft.vertices.rows()).col(0).array() -= 10;  // soft lands on the bone
+  Volume G(unitGrid({22, 12, 12}), ScalarType::UInt8);
+  for (std::int64_t k = 0; k < 12; ++k)
+    for (std::int64_t j = 0; j < 12; ++j)
+      for (std::int64_t i = 0; i < 22; ++i)
+        G.data<std::uint8_t>()[G.index(i, j, k)] = i < 10 ? 1 : 2;
+  auto labelAt = [&](const Volume& v) { return int(v.data<std::uint8_t>()[v.index(5, 5, 5)]); };
+  EXPECT_EQ(labelAt(rasterizeLabels(G, mesh, deformed, G.geometry())), 2);  // later tet wins
+  mesh.rigid.assign(std::size_t(mesh.tets.rows()), 0);
+  std::fill_n(mesh.rigid.begin(), bone.tets.rows(), 11);
+  const Volume withPieces = rasterizeLabels(G, mesh, deformed, G.geometry());
+  int notBone = 0;
+  for (std::int64_t k = 2; k < 8; ++k)
+    for (std::int64_t j = 2; j < 8; ++j)
+      for (std::int64_t i = 2; i < 8; ++i)
+        notBone += withPieces.data<std::uint8_t>()[withPieces.index(i, j, k)] != 1;
+  EXPECT_EQ(notBone, 0);
+}

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 using namespace repose;
 using namespace repose::test;
 
@@ -178,4 +180,50 @@ TEST(RigidHandles, JointRingsWidenTheTransitionOnly) {
     EXPECT_NEAR(hi, 50 + 5 * rings, 1e-9) << rings;
   }
   EXPECT_THROW(computeHandleInfluence(bar.mesh, bar.cage, {h}, 0, -1), Error);
+}
+
+// Whole pieces (TransferMesh::rigid): a bone straddling the parts' border goes with the group
+// holding most of it, every vertex of it alone; one inside part 1 goes with part 1's group; where
+// two pieces of different groups share vertices, those split evenly.
+TEST(RigidHandles, WholePiecesMoveWithTheGroupCarryingMostOfThem) {
+  Bar bar;
+  auto centreX = [&](Eigen::Index t) {
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += bar.mesh.vertices(bar.mesh.tets(t, k), 0) / 4;
+    return x;
+  };
+  bar.mesh.rigid.assign(std::size_t(bar.mesh.tets.rows()), 0);
+  for (Eigen::Index t = 0; t < bar.mesh.tets.rows(); ++t) {
+    const double x = centreX(t);
+    if (x > 40 && x < 75) bar.mesh.rigid[t] = 14;  // mostly in part 2
+    if (x > 10 && x < 40) bar.mesh.rigid[t] = 10;  // in part 1, touching the first at x = 40
+  }
+  RigidHandle limb, body;
+  limb.parts = {2}, body.parts = {1};
+  const HandleInfluence inf = computeHandleInfluence(bar.mesh, bar.cage, {limb, body});
+  int shared = 0;
+  for (Eigen::Index t = 0; t < bar.mesh.tets.rows(); ++t) {
+    if (!bar.mesh.rigid[t]) continue;
+    for (int k = 0; k < 4; ++k) {
+      const int v = bar.mesh.tets(t, k);
+      const double x = bar.mesh.vertices(v, 0);
+      if (std::fabs(x - 40) < 1e-9) {
+        EXPECT_DOUBLE_EQ(inf.membership(v, 0), 0.5);
+        EXPECT_DOUBLE_EQ(inf.membership(v, 1), 0.5);
+        ++shared;
+        continue;
+      }
+      const int group = bar.mesh.rigid[t] == 14 ? 0 : 1;
+      EXPECT_EQ(inf.membership(v, group), 1.0) << "vertex at x = " << x;
+      EXPECT_EQ(inf.membership(v, 1 - group), 0.0);
+      EXPECT_EQ(inf.weight[v], 1.0);
+    }
+  }
+  EXPECT_GT(shared, 0);
+  // Without pieces the bone's part-1 end (x in 40..50) would blend towards part 1.
+  bar.mesh.rigid.clear();
+  const HandleInfluence plain = computeHandleInfluence(bar.mesh, bar.cage, {limb, body});
+  for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v)
+    if (bar.mesh.vertices(v, 0) > 40.1 && bar.mesh.vertices(v, 0) < 49.9)
+      EXPECT_EQ(plain.membership(v, 0), 0.0);
 }

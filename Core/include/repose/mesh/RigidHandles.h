@@ -54,7 +54,8 @@ Eigen::Isometry3d blendMotions(const Eigen::Ref<const Eigen::VectorXd>& weights,
 // Throws repose::Error for a cage index out of range or a cage vertex in two groups.
 // jointRings > 0 widens each transition by that many rings of TM vertices on both sides
 // (memberships averaged with their edge neighbours): a gentler bend, less of the crease folding
-// over itself, but bone ends near the joint bend with it (docs/QUALITY.md).
+// over itself (docs/QUALITY.md). Then, when the mesh has whole pieces (TransferMesh::rigid), each
+// piece goes to the group carrying most of it, all its vertices with that group alone.
 HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleMesh& cage,
                                        const std::vector<RigidHandle>& handles, int threads = 0,
                                        int jointRings = 0);

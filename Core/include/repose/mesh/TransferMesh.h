@@ -7,6 +7,7 @@
 #include "repose/volume/Volume.h"
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,10 @@ struct TransferMesh {
   Eigen::MatrixX3d vertices;  // #V by 3 rest positions, RAS mm
   Eigen::MatrixX4i tets;      // #T by 4 vertex indices, positively oriented (volume > 0)
   Eigen::VectorXi labels;     // #T body-part label (subdomain of S) of each tet
+  // #T labels of rigid tissue (bone; a label of G), 0 for soft tissue; empty when not meshed with
+  // bones. Bones are subdomains of their own (TransferMeshOptions::rigidTissue), so a bone is a
+  // union of whole tets, which a pose moves as one piece (computeHandleInfluence).
+  std::vector<int> rigid;
   // The largest voxel size of the grid it was meshed from (mm; 0 when unknown). Mesh_3 puts the
   // surface to within about this of the label boundary; the rasterizer's shell covers the gap.
   double sourceSpacingMm = 0;
@@ -36,6 +41,10 @@ struct SizingField {
 struct TransferMeshOptions {
   double sizeMm = 0;                    // uniform size; 0: 5% of S's diagonal (the seed's default)
   const SizingField* sizing = nullptr;  // overrides sizeMm when set
+  // Optional label map on S's grid: the label of rigid tissue (bone, from G and a tissue table)
+  // where there is one, else 0. Its boundaries become subdomain boundaries of the mesh and
+  // TransferMesh::rigid carries its labels.
+  const Volume* rigidTissue = nullptr;
   ProgressFn progress;
 };
 

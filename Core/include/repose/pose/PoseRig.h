@@ -19,16 +19,42 @@ struct RigSettings {
   double dilateMm = 10;
   double meshMm = 0;  // transfer-mesh tet size; 0: 5% of S's diagonal
   int threads = 0;
+  // Labels of G that are rigid tissue (bones; TissueTable's rigid column). Meshed as pieces of
+  // their own that a pose moves whole with their body part, so they stay rigid at the joints.
+  std::vector<int> rigidLabels;
+  // Also mesh as whole pieces the labels of G that lie in one body part of S (organs: the
+  // bladder beside the hip moves with the pelvis instead of bending with the thigh).
+  bool wholeOrgans = true;
 };
+
+// The share of a label's voxels in one body part above which it is an organ of that part.
+constexpr double kWholeOrganShare = 0.99;
+
+// The labels of G that buildRigGeometry meshes as whole pieces: settings.rigidLabels, and with
+// settings.wholeOrgans every label with kWholeOrganShare of its voxels in one part of S.
+std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
+                                   const RigSettings& settings);
 
 struct RigGeometry {
   TriangleMesh cage;
   TransferMesh mesh;
 };
 
-// Cage and transfer mesh of S, separated where asked. Progress: cage 0-0.5, mesh 0.5-1.
+// The map buildRigGeometry meshes the pieces from (TransferMeshOptions::rigidTissue): on S's grid,
+// the label of G where it is one of the labelsMovingWhole, else 0, with a seam of 0 where pieces
+// of different body parts touch (a joint). An empty Volume when no label moves whole.
+Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSettings& settings);
+
+// Tets of pieces that share a vertex with a piece of another body part (a bone end meshed onto
+// its neighbour across a joint, closer than the seam) become soft tissue, so that pieces of
+// different parts never share a vertex and each moves exactly with its group. Returns how many.
+int demotePiecesAcrossJoints(TransferMesh& mesh);
+
+// Cage and transfer mesh of S, separated where asked; with G (organs, on S's grid) the mesh has
+// the labelsMovingWhole as pieces of their own. Progress: cage 0-0.5, mesh 0.5-1.
 RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparation>& separations,
-                             const RigSettings& settings, const ProgressFn& progress = {});
+                             const RigSettings& settings, const ProgressFn& progress = {},
+                             const Volume* organs = nullptr);
 
 class PoseRig {
  public:

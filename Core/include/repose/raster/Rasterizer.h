@@ -61,7 +61,8 @@ struct RasterReport {
 // Labels: each output voxel whose centre lies in a deformed tet (or its shell, see RasterOptions)
 // takes the value of `labels` at the nearest input voxel to its rest position (0 beyond the input
 // grid); other voxels are 0. Where
-// folded tets overlap, the highest-numbered tet wins. Every layer of `labels` is mapped; the
+// folded tets overlap, a tet of a whole piece (a bone or organ: TransferMesh::rigid) wins over
+// soft tissue, and among equals the highest-numbered tet. Every layer of `labels` is mapped; the
 // scalar type and label table are kept.
 Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
                        const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,

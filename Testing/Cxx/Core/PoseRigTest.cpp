@@ -1,0 +1,172 @@
+// The rig's whole pieces (PoseRig.h): bones and the organs that lie in one body part are meshed
+// as pieces of their own, with a seam where pieces of two parts touch, and every frame moves each
+// piece exactly with one group; the mesh file keeps them.
+#include "TestPaths.h"
+
+#include "repose/mesh/TransferMesh.h"
+#include "repose/phantom/Phantom.h"
+#include "repose/pose/PoseRig.h"
+#include "repose/volume/TissueTable.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+using namespace repose;
+using namespace repose::test;
+
+namespace {
+
+// The 4 mm phantom and the settings `repose pose` uses for it (bones from its tissue table).
+struct Rigged {
+  Volume organs, parts;
+  RigSettings settings;
+  Rigged() {
+    PhantomOptions o;
+    o.voxelMm = 4;
+    std::tie(organs, parts) = Phantom(o).makeVolumes();
+    const TissueTable tissues =
+        readTissueTable(std::string(REPOSE_SOURCE_DIR) + "/Resources/Tissues/phantom.csv");
+    for (const auto& [label, tissue] : tissues)
+      if (tissue.rigid) settings.rigidLabels.push_back(label);
+    settings.cageVertices = 200;
+  }
+};
+
+int labelNamed(const Volume& v, const std::string& name) {
+  for (const Label& l : v.labels().labels())
+    if (l.name == name) return l.value;
+  ADD_FAILURE() << "no label " << name;
+  return -1;
+}
+
+const Rigged& rigged() {
+  static const Rigged r;
+  return r;
+}
+
+}  // namespace
+
+TEST(PoseRig, BonesAndOrgansOfOnePartMoveWholeButNotTheTissuesThatCrossJoints) {
+  const Rigged& r = rigged();
+  const std::vector<int> whole = labelsMovingWhole(r.organs, r.parts, r.settings);
+  const std::set<int> set(whole.begin(), whole.end());
+  for (const int bone : r.settings.rigidLabels) EXPECT_TRUE(set.count(bone)) << bone;
+  for (const char* organ : {"brain", "urinary_bladder", "liver", "lung_left", "heart"})
+    EXPECT_TRUE(set.count(labelNamed(r.organs, organ))) << organ;
+  for (const char* crossing : {"skin", "subcutaneous_fat", "muscle"})
+    EXPECT_FALSE(set.count(labelNamed(r.organs, crossing))) << crossing;
+  RigSettings bonesOnly = r.settings;
+  bonesOnly.wholeOrgans = false;
+  EXPECT_EQ(labelsMovingWhole(r.organs, r.parts, bonesOnly), r.settings.rigidLabels);
+
+  // The map: those labels where G has them, and no two pieces of different parts face to face.
+  const Volume map = wholePieceMap(r.organs, r.parts, r.settings);
+  ASSERT_EQ(map.dims(), r.parts.dims());
+  const std::uint16_t* m = map.data<std::uint16_t>();
+  const auto d = map.dims();
+  std::map<int, std::int64_t> kept, total;
+  int touching = 0;
+  for (std::int64_t k = 0; k + 1 < d[2]; ++k)
+    for (std::int64_t j = 0; j + 1 < d[1]; ++j)
+      for (std::int64_t i = 0; i + 1 < d[0]; ++i) {
+        const std::int64_t at = map.index(i, j, k);
+        const int label = int(r.organs.valueAsDouble(at));
+        if (set.count(label)) ++total[label];
+        if (m[at] == 0) continue;
+        EXPECT_EQ(m[at], label);
+        ++kept[label];
+        for (const std::int64_t n :
+             {map.index(i + 1, j, k), map.index(i, j + 1, k), map.index(i, j, k + 1)})
+          touching +=
+              m[n] != 0 && m[n] != m[at] && r.parts.valueAsDouble(n) != r.parts.valueAsDouble(at);
+      }
+  EXPECT_EQ(touching, 0);
+  for (const int label : whole)
+    if (total[label] > 0) {
+      EXPECT_GE(kept[label], 0.8 * double(total[label])) << label;
+    }
+  // The seam exists: the humerus and the radius/ulna touch at the elbows in G.
+  EXPECT_LT(kept[labelNamed(r.organs, "humerus")], total[labelNamed(r.organs, "humerus")]);
+}
+
+TEST(PoseRig, EveryPieceMovesExactlyWithOneGroupInEveryFrame) {
+  const Rigged& r = rigged();
+  RigGeometry geometry = buildRigGeometry(r.parts, {}, r.settings, {}, &r.organs);
+  const TransferMesh& mesh = geometry.mesh;
+  ASSERT_EQ(mesh.rigid.size(), std::size_t(mesh.tets.rows()));
+  // Pieces are whole tets of their label: their centres lie in that label's voxels.
+  std::int64_t pieceTets = 0, agree = 0;
+  std::set<int> pieceLabels;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (!mesh.rigid[t]) continue;
+    ++pieceTets;
+    pieceLabels.insert(mesh.rigid[t]);
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += mesh.vertices.row(mesh.tets(t, k)).transpose() / 4;
+    const Eigen::Vector3d ijk = r.organs.geometry().rasToVoxel(c);
+    agree += r.organs.valueAsDouble(r.organs.index(std::lround(ijk.x()), std::lround(ijk.y()),
+                                                   std::lround(ijk.z()))) == mesh.rigid[t];
+  }
+  EXPECT_GE(agree, 0.9 * double(pieceTets));
+  EXPECT_TRUE(pieceLabels.count(labelNamed(r.organs, "femur")));
+  EXPECT_TRUE(pieceLabels.count(labelNamed(r.organs, "urinary_bladder")));
+
+  // No vertex is shared by pieces of two body parts (across a joint), and demoting finds none.
+  std::map<int, std::set<int>> partsAtVertex;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    if (mesh.rigid[t])
+      for (int k = 0; k < 4; ++k) partsAtVertex[mesh.tets(t, k)].insert(mesh.labels[t]);
+  for (const auto& [v, parts] : partsAtVertex) ASSERT_EQ(parts.size(), 1u) << "vertex " << v;
+  TransferMesh copy = mesh;
+  EXPECT_EQ(demotePiecesAcrossJoints(copy), 0);
+
+  // The file keeps them.
+  ScratchDir dir("rig");
+  writeTransferMesh(mesh, dir.file("tm.vtu"));
+  EXPECT_EQ(readTransferMesh(dir.file("tm.vtu")).rigid, mesh.rigid);
+
+  // The leg step: each piece's vertices are exactly one group's motion of their rest positions.
+  const Pose pose = readPoseFile(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/walk.pose.json");
+  const PoseRig rig(std::move(geometry), pose, r.parts.labels());
+  // Every vertex left in V_c is reproduced by its Green coordinates.
+  {
+    const Eigen::MatrixX3d g = rig.deformation().greenPositions(rig.cage().vertices);
+    const std::vector<int>& vc = rig.deformation().embedding().cageVertices;
+    for (std::size_t r = 0; r < vc.size(); ++r)
+      ASSERT_LT((g.row(Eigen::Index(r)) - rig.mesh().vertices.row(vc[r])).norm(), 0.02) << vc[r];
+  }
+  for (std::size_t f = 0; f < rig.frameCount(); f += 3) {
+    const PoseRig::Frame frame = rig.frame(f);
+    std::map<int, std::set<int>> groupsOfLabel;
+    const std::vector<char>& inCage = rig.deformation().embedding().inside;
+    std::int64_t pieces = 0, checked = 0;
+    for (Eigen::Index t = 0; t < rig.mesh().tets.rows(); ++t) {
+      if (!rig.mesh().rigid[t]) continue;
+      // Vertices outside the cage (a few at the crown and soles) are left to the solver.
+      ++pieces;
+      bool allInCage = true;
+      for (int k = 0; k < 4; ++k) allInCage &= inCage[rig.mesh().tets(t, k)] != 0;
+      if (!allInCage) continue;
+      ++checked;
+      int group = -1;
+      for (std::size_t g = 0; g < frame.handles.size() && group < 0; ++g) {
+        bool all = true;
+        for (int k = 0; k < 4; ++k) {
+          const int v = rig.mesh().tets(t, k);
+          const Eigen::Vector3d rest = rig.mesh().vertices.row(v).transpose();
+          all &= (frame.handles[g].motion * rest - frame.deformed.row(v).transpose()).norm() < 1e-6;
+        }
+        if (all) group = int(g);
+      }
+      ASSERT_GE(group, 0) << "frame " << f << ": tet " << t << " of piece label "
+                          << rig.mesh().rigid[t] << " follows no group";
+      groupsOfLabel[rig.mesh().labels[t]].insert(group);
+    }
+    EXPECT_GE(checked, 0.95 * double(pieces));
+    // One group per body part: the thigh's femur goes with its leg, the pelvis with the body.
+    for (const auto& [part, groups] : groupsOfLabel)
+      EXPECT_EQ(groups.size(), 1u) << "frame " << f << ", body part " << part;
+  }
+}
