@@ -32,11 +32,15 @@ class qSlicerReposeModule : public QObject, public qSlicerAbstractReposeModule {
   QWidget* createWidgetRepresentation(QWidget* parent) override;
   QStringList fileFilters() const override;
   bool openFile(const QString& path, QString* errorMessage) override;
+  QWidget* createViewRepresentation(QWidget* parent) override;
+  bool saveScene(const QString& folder, QString* errorMessage) override;
+  bool isBusy() const override;
 
   vtkSlicerReposeLogic* logic() const;
   vtkMRMLReposeParametersNode* parameterNode() const;
 
  private:
+  bool openScene(const QString& folder, QString* errorMessage);
   vtkSmartPointer<vtkSlicerReposeLogic> Logic;
   vtkSmartPointer<vtkMRMLReposeParametersNode> ParameterNode;
 };

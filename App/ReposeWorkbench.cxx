@@ -6,6 +6,7 @@
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QPixmap>
+#include <QSurfaceFormat>
 #include <QTextStream>
 #include <QTimer>
 
@@ -33,6 +34,22 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     for (const char* option : {"--list-modules", "--help", "-h", "--version", "-v"})
       headless = headless || std::strcmp(argv[i], option) == 0;
+  // Modules' 3D views (VTK) need an OpenGL 3.2 core context; it must be the default before the
+  // application exists.
+  if (!headless) {
+    QSurfaceFormat format;
+    format.setRenderableType(QSurfaceFormat::OpenGL);
+    format.setVersion(3, 2);
+    format.setProfile(QSurfaceFormat::CoreProfile);
+    format.setSwapBehavior(QSurfaceFormat::DoubleBuffer);
+    format.setRedBufferSize(8);
+    format.setGreenBufferSize(8);
+    format.setBlueBufferSize(8);
+    format.setDepthBufferSize(8);
+    format.setAlphaBufferSize(8);
+    format.setStencilBufferSize(0);
+    QSurfaceFormat::setDefaultFormat(format);
+  }
   std::unique_ptr<QCoreApplication> app(headless ? new QCoreApplication(argc, argv)
                                                  : new QApplication(argc, argv));
   QCoreApplication::setApplicationName("ReposeWorkbench");
@@ -48,10 +65,16 @@ int main(int argc, char** argv) {
       "dir");
   const QCommandLineOption moduleOption("module", "Show module <name> first.", "name");
   const QCommandLineOption openOption("open", "Open <file> with the current module.", "file");
+  const QCommandLineOption sceneOption(
+      "scene", "Open the scene folder <dir> (scene.json and its files) with the current module.",
+      "dir");
   const QCommandLineOption screenshotOption(
-      "screenshot", "Render the window to <png> and exit (works with QT_QPA_PLATFORM=offscreen).",
+      "screenshot",
+      "Render the window to <png> and exit (after the module's background work; the 3D view "
+      "needs a display, e.g. xvfb-run).",
       "png");
-  parser.addOptions({listOption, pathOption, moduleOption, openOption, screenshotOption});
+  parser.addOptions(
+      {listOption, pathOption, moduleOption, openOption, sceneOption, screenshotOption});
   parser.process(*app);
 
   qReposeModuleDiscovery discovery;
@@ -67,8 +90,14 @@ int main(int argc, char** argv) {
   }
   bool opened = true;
   if (parser.isSet(openOption)) opened = window.openFile(parser.value(openOption));
+  if (parser.isSet(sceneOption)) opened = window.openFile(parser.value(sceneOption)) && opened;
   window.show();
   if (parser.isSet(screenshotOption)) {
+    // The scene's background work (live posing) finishes before the picture is taken.
+    if (!window.waitWhileBusy(300)) {
+      err << "error: the module was still busy after 300 s\n";
+      return 1;
+    }
     QCoreApplication::processEvents();
     const QString path = parser.value(screenshotOption);
     if (!window.grab().save(path)) {

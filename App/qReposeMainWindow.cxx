@@ -8,6 +8,13 @@
 #include <QApplication>
 #include <QComboBox>
 #include <QDockWidget>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QElapsedTimer>
+#include <QLabel>
+#include <QMimeData>
+#include <QThread>
+#include <QUrl>
 #include <QFileDialog>
 #include <QGroupBox>
 #include <QMenuBar>
@@ -51,15 +58,32 @@ qReposeMainWindow::qReposeMainWindow(qReposeModuleDiscovery* discovery, QWidget*
   dock->setWidget(panel);
   this->addDockWidget(Qt::LeftDockWidgetArea, dock);
 
+  // The centre holds the current module's views (Slicer's layout area); the log sits below.
+  this->Views = new QStackedWidget;
+  this->Views->setObjectName("ModuleViews");
+  auto* placeholder = new QLabel("This module has no views.");
+  placeholder->setAlignment(Qt::AlignCenter);
+  this->Views->addWidget(placeholder);
+  this->setCentralWidget(this->Views);
   this->Log = new QPlainTextEdit;
   this->Log->setObjectName("MessageLog");
   this->Log->setReadOnly(true);
-  this->setCentralWidget(this->Log);
+  auto* logDock = new QDockWidget("Messages");
+  logDock->setObjectName("MessageDock");
+  logDock->setFeatures(QDockWidget::DockWidgetMovable | QDockWidget::DockWidgetFloatable);
+  logDock->setWidget(this->Log);
+  this->addDockWidget(Qt::BottomDockWidgetArea, logDock);
+  this->setAcceptDrops(true);
 
   QMenu* fileMenu = this->menuBar()->addMenu("&File");
   QAction* openAction = fileMenu->addAction("&Open...");
   openAction->setShortcut(QKeySequence::Open);
   connect(openAction, &QAction::triggered, this, &qReposeMainWindow::onOpenTriggered);
+  QAction* openSceneAction = fileMenu->addAction("Open &Scene Folder...");
+  connect(openSceneAction, &QAction::triggered, this, &qReposeMainWindow::onOpenSceneTriggered);
+  QAction* saveSceneAction = fileMenu->addAction("Save Scene &As...");
+  saveSceneAction->setShortcut(QKeySequence::SaveAs);
+  connect(saveSceneAction, &QAction::triggered, this, &qReposeMainWindow::onSaveSceneTriggered);
   fileMenu->addSeparator();
   QAction* quitAction = fileMenu->addAction("&Quit");
   quitAction->setShortcut(QKeySequence::Quit);
@@ -99,6 +123,13 @@ void qReposeMainWindow::onModuleIndexChanged(int index) {
     this->ModulePanels->addWidget(widget);
   }
   this->ModulePanels->setCurrentWidget(this->Panels.value(name));
+  if (!this->ModuleViews.contains(name)) {
+    QWidget* views = m->module->createViewRepresentation(this->Views);
+    this->ModuleViews.insert(name, views);
+    if (views) this->Views->addWidget(views);
+  }
+  QWidget* views = this->ModuleViews.value(name);
+  this->Views->setCurrentWidget(views ? views : this->Views->widget(0));
   this->HelpBrowser->setHtml("<p>" + m->module->helpText() + "</p><p><i>Contributors:</i> " +
                              m->module->contributors().join(", ") + "</p><p>" +
                              m->module->acknowledgementText() + "</p>");
@@ -113,6 +144,54 @@ bool qReposeMainWindow::openFile(const QString& path) {
   this->logMessage(message);
   this->statusBar()->showMessage(message, 10000);
   return ok;
+}
+
+bool qReposeMainWindow::saveScene(const QString& folder) {
+  const qReposeModuleDiscovery::Module* m = this->Discovery->findModule(this->currentModuleName());
+  QString error;
+  const bool ok = m ? m->module->saveScene(folder, &error) : false;
+  if (!m) error = "no module is loaded to save a scene";
+  const QString message = ok ? "Saved the scene to " + folder : "Error: " + error;
+  this->logMessage(message);
+  this->statusBar()->showMessage(message, 10000);
+  return ok;
+}
+
+bool qReposeMainWindow::waitWhileBusy(double seconds) {
+  const qReposeModuleDiscovery::Module* m = this->Discovery->findModule(this->currentModuleName());
+  QElapsedTimer timer;
+  timer.start();
+  while (m && m->module->isBusy()) {
+    if (timer.elapsed() > seconds * 1000) return false;
+    QCoreApplication::processEvents(QEventLoop::AllEvents, 50);
+    QThread::msleep(10);
+  }
+  QCoreApplication::processEvents();
+  return true;
+}
+
+QWidget* qReposeMainWindow::currentViews() const {
+  return this->ModuleViews.value(this->currentModuleName());
+}
+
+void qReposeMainWindow::dragEnterEvent(QDragEnterEvent* event) {
+  if (event->mimeData()->hasUrls()) event->acceptProposedAction();
+}
+
+void qReposeMainWindow::dropEvent(QDropEvent* event) {
+  for (const QUrl& url : event->mimeData()->urls())
+    if (url.isLocalFile()) this->openFile(url.toLocalFile());
+  event->acceptProposedAction();
+}
+
+void qReposeMainWindow::onOpenSceneTriggered() {
+  const QString folder = QFileDialog::getExistingDirectory(this, "Open a scene folder");
+  if (!folder.isEmpty()) this->openFile(folder);
+}
+
+void qReposeMainWindow::onSaveSceneTriggered() {
+  const QString folder = QFileDialog::getExistingDirectory(this, "Save the scene into a folder");
+  if (!folder.isEmpty()) this->saveScene(folder);
 }
 
 void qReposeMainWindow::onOpenTriggered() {

@@ -20,13 +20,26 @@ class qReposeMainWindow : public QMainWindow {
   // Shows a module's panel (created on first selection). False if no module has that name.
   bool selectModule(const QString& name);
   QString currentModuleName() const;
-  // Hands `path` to the current module; the outcome goes to the log and the status bar.
+  // Hands `path` (a file, or a folder such as a scene folder) to the current module; the outcome
+  // goes to the log and the status bar.
   bool openFile(const QString& path);
+  bool saveScene(const QString& folder);
+  // Lets the current module's background work finish (processing events), at most `seconds`.
+  // False if it was still busy then.
+  bool waitWhileBusy(double seconds);
+  // The current module's views (the window's centre), or null if it has none.
+  QWidget* currentViews() const;
   void logMessage(const QString& message);
   QString logText() const;
 
+ protected:
+  void dragEnterEvent(QDragEnterEvent* event) override;
+  void dropEvent(QDropEvent* event) override;
+
  private:
   void onOpenTriggered();
+  void onOpenSceneTriggered();
+  void onSaveSceneTriggered();
   void onModuleIndexChanged(int index);
 
   qReposeModuleDiscovery* Discovery;
@@ -34,5 +47,7 @@ class qReposeMainWindow : public QMainWindow {
   QTextBrowser* HelpBrowser = nullptr;
   QStackedWidget* ModulePanels = nullptr;
   QPlainTextEdit* Log = nullptr;
-  QHash<QString, QWidget*> Panels;  // by module name
+  QStackedWidget* Views = nullptr;       // the modules' views; a placeholder for modules without
+  QHash<QString, QWidget*> Panels;       // by module name
+  QHash<QString, QWidget*> ModuleViews;  // by module name
 };

@@ -27,10 +27,19 @@ class qSlicerAbstractReposeModule {
   // The module panel; the caller owns it (through `parent`). May be called more than once.
   virtual QWidget* createWidgetRepresentation(QWidget* parent) = 0;
 
-  // Files the module opens (File > Open...), as QFileDialog filters, and opening one.
+  // Files the module opens (File > Open...), as QFileDialog filters, and opening one (a file,
+  // or a folder the module knows, such as a scene folder).
   virtual QStringList fileFilters() const = 0;
   virtual bool openFile(const QString& path, QString* errorMessage) = 0;
+
+  // The module's views (Slicer's layout area: slice and 3D views), shown in the window's centre
+  // while the module is current; the caller owns it. Null: the module has none.
+  virtual QWidget* createViewRepresentation(QWidget* parent) = 0;
+  // Saving the module's state as a scene folder (File > Save Scene).
+  virtual bool saveScene(const QString& folder, QString* errorMessage) = 0;
+  // True while the module runs background work (the host waits for it before a screenshot).
+  virtual bool isBusy() const = 0;
 };
 
-#define qSlicerAbstractReposeModule_iid "org.repose.qSlicerAbstractReposeModule/1.0"
+#define qSlicerAbstractReposeModule_iid "org.repose.qSlicerAbstractReposeModule/1.1"
 Q_DECLARE_INTERFACE(qSlicerAbstractReposeModule, qSlicerAbstractReposeModule_iid)

@@ -32,6 +32,8 @@ vtkSlicerReposeLogic::vtkSlicerReposeLogic()
 
 vtkSlicerReposeLogic::~vtkSlicerReposeLogic() {
   this->SetParameterNode(nullptr);
+  this->Job.reset();  // a running job is cancelled and its commit dropped before the rest goes
+  this->ReleaseLivePose();
 }
 
 void vtkSlicerReposeLogic::SetParameterNode(vtkMRMLReposeParametersNode* node) {

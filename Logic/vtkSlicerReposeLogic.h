@@ -12,6 +12,7 @@
 #include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
 #include <vtkObject.h>
+#include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 
 #include <array>
@@ -104,6 +105,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
                              const std::array<double, 3>& axis, double angleDeg,
                              const std::array<double, 3>& pivot,
                              const std::array<double, 3>& translation);
+  // A drag: the edits between Begin and End are one undo step (each still re-solves live).
+  void BeginPoseInteraction();
+  void EndPoseInteraction();
   bool Undo();
   bool Redo();
   bool CanUndo() const;
@@ -115,10 +119,42 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   bool SaveScene(const std::string& folder);
   bool LoadScene(const std::string& folder);
 
+  // ---- Live posing while a pose is edited (vtkSlicerReposeLogicLive.cxx) ----
+  // Prepares a pose node whose rig is built for interactive frames: G converted, the transfer
+  // mesh embedded in the cage, the groups resolved, both systems factorized, on the worker like
+  // every long step (WaitForJob/PollJob commits it). Afterwards every change of that pose node
+  // (SetPoseGroupTransform, Undo, Redo, its current frame) re-solves the frame at preview
+  // precision on the calling thread and fires ModifiedEvent.
+  bool StartLivePose(vtkMRMLReposePoseNode* pose);
+  void StopLivePose();
+  vtkMRMLReposePoseNode* GetLivePose() const;
+  // Re-solves the live frame from the pose node now. False with a message on failure.
+  bool UpdateLiveFrame();
+  // Wall time of the last live frame solve (ms).
+  double GetLiveFrameMilliseconds() const;
+  // The posed cage and the posed body surface (the transfer mesh's outer faces), RAS mm; null
+  // without a live pose.
+  vtkPolyData* GetLiveCage() const;
+  vtkPolyData* GetLiveBodySurface() const;
+  // RAS box (xmin, xmax, ymin, ymax, zmin, zmax) of the rest and posed body together, where the
+  // views place their slices.
+  std::array<double, 6> GetLiveBounds() const;
+  // The centre of the rest body's box (where the views' slices start).
+  std::array<double, 3> GetLiveRestCenter() const;
+  // The live frame's labels of G on the slice plane through `positionMm` (orientation 0 axial,
+  // 1 coronal, 2 sagittal), square pixels, `pixels` across the box's larger in-plane side and as
+  // many as the box needs across the other: a one-voxel-thick label image on RAS axes (what the
+  // slice views show while a handle is dragged). Null without a live pose. `milliseconds`
+  // (optional) receives the rasterization time.
+  vtkSmartPointer<vtkImageData> ComputeLiveSlice(int orientation, double positionMm, int pixels,
+                                                 double* milliseconds = nullptr);
+
  protected:
   vtkSlicerReposeLogic();
   ~vtkSlicerReposeLogic() override;
   void OnParameterNodeModified();
+  void OnLivePoseModified();
+  void ReleaseLivePose();  // StopLivePose without the ModifiedEvent
 
  private:
   vtkSlicerReposeLogic(const vtkSlicerReposeLogic&) = delete;
@@ -142,4 +178,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
     std::string nodeID, before, after;
   };
   std::vector<PoseEdit> UndoStack, RedoStack;
+  bool Interacting = false, InteractionRecorded = false;
+  struct LiveSession;
+  std::shared_ptr<LiveSession> Live;  // shared_ptr: its type is complete only in the Live file
 };

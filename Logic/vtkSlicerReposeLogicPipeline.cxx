@@ -361,6 +361,16 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::GetLastPosedSegmentation() 
   return this->LastPosedSegmentation;
 }
 
+void vtkSlicerReposeLogic::BeginPoseInteraction() {
+  this->Interacting = true;
+  this->InteractionRecorded = false;
+}
+
+void vtkSlicerReposeLogic::EndPoseInteraction() {
+  this->Interacting = false;
+  this->InteractionRecorded = false;
+}
+
 bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
                                                  const std::string& group,
                                                  const std::array<double, 3>& axis, double angleDeg,
@@ -397,7 +407,12 @@ bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
     }
     const std::string before = node->GetPoseJSON(), after = repose::poseToJson(pose);
     if (after == before) return true;
-    this->UndoStack.push_back({node->GetID(), before, after});
+    if (this->Interacting && this->InteractionRecorded && !this->UndoStack.empty() &&
+        this->UndoStack.back().nodeID == node->GetID())
+      this->UndoStack.back().after = after;  // the same drag: one step
+    else
+      this->UndoStack.push_back({node->GetID(), before, after});
+    this->InteractionRecorded = this->Interacting;
     this->RedoStack.clear();
     node->SetPoseJSON(after);
     return true;

@@ -25,6 +25,10 @@ void vtkMRMLReposeParametersNode::ForEachField(F&& f) {
   f("TransferMeshSizeMm", &Self::TransferMeshSizeMm, &Self::SetTransferMeshSizeMm);
   f("OutputMemoryBudgetMB", &Self::OutputMemoryBudgetMB, &Self::SetOutputMemoryBudgetMB);
   f("OutputFolder", &Self::OutputFolder, &Self::SetOutputFolder);
+  f("PosePath", &Self::PosePath, &Self::SetPosePath);
+  f("ActivePoseNodeID", &Self::ActivePoseNodeID, &Self::SetActivePoseNodeID);
+  f("ActiveGroup", &Self::ActiveGroup, &Self::SetActiveGroup);
+  f("LabelOpacity", &Self::LabelOpacity, &Self::SetLabelOpacity);
 }
 
 namespace {
@@ -62,6 +66,10 @@ void vtkMRMLReposeParametersNode::SetTransferMeshSizeMm(double mm) {
 }
 void vtkMRMLReposeParametersNode::SetOutputMemoryBudgetMB(int mib) {
   if (clampAssign(this->OutputMemoryBudgetMB, mib, 64, 1 << 20)) this->Modified();
+}
+
+void vtkMRMLReposeParametersNode::SetLabelOpacity(double opacity) {
+  if (clampAssign(this->LabelOpacity, opacity, 0.0, 1.0)) this->Modified();
 }
 
 int vtkMRMLReposeParametersNode::StartModify() {

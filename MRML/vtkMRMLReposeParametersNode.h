@@ -61,6 +61,18 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   vtkSetMacro(OutputFolder, std::string);
   const std::string& GetOutputFolder() const { return this->OutputFolder; }
 
+  // The pose being edited: its file, its node in the Logic's scene, and the handle group the
+  // panel's rotation controls act on.
+  vtkSetMacro(PosePath, std::string);
+  const std::string& GetPosePath() const { return this->PosePath; }
+  vtkSetMacro(ActivePoseNodeID, std::string);
+  const std::string& GetActivePoseNodeID() const { return this->ActivePoseNodeID; }
+  vtkSetMacro(ActiveGroup, std::string);
+  const std::string& GetActiveGroup() const { return this->ActiveGroup; }
+  // Opacity of the labels over the image in the slice views, clamped to [0, 1].
+  void SetLabelOpacity(double opacity);
+  double GetLabelOpacity() const { return this->LabelOpacity; }
+
  protected:
   vtkMRMLReposeParametersNode() = default;
   ~vtkMRMLReposeParametersNode() override = default;
@@ -75,10 +87,14 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   std::string BodyPartMapPath;
   std::string ImagePath;
   int CageVertexCount = 300;
-  double CageDilationMm = 5.0;
+  double CageDilationMm = 10.0;  // as `repose pose --dilate-mm`
   double TransferMeshSizeMm = 0.0;
   int OutputMemoryBudgetMB = 4096;
   std::string OutputFolder;
+  std::string PosePath;
+  std::string ActivePoseNodeID;
+  std::string ActiveGroup;
+  double LabelOpacity = 0.8;
 
  private:
   vtkMRMLReposeParametersNode(const vtkMRMLReposeParametersNode&) = delete;

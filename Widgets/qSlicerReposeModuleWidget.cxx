@@ -1,18 +1,50 @@
-// qSlicerReposeModuleWidget: UI wiring (pointer-to-member connections only) and the VTK
-// observers that keep the panel in step with the parameter node and the logic.
+// qSlicerReposeModuleWidget: UI wiring (pointer-to-member connections only), the VTK observers
+// that keep the panel in step with the parameter node and the logic, and the job timer.
 #include "qSlicerReposeModuleWidget.h"
 
 #include "ui_qSlicerReposeModuleWidget.h"
 
 #include "vtkMRMLReposeParametersNode.h"
+#include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeLogic.h"
+
+#include <repose/pose/Pose.h>
 
 #include <vtkCommand.h>
 #include <vtkSmartPointer.h>
 
+#include <QApplication>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QSignalBlocker>
+#include <QThread>
+#include <QTimer>
+
+#include <cmath>
+#include <optional>
+
+namespace {
+
+// The transform a group has in a keyframe (its base transform where the keyframe does not name
+// it), as the pose's frames() uses.
+std::optional<repose::PoseTransform> groupTransform(const repose::Pose& pose,
+                                                    const std::string& group, int keyframe) {
+  for (const repose::PoseGroup& g : pose.groups) {
+    if (g.name != group || g.fixed) continue;
+    if (!pose.keyframes.empty()) {
+      const auto& k =
+          pose.keyframes[std::size_t(std::clamp<int>(keyframe, 0, int(pose.keyframes.size()) - 1))];
+      for (const auto& [name, t] : k.transforms)
+        if (name == group) return t;
+    }
+    return g.transform;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
  public:
@@ -20,16 +52,92 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   vtkSmartPointer<vtkMRMLReposeParametersNode> ParameterNode;
   unsigned long LogicObserverTag = 0;
   unsigned long NodeObserverTag = 0;
+  QTimer JobTimer;
+  enum class Step { None, Rig, Live, Export } RunningStep = Step::None;
+  QString JobStatus = "Idle.";
+  bool Updating = false;
 };
 
 qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
     : QWidget(parent), d_ptr(new qSlicerReposeModuleWidgetPrivate) {
   Q_D(qSlicerReposeModuleWidget);
   d->setupUi(this);
+  d->JobTimer.setInterval(100);
+  connect(&d->JobTimer, &QTimer::timeout, this, &qSlicerReposeModuleWidget::onJobTimer);
   connect(d->InputPathLineEdit, &QLineEdit::editingFinished, this,
           &qSlicerReposeModuleWidget::onInputPathEditingFinished);
   connect(d->InputBrowseButton, &QToolButton::clicked, this,
           &qSlicerReposeModuleWidget::onBrowseClicked);
+  auto pathEdit = [this, d](QLineEdit* edit,
+                            void (vtkMRMLReposeParametersNode::*set)(std::string)) {
+    connect(edit, &QLineEdit::editingFinished, this, [this, d, edit, set] {
+      if (d->ParameterNode)
+        (d->ParameterNode.GetPointer()->*set)(edit->text().trimmed().toStdString());
+    });
+  };
+  pathEdit(d->BodyPartPathLineEdit, &vtkMRMLReposeParametersNode::SetBodyPartMapPath);
+  pathEdit(d->ImagePathLineEdit, &vtkMRMLReposeParametersNode::SetImagePath);
+  pathEdit(d->OutputFolderLineEdit, &vtkMRMLReposeParametersNode::SetOutputFolder);
+  auto browse = [this](QToolButton* button, QLineEdit* edit, bool folder) {
+    connect(button, &QToolButton::clicked, this, [this, edit, folder] {
+      const QString start = QFileInfo(edit->text()).absolutePath();
+      const QString path =
+          folder ? QFileDialog::getExistingDirectory(this, "Choose a folder", start)
+                 : QFileDialog::getOpenFileName(this, "Choose a file", start,
+                                                inputFileFilters().join(";;") + ";;All files (*)");
+      if (path.isEmpty()) return;
+      edit->setText(path);
+      emit edit->editingFinished();
+    });
+  };
+  browse(d->BodyPartBrowseButton, d->BodyPartPathLineEdit, false);
+  browse(d->ImageBrowseButton, d->ImagePathLineEdit, false);
+  browse(d->OutputBrowseButton, d->OutputFolderLineEdit, true);
+  connect(d->PosePathLineEdit, &QLineEdit::editingFinished, this,
+          &qSlicerReposeModuleWidget::onPosePathEditingFinished);
+  connect(d->PoseBrowseButton, &QToolButton::clicked, this,
+          &qSlicerReposeModuleWidget::onPoseBrowseClicked);
+  connect(d->CageVertexCountSpinBox, qOverload<int>(&QSpinBox::valueChanged), this, [d](int v) {
+    if (d->ParameterNode && !d->Updating) d->ParameterNode->SetCageVertexCount(v);
+  });
+  connect(d->CageDilationSpinBox, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+          [d](double v) {
+            if (d->ParameterNode && !d->Updating) d->ParameterNode->SetCageDilationMm(v);
+          });
+  connect(d->TransferMeshSizeSpinBox, qOverload<double>(&QDoubleSpinBox::valueChanged), this,
+          [d](double v) {
+            if (d->ParameterNode && !d->Updating) d->ParameterNode->SetTransferMeshSizeMm(v);
+          });
+  connect(d->MemoryBudgetSpinBox, qOverload<int>(&QSpinBox::valueChanged), this, [d](int v) {
+    if (d->ParameterNode && !d->Updating) d->ParameterNode->SetOutputMemoryBudgetMB(v);
+  });
+  connect(d->OpacitySlider, &QSlider::valueChanged, this, [d](int v) {
+    if (d->ParameterNode && !d->Updating) d->ParameterNode->SetLabelOpacity(v / 100.0);
+  });
+  connect(d->GroupComboBox, &QComboBox::currentTextChanged, this, [d](const QString& group) {
+    if (d->ParameterNode && !d->Updating && !group.isEmpty())
+      d->ParameterNode->SetActiveGroup(group.toStdString());
+  });
+  connect(d->AngleSlider, &QSlider::sliderPressed, this,
+          &qSlicerReposeModuleWidget::onAngleSliderPressed);
+  connect(d->AngleSlider, &QSlider::sliderReleased, this,
+          &qSlicerReposeModuleWidget::onAngleSliderReleased);
+  connect(d->AngleSlider, &QSlider::valueChanged, this, &qSlicerReposeModuleWidget::onAngleChanged);
+  connect(d->AngleSpinBox, qOverload<int>(&QSpinBox::valueChanged), this,
+          &qSlicerReposeModuleWidget::onAngleChanged);
+  connect(d->KeyframeSpinBox, qOverload<int>(&QSpinBox::valueChanged), this, [this, d](int k) {
+    if (vtkMRMLReposePoseNode* pose = this->activePose(); pose && !d->Updating)
+      pose->SetCurrentFrame(k);
+  });
+  connect(d->UndoButton, &QToolButton::clicked, this, [d] {
+    if (d->Logic) d->Logic->Undo();
+  });
+  connect(d->RedoButton, &QToolButton::clicked, this, [d] {
+    if (d->Logic) d->Logic->Redo();
+  });
+  connect(d->BuildRigButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::buildRig);
+  connect(d->ExportButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::exportPose);
+  connect(d->CancelButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::cancelJob);
   this->updateWidgetFromMRML();
 }
 
@@ -86,31 +194,273 @@ QString qSlicerReposeModuleWidget::inputInfoText() const {
   return d->InputInfoTextBox->toPlainText();
 }
 
+bool qSlicerReposeModuleWidget::setPosePath(const QString& path) {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->ParameterNode || !d->Logic) return false;
+  vtkMRMLReposePoseNode* pose = d->Logic->AddPose(path.toStdString());
+  const int state = d->ParameterNode->StartModify();
+  d->ParameterNode->SetPosePath(path.toStdString());
+  d->ParameterNode->SetActivePoseNodeID(pose ? pose->GetID() : "");
+  std::string first;
+  if (pose)
+    for (const repose::PoseGroup& g :
+         repose::parsePose(pose->GetPoseJSON(), path.toStdString()).groups)
+      if (!g.fixed && first.empty()) first = g.name;
+  d->ParameterNode->SetActiveGroup(first);
+  d->ParameterNode->EndModify(state);
+  if (!pose) d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
+  this->updateWidgetFromMRML();
+  return pose != nullptr;
+}
+
+vtkMRMLReposePoseNode* qSlicerReposeModuleWidget::activePose() const {
+  Q_D(const qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return nullptr;
+  return vtkMRMLReposePoseNode::SafeDownCast(
+      d->Logic->GetScene()->GetNodeByID(d->ParameterNode->GetActivePoseNodeID()));
+}
+
+bool qSlicerReposeModuleWidget::buildRig() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return false;
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  auto fail = [&](const QString& why) {
+    d->JobStatus = "Error: " + why;
+    this->updateWidgetFromMRML();
+    return false;
+  };
+  if (d->ParameterNode->GetInputSegmentationPath().empty())
+    return fail("choose a segmentation first");
+  if (!pose) return fail("load a pose file first (its groups and separations shape the rig)");
+  // The segmentation node of the current paths (made again when a path changed).
+  auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
+      d->Logic->GetScene()->GetNodeByID(d->ParameterNode->GetInputSegmentationNodeID()));
+  if (!seg || seg->GetLabelMapFileName() != d->ParameterNode->GetInputSegmentationPath() ||
+      seg->GetBodyPartMapFileName() != d->ParameterNode->GetBodyPartMapPath() ||
+      seg->GetImageFileName() != d->ParameterNode->GetImagePath()) {
+    seg = d->Logic->AddSegmentation(d->ParameterNode->GetInputSegmentationPath(),
+                                    d->ParameterNode->GetBodyPartMapPath(),
+                                    d->ParameterNode->GetImagePath());
+    if (!seg) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
+    d->ParameterNode->SetInputSegmentationNodeID(seg->GetID());
+  }
+  if (!d->Logic->StartBuildRig(seg, pose))
+    return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
+  d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Rig;
+  d->JobStatus = "Building the cage and the transfer mesh...";
+  d->JobTimer.start();
+  this->updateWidgetFromMRML();
+  return true;
+}
+
+bool qSlicerReposeModuleWidget::exportPose() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return false;
+  const std::string folder = d->ParameterNode->GetOutputFolder();
+  bool ok =
+      !folder.empty() && this->activePose() && d->Logic->StartApplyPose(this->activePose(), folder);
+  if (!ok) {
+    d->JobStatus =
+        "Error: " + (folder.empty() ? QString("choose an output folder first")
+                                    : QString::fromStdString(d->Logic->GetLastErrorMessage()));
+    this->updateWidgetFromMRML();
+    return false;
+  }
+  d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Export;
+  d->JobStatus = "Exporting at full resolution...";
+  d->JobTimer.start();
+  this->updateWidgetFromMRML();
+  return true;
+}
+
+void qSlicerReposeModuleWidget::cancelJob() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (d->Logic && d->Logic->IsJobRunning()) d->Logic->CancelJob();
+}
+
+void qSlicerReposeModuleWidget::waitForJobs() {
+  Q_D(qSlicerReposeModuleWidget);
+  while (d->RunningStep != qSlicerReposeModuleWidgetPrivate::Step::None) {
+    QApplication::processEvents();
+    QThread::msleep(20);
+    this->onJobTimer();
+  }
+}
+
+QString qSlicerReposeModuleWidget::jobStatusText() const {
+  Q_D(const qSlicerReposeModuleWidget);
+  return d->JobStatus;
+}
+
+void qSlicerReposeModuleWidget::onJobTimer() {
+  Q_D(qSlicerReposeModuleWidget);
+  using Step = qSlicerReposeModuleWidgetPrivate::Step;
+  if (!d->Logic || d->RunningStep == Step::None) {
+    d->JobTimer.stop();
+    return;
+  }
+  const int status = d->Logic->PollJob();
+  if (status == vtkSlicerReposeLogic::JobRunning) {
+    d->JobProgressBar->setValue(int(std::lround(100 * d->Logic->GetJobProgress())));
+    d->JobStatusLabel->setText(QString::fromStdString(d->Logic->GetJobStage()) + "...");
+    return;
+  }
+  const Step finished = d->RunningStep;
+  d->RunningStep = Step::None;
+  d->JobTimer.stop();
+  if (status == vtkSlicerReposeLogic::JobSucceeded && finished == Step::Rig) {
+    // The rig is there: prepare live posing at once, so the views follow the pose.
+    if (d->Logic->StartLivePose(this->activePose())) {
+      d->RunningStep = Step::Live;
+      d->JobStatus = "Preparing live posing...";
+      d->JobTimer.start();
+    } else {
+      d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
+    }
+  } else if (status == vtkSlicerReposeLogic::JobSucceeded) {
+    d->JobStatus =
+        finished == Step::Live
+            ? "Live: drag the angle, the views follow."
+            : "Exported to " + QString::fromStdString(d->ParameterNode->GetOutputFolder());
+  } else if (status == vtkSlicerReposeLogic::JobCancelled) {
+    d->JobStatus = "Cancelled; nothing was written.";
+  } else {
+    d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
+  }
+  this->updateWidgetFromMRML();
+}
+
+bool qSlicerReposeModuleWidget::setActiveGroupAngle(double angleDeg) {
+  Q_D(qSlicerReposeModuleWidget);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  if (!pose || !d->Logic) return false;
+  const repose::Pose p = repose::parsePose(pose->GetPoseJSON(), pose->GetName());
+  const auto t = groupTransform(p, d->ParameterNode->GetActiveGroup(), pose->GetCurrentFrame());
+  if (!t) return false;
+  return d->Logic->SetPoseGroupTransform(
+      pose, d->ParameterNode->GetActiveGroup(), {t->axis.x(), t->axis.y(), t->axis.z()}, angleDeg,
+      {t->pivot.x(), t->pivot.y(), t->pivot.z()},
+      {t->translation.x(), t->translation.y(), t->translation.z()});
+}
+
+double qSlicerReposeModuleWidget::activeGroupAngle() const {
+  Q_D(const qSlicerReposeModuleWidget);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  if (!pose || !d->ParameterNode) return 0;
+  const auto t = groupTransform(repose::parsePose(pose->GetPoseJSON(), pose->GetName()),
+                                d->ParameterNode->GetActiveGroup(), pose->GetCurrentFrame());
+  return t ? t->angleDeg : 0;
+}
+
+void qSlicerReposeModuleWidget::onAngleSliderPressed() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (d->Logic) d->Logic->BeginPoseInteraction();
+}
+
+void qSlicerReposeModuleWidget::onAngleSliderReleased() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (d->Logic) d->Logic->EndPoseInteraction();
+}
+
+void qSlicerReposeModuleWidget::onAngleChanged(int angle) {
+  Q_D(qSlicerReposeModuleWidget);
+  if (d->Updating) return;
+  this->setActiveGroupAngle(angle);
+}
+
 QStringList qSlicerReposeModuleWidget::inputFileFilters() {
   return {"Label maps (*.nii *.nii.gz *.nrrd *.nhdr *.seg.nrrd)"};
 }
 
 void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   Q_D(qSlicerReposeModuleWidget);
+  if (d->Updating) return;
+  d->Updating = true;
   vtkMRMLReposeParametersNode* node = d->ParameterNode;
-  d->InputGroupBox->setEnabled(node != nullptr && d->Logic != nullptr);
-  const QString path = node ? QString::fromStdString(node->GetInputSegmentationPath()) : QString();
-  if (d->InputPathLineEdit->text() != path) {
-    const QSignalBlocker blocker(d->InputPathLineEdit);
-    d->InputPathLineEdit->setText(path);
+  const bool ready = node != nullptr && d->Logic != nullptr;
+  for (QWidget* w :
+       {static_cast<QWidget*>(d->InputGroupBox), static_cast<QWidget*>(d->PoseGroupBox),
+        static_cast<QWidget*>(d->CageGroupBox), static_cast<QWidget*>(d->TransferMeshGroupBox),
+        static_cast<QWidget*>(d->OutputGroupBox)})
+    w->setEnabled(ready);
+  auto setText = [](QLineEdit* edit, const std::string& text) {
+    const QString t = QString::fromStdString(text);
+    if (edit->text() != t) {
+      const QSignalBlocker blocker(edit);
+      edit->setText(t);
+    }
+  };
+  setText(d->InputPathLineEdit, node ? node->GetInputSegmentationPath() : "");
+  setText(d->BodyPartPathLineEdit, node ? node->GetBodyPartMapPath() : "");
+  setText(d->ImagePathLineEdit, node ? node->GetImagePath() : "");
+  setText(d->PosePathLineEdit, node ? node->GetPosePath() : "");
+  setText(d->OutputFolderLineEdit, node ? node->GetOutputFolder() : "");
+  if (node) {
+    d->CageVertexCountSpinBox->setValue(node->GetCageVertexCount());
+    d->CageDilationSpinBox->setValue(node->GetCageDilationMm());
+    d->TransferMeshSizeSpinBox->setValue(node->GetTransferMeshSizeMm());
+    d->MemoryBudgetSpinBox->setValue(node->GetOutputMemoryBudgetMB());
+    d->OpacitySlider->setValue(int(std::lround(100 * node->GetLabelOpacity())));
   }
   QString info;
   if (!node)
     info = "No parameter node.";
   else if (!d->Logic)
     info = "No logic.";
-  else if (!d->Logic->GetLastErrorMessage().empty())
+  else if (!d->Logic->GetLastErrorMessage().empty() && !d->Logic->GetVolumeImageData())
     info = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
   else if (d->Logic->GetVolumeImageData())
     info = QString::fromStdString(d->Logic->GetVolumeSummary());
   else
     info = "No volume loaded.";
   if (d->InputInfoTextBox->toPlainText() != info) d->InputInfoTextBox->setPlainText(info);
+
+  // Pose: the groups that can turn, the active one's angle, keyframes, undo/redo.
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  QStringList groups;
+  int keyframes = 0;
+  if (pose) {
+    const repose::Pose p = repose::parsePose(pose->GetPoseJSON(), pose->GetName());
+    for (const repose::PoseGroup& g : p.groups)
+      if (!g.fixed) groups << QString::fromStdString(g.name);
+    keyframes = int(p.keyframes.size());
+  }
+  QStringList current;
+  for (int i = 0; i < d->GroupComboBox->count(); ++i) current << d->GroupComboBox->itemText(i);
+  if (current != groups) {
+    d->GroupComboBox->clear();
+    d->GroupComboBox->addItems(groups);
+  }
+  if (node) d->GroupComboBox->setCurrentText(QString::fromStdString(node->GetActiveGroup()));
+  const int angle = int(std::lround(this->activeGroupAngle()));
+  if (!d->AngleSlider->isSliderDown()) d->AngleSlider->setValue(angle);
+  d->AngleSpinBox->setValue(angle);
+  d->KeyframeSpinBox->setMaximum(std::max(0, keyframes - 1));
+  d->KeyframeSpinBox->setValue(pose ? pose->GetCurrentFrame() : 0);
+  d->KeyframeSpinBox->setEnabled(keyframes > 1);
+  d->UndoButton->setEnabled(d->Logic && d->Logic->CanUndo());
+  d->RedoButton->setEnabled(d->Logic && d->Logic->CanRedo());
+  const bool live = d->Logic && pose && d->Logic->GetLivePose() == pose;
+  d->AngleSlider->setEnabled(pose != nullptr && !groups.isEmpty());
+  d->LiveStatusLabel->setText(live ? QString("Live: frame solved in %1 ms")
+                                         .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
+                              : pose ? "Build the cage and mesh to pose live."
+                                     : "No pose loaded.");
+
+  // Jobs: progress, status, what can be pressed. A job someone else started (the module opening
+  // a scene) is polled here too, so it commits and the views follow.
+  const bool running = d->Logic && d->Logic->IsJobRunning();
+  if (running && d->RunningStep == qSlicerReposeModuleWidgetPrivate::Step::None) {
+    d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Live;
+    d->JobStatus = QString::fromStdString(d->Logic->GetJobStage()) + "...";
+    d->JobTimer.start();
+  }
+  d->BuildRigButton->setEnabled(ready && !running);
+  d->ExportButton->setEnabled(ready && !running && pose != nullptr);
+  d->CancelButton->setEnabled(running);
+  if (!running) d->JobProgressBar->setValue(d->JobStatus.startsWith("Error") ? 0 : 100);
+  d->JobStatusLabel->setText(d->JobStatus);
+  d->Updating = false;
 }
 
 void qSlicerReposeModuleWidget::onInputPathEditingFinished() {
@@ -128,4 +478,19 @@ void qSlicerReposeModuleWidget::onBrowseClicked() {
   const QString path =
       QFileDialog::getOpenFileName(this, "Choose a label map", start, filters.join(";;"));
   if (!path.isEmpty()) this->setInputPath(path);
+}
+
+void qSlicerReposeModuleWidget::onPosePathEditingFinished() {
+  Q_D(qSlicerReposeModuleWidget);
+  const QString path = d->PosePathLineEdit->text().trimmed();
+  if (d->ParameterNode && !path.isEmpty() && path.toStdString() != d->ParameterNode->GetPosePath())
+    this->setPosePath(path);
+}
+
+void qSlicerReposeModuleWidget::onPoseBrowseClicked() {
+  Q_D(qSlicerReposeModuleWidget);
+  const QString path = QFileDialog::getOpenFileName(
+      this, "Choose a pose file", QFileInfo(d->PosePathLineEdit->text()).absolutePath(),
+      "Pose files (*.pose.json);;All files (*)");
+  if (!path.isEmpty()) this->setPosePath(path);
 }

@@ -1,5 +1,8 @@
-// qSlicerReposeModuleWidget: the Repose module panel. Rebuilds itself from the parameter node
-// and the logic on every Modified (updateWidgetFromMRML) and writes user edits to the node.
+// qSlicerReposeModuleWidget: the Repose module panel (Input, Pose, Cage, Transfer mesh, Output).
+// Rebuilds itself from the parameter node and the logic on every Modified (updateWidgetFromMRML)
+// and writes every user edit to the node or through the logic: no state lives only here. Long
+// steps (rig, live preparation, export) run as the logic's jobs, polled by a timer, with a
+// progress bar and Cancel.
 #pragma once
 
 #include "qSlicerReposeModuleWidgetsExport.h"
@@ -9,6 +12,7 @@
 
 class qSlicerReposeModuleWidgetPrivate;
 class vtkMRMLReposeParametersNode;
+class vtkMRMLReposePoseNode;
 class vtkSlicerReposeLogic;
 
 class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QWidget {
@@ -29,6 +33,22 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   bool setInputPath(const QString& path);
   // The info box text: the loaded volume's summary, an error line, or a hint.
   QString inputInfoText() const;
+  // The pose file: loaded into a pose node of the logic's scene, which becomes the active pose.
+  bool setPosePath(const QString& path);
+  vtkMRMLReposePoseNode* activePose() const;
+
+  // The buttons, as a user presses them (and tests do). Each starts a job and returns at once;
+  // false with the reason in jobStatusText() when it cannot start.
+  bool buildRig();  // cage and mesh, then live posing
+  bool exportPose();
+  void cancelJob();
+  // Runs the job timer's step until no job is left (tests and scripts; the GUI never blocks).
+  void waitForJobs();
+  QString jobStatusText() const;
+
+  // The rotation controls: the active group turned to `angleDeg` about its own axis and pivot.
+  bool setActiveGroupAngle(double angleDeg);
+  double activeGroupAngle() const;
 
   // File dialog filters for the input (also used by the module's File > Open).
   static QStringList inputFileFilters();
@@ -38,6 +58,12 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
  private:
   void onInputPathEditingFinished();
   void onBrowseClicked();
+  void onPosePathEditingFinished();
+  void onPoseBrowseClicked();
+  void onJobTimer();
+  void onAngleSliderPressed();
+  void onAngleSliderReleased();
+  void onAngleChanged(int angle);
 
   QScopedPointer<qSlicerReposeModuleWidgetPrivate> d_ptr;
   Q_DECLARE_PRIVATE(qSlicerReposeModuleWidget)

@@ -146,10 +146,31 @@ PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision) const
   if (index >= frames_.size())
     throw Error("pose " + pose_.name + " has " + std::to_string(frames_.size()) + " frames, not " +
                 std::to_string(index + 1));
+  return solveFrame(frames_[index].first, frames_[index].second, precision);
+}
+
+PoseRig::Frame PoseRig::frame(const Pose& edited, std::size_t index,
+                              GreenPrecision precision) const {
+  bool same = edited.groups.size() == pose_.groups.size();
+  for (std::size_t g = 0; same && g < edited.groups.size(); ++g)
+    same = edited.groups[g].name == pose_.groups[g].name &&
+           edited.groups[g].fixed == pose_.groups[g].fixed;
+  if (!same)
+    throw Error("pose " + edited.name + ": its groups are not those the rig was prepared for");
+  const auto frames = edited.frames();
+  if (index >= frames.size())
+    throw Error("pose " + edited.name + " has " + std::to_string(frames.size()) + " frames, not " +
+                std::to_string(index + 1));
+  return solveFrame(frames[index].first, frames[index].second, precision);
+}
+
+PoseRig::Frame PoseRig::solveFrame(const std::string& name,
+                                   const std::vector<Eigen::Isometry3d>& motions,
+                                   GreenPrecision precision) const {
   Frame f;
-  f.name = frames_[index].first;
+  f.name = name;
   f.handles = handles_;
-  setMotions(f.handles, frames_[index].second);
+  setMotions(f.handles, motions);
   f.cage = poseCage(geometry_.cage, f.handles);
   f.deformed = deformation_->deform(f.cage, influence_, f.handles, &f.tetMaps, precision);
   return f;

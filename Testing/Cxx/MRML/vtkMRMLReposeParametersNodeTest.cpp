@@ -37,6 +37,10 @@ void fillNonDefault(vtkMRMLReposeParametersNode* node) {
   node->SetTransferMeshSizeMm(12.5);
   node->SetOutputMemoryBudgetMB(2048);
   node->SetOutputFolder("/out/\"quoted\" folder");
+  node->SetPosePath("/poses/elbow90.pose.json");
+  node->SetActivePoseNodeID("vtkMRMLReposePoseNode1");
+  node->SetActiveGroup("left forearm and hand");
+  node->SetLabelOpacity(0.35);
 }
 
 void expectEqualFields(vtkMRMLReposeParametersNode* a, vtkMRMLReposeParametersNode* b) {
@@ -49,6 +53,10 @@ void expectEqualFields(vtkMRMLReposeParametersNode* a, vtkMRMLReposeParametersNo
   EXPECT_EQ(a->GetTransferMeshSizeMm(), b->GetTransferMeshSizeMm());
   EXPECT_EQ(a->GetOutputMemoryBudgetMB(), b->GetOutputMemoryBudgetMB());
   EXPECT_EQ(a->GetOutputFolder(), b->GetOutputFolder());
+  EXPECT_EQ(a->GetPosePath(), b->GetPosePath());
+  EXPECT_EQ(a->GetActivePoseNodeID(), b->GetActivePoseNodeID());
+  EXPECT_EQ(a->GetActiveGroup(), b->GetActiveGroup());
+  EXPECT_EQ(a->GetLabelOpacity(), b->GetLabelOpacity());
 }
 
 const char* const kFieldNames[] = {"InputSegmentationNodeID",
@@ -59,14 +67,18 @@ const char* const kFieldNames[] = {"InputSegmentationNodeID",
                                    "CageDilationMm",
                                    "TransferMeshSizeMm",
                                    "OutputMemoryBudgetMB",
-                                   "OutputFolder"};
+                                   "OutputFolder",
+                                   "PosePath",
+                                   "ActivePoseNodeID",
+                                   "ActiveGroup",
+                                   "LabelOpacity"};
 
 }  // namespace
 
 TEST(vtkMRMLReposeParametersNode, DefaultsAndSetGet) {
   vtkNew<vtkMRMLReposeParametersNode> node;
   EXPECT_EQ(node->GetCageVertexCount(), 300);
-  EXPECT_EQ(node->GetCageDilationMm(), 5.0);
+  EXPECT_EQ(node->GetCageDilationMm(), 10.0);
   EXPECT_EQ(node->GetTransferMeshSizeMm(), 0.0);
   EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 4096);
   EXPECT_TRUE(node->GetInputSegmentationPath().empty());
@@ -96,6 +108,10 @@ TEST(vtkMRMLReposeParametersNode, ClampsToRanges) {
   EXPECT_EQ(node->GetTransferMeshSizeMm(), 1000.0);
   node->SetOutputMemoryBudgetMB(1);
   EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 64);
+  node->SetLabelOpacity(1.5);
+  EXPECT_EQ(node->GetLabelOpacity(), 1.0);
+  node->SetLabelOpacity(-0.5);
+  EXPECT_EQ(node->GetLabelOpacity(), 0.0);
   // NaN and infinity are refused: the value stays.
   node->SetCageDilationMm(3.0);
   node->SetCageDilationMm(std::nan(""));

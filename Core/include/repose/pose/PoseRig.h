@@ -74,6 +74,11 @@ class PoseRig {
   std::size_t frameCount() const { return frames_.size(); }
   const std::string& frameName(std::size_t index) const { return frames_.at(index).first; }
   Frame frame(std::size_t index, GreenPrecision precision = GreenPrecision::Exact) const;
+  // A frame of an edited copy of the pose (the same groups, other transforms or keyframes): what
+  // an interactive edit re-solves. Throws repose::Error when the groups differ or the index is out
+  // of range.
+  Frame frame(const Pose& edited, std::size_t index,
+              GreenPrecision precision = GreenPrecision::Exact) const;
 
   const TriangleMesh& cage() const { return geometry_.cage; }
   const TransferMesh& mesh() const { return geometry_.mesh; }
@@ -83,6 +88,8 @@ class PoseRig {
   const Pose& pose() const { return pose_; }
 
  private:
+  Frame solveFrame(const std::string& name, const std::vector<Eigen::Isometry3d>& motions,
+                   GreenPrecision precision) const;
   RigGeometry geometry_;
   Pose pose_;
   std::unique_ptr<CageDeformation> deformation_;

@@ -1,0 +1,234 @@
+// vtkSlicerReposeLogic, the live half: a pose node prepared for interaction (its rig embedded and
+// factorized once, on the worker), then each edit re-solved at preview precision on the calling
+// thread, and the deformed labels rasterized on the slice planes the views show.
+#include "vtkMRMLReposeCageNode.h"
+#include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkMRMLReposeTransferMeshNode.h"
+#include "vtkSlicerReposeJob.h"
+#include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeMeshConversion.h"
+#include "vtkSlicerReposeVolumeConversion.h"
+
+#include <repose/pose/PoseRig.h>
+#include <repose/raster/Rasterizer.h>
+#include <repose/util/Error.h>
+
+#include <vtkCellArray.h>
+#include <vtkCommand.h>
+#include <vtkPoints.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+using Conversion = vtkSlicerReposeVolumeConversion;
+
+struct vtkSlicerReposeLogic::LiveSession {
+  vtkSmartPointer<vtkMRMLReposePoseNode> Pose;
+  unsigned long PoseObserverTag = 0;
+  std::shared_ptr<const repose::Volume> Labels;  // G
+  std::shared_ptr<const repose::PoseRig> Rig;
+  std::vector<std::uint8_t> OuterFaces;
+  Eigen::MatrixX3d Deformed;  // the live frame's TM vertices
+  Eigen::Vector3d Lo{0, 0, 0}, Hi{0, 0, 0};
+  vtkSmartPointer<vtkPolyData> Cage, Body;
+  double FrameMilliseconds = 0;
+};
+
+namespace {
+
+// The outer faces of the rest mesh as triangles over the TM's vertices (posed by moving points).
+vtkSmartPointer<vtkPolyData> bodySurface(const repose::TransferMesh& mesh,
+                                         const std::vector<std::uint8_t>& outer) {
+  static const int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  vtkNew<vtkCellArray> triangles;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    for (int f = 0; f < 4; ++f)
+      if (outer[std::size_t(t)] & (1u << f)) {
+        const vtkIdType ids[3] = {mesh.tets(t, kFace[f][0]), mesh.tets(t, kFace[f][1]),
+                                  mesh.tets(t, kFace[f][2])};
+        triangles->InsertNextCell(3, ids);
+      }
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(mesh.vertices.rows());
+  poly->SetPoints(points);
+  poly->SetPolys(triangles);
+  return poly;
+}
+
+void setPoints(vtkPolyData* poly, const Eigen::MatrixX3d& positions) {
+  vtkPoints* points = poly->GetPoints();
+  points->SetNumberOfPoints(positions.rows());
+  for (Eigen::Index v = 0; v < positions.rows(); ++v)
+    points->SetPoint(v, positions(v, 0), positions(v, 1), positions(v, 2));
+  points->Modified();
+  poly->Modified();
+}
+
+}  // namespace
+
+bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!poseNode) throw repose::Error("no pose");
+    if (this->Job->IsRunning()) throw repose::Error("another job is running");
+    auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
+        this->Scene->GetReferencedNode(poseNode, "segmentation"));
+    auto* cageNode =
+        vtkMRMLReposeCageNode::SafeDownCast(this->Scene->GetReferencedNode(poseNode, "cage"));
+    auto* meshNode = vtkMRMLReposeTransferMeshNode::SafeDownCast(
+        this->Scene->GetReferencedNode(poseNode, "transfer_mesh"));
+    if (!seg || !seg->GetLabelMap() || !cageNode || !meshNode)
+      throw repose::Error("pose " + poseNode->GetName() +
+                          " has no segmentation, cage and transfer mesh yet (build the rig)");
+    // Converted here, on the caller's thread: the worker never touches the nodes.
+    auto G = std::make_shared<const repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
+    repose::LabelTable partLabels;
+    if (seg->GetBodyPartMap()) {
+      partLabels = Conversion::GetLabelTable(seg->GetBodyPartMap());
+    } else {  // as the rig job: the body mask of G is the one part
+      repose::Label body;
+      body.value = 1;
+      body.name = "body";
+      partLabels.set(body);
+    }
+    repose::RigGeometry geometry{
+        vtkSlicerReposeMeshConversion::FromPolyData(cageNode->GetMesh()),
+        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
+    const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
+    this->Job->Start(
+        "live pose",
+        [=, geometry = std::move(geometry)](
+            const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
+          repose::reportProgress(progress, 0, "embedding");
+          auto session = std::make_shared<LiveSession>();
+          session->Labels = G;
+          session->Rig =
+              std::make_shared<const repose::PoseRig>(std::move(geometry), pose, partLabels);
+          session->OuterFaces = repose::outerFaces(session->Rig->mesh());
+          session->Cage = vtkSlicerReposeMeshConversion::ToPolyData(session->Rig->cage());
+          session->Body = bodySurface(session->Rig->mesh(), session->OuterFaces);
+          repose::reportProgress(progress, 1, "embedding");
+          return [this, session, poseRef] {
+            this->StopLivePose();
+            session->Pose = poseRef;
+            this->Live = session;
+            // Every change of the pose node (an edit, undo/redo, the keyframe) re-solves.
+            session->PoseObserverTag = poseRef->AddObserver(
+                vtkCommand::ModifiedEvent, this, &vtkSlicerReposeLogic::OnLivePoseModified);
+            this->UpdateLiveFrame();
+          };
+        });
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+void vtkSlicerReposeLogic::OnLivePoseModified() {
+  this->UpdateLiveFrame();
+}
+
+void vtkSlicerReposeLogic::ReleaseLivePose() {
+  if (this->Live && this->Live->Pose) this->Live->Pose->RemoveObserver(this->Live->PoseObserverTag);
+  this->Live.reset();
+}
+
+void vtkSlicerReposeLogic::StopLivePose() {
+  if (!this->Live) return;
+  this->ReleaseLivePose();
+  this->Modified();
+}
+
+vtkMRMLReposePoseNode* vtkSlicerReposeLogic::GetLivePose() const {
+  return this->Live ? this->Live->Pose.GetPointer() : nullptr;
+}
+
+bool vtkSlicerReposeLogic::UpdateLiveFrame() {
+  if (!this->Live) return false;
+  LiveSession& live = *this->Live;
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    const repose::Pose pose = repose::parsePose(live.Pose->GetPoseJSON(), live.Pose->GetName());
+    const std::size_t frames = pose.frames().size();
+    const std::size_t index =
+        std::min<std::size_t>(std::size_t(live.Pose->GetCurrentFrame()), frames - 1);
+    const repose::PoseRig::Frame frame =
+        live.Rig->frame(pose, index, repose::GreenPrecision::Preview);
+    live.Deformed = frame.deformed;
+    setPoints(live.Cage, frame.cage);
+    setPoints(live.Body, frame.deformed);
+    const repose::TransferMesh& mesh = live.Rig->mesh();
+    live.Lo = mesh.vertices.colwise().minCoeff().transpose().cwiseMin(
+        frame.deformed.colwise().minCoeff().transpose());
+    live.Hi = mesh.vertices.colwise().maxCoeff().transpose().cwiseMax(
+        frame.deformed.colwise().maxCoeff().transpose());
+    live.FrameMilliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    this->Modified();
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    this->Modified();
+    return false;
+  }
+}
+
+double vtkSlicerReposeLogic::GetLiveFrameMilliseconds() const {
+  return this->Live ? this->Live->FrameMilliseconds : 0;
+}
+
+vtkPolyData* vtkSlicerReposeLogic::GetLiveCage() const {
+  return this->Live ? this->Live->Cage.GetPointer() : nullptr;
+}
+
+vtkPolyData* vtkSlicerReposeLogic::GetLiveBodySurface() const {
+  return this->Live ? this->Live->Body.GetPointer() : nullptr;
+}
+
+std::array<double, 3> vtkSlicerReposeLogic::GetLiveRestCenter() const {
+  if (!this->Live) return {0, 0, 0};
+  const repose::TransferMesh& mesh = this->Live->Rig->mesh();
+  const Eigen::Vector3d c =
+      (mesh.vertices.colwise().minCoeff() + mesh.vertices.colwise().maxCoeff()).transpose() / 2;
+  return {c.x(), c.y(), c.z()};
+}
+
+std::array<double, 6> vtkSlicerReposeLogic::GetLiveBounds() const {
+  if (!this->Live) return {0, 0, 0, 0, 0, 0};
+  const LiveSession& l = *this->Live;
+  return {l.Lo.x(), l.Hi.x(), l.Lo.y(), l.Hi.y(), l.Lo.z(), l.Hi.z()};
+}
+
+vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orientation,
+                                                                     double positionMm, int pixels,
+                                                                     double* milliseconds) {
+  if (!this->Live || this->Live->Deformed.rows() == 0 || orientation < 0 || orientation > 2 ||
+      pixels < 2)
+    return nullptr;
+  const LiveSession& live = *this->Live;
+  const auto start = std::chrono::steady_clock::now();
+  repose::VolumeGeometry grid = repose::slicePlaneGrid(
+      static_cast<repose::SliceOrientation>(orientation), positionMm, live.Lo, live.Hi, pixels);
+  // Square pixels across the larger side; the smaller side only as long as the box.
+  const int u = orientation == 2 ? 1 : 0, v = orientation == 0 ? 1 : 2;
+  const double pixel = grid.ijkToRas.block<3, 1>(0, 0).norm();
+  grid.dims[0] = std::clamp<std::int64_t>(
+      std::int64_t(std::ceil((live.Hi[u] - live.Lo[u]) / pixel)), 1, pixels);
+  grid.dims[1] = std::clamp<std::int64_t>(
+      std::int64_t(std::ceil((live.Hi[v] - live.Lo[v]) / pixel)), 1, pixels);
+  repose::RasterOptions options;
+  options.outerFaces = &live.OuterFaces;
+  const repose::Volume slice =
+      repose::rasterizeLabels(*live.Labels, live.Rig->mesh(), live.Deformed, grid, options);
+  if (milliseconds)
+    *milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return Conversion::ToImageData(slice);
+}

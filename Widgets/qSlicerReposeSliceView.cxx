@@ -1,0 +1,144 @@
+// qSlicerReposeSliceView: turns a one-slice label image (and image) into an RGB QImage once per
+// update, and scales it into the widget with its aspect kept.
+#include "qSlicerReposeSliceView.h"
+
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkLookupTable.h>
+#include <vtkPointData.h>
+
+#include <QPainter>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+qSlicerReposeSliceView::qSlicerReposeSliceView(int orientation, QWidget* parent)
+    : QWidget(parent), Orientation(std::clamp(orientation, 0, 2)) {
+  this->setObjectName(this->viewName() + "SliceView");
+  this->setMinimumSize(120, 120);
+  this->setAttribute(Qt::WA_OpaquePaintEvent);
+}
+
+QString qSlicerReposeSliceView::viewName() const {
+  return this->Orientation == 0 ? "Red" : this->Orientation == 1 ? "Green" : "Yellow";
+}
+
+QColor qSlicerReposeSliceView::viewColor() const {
+  // Slicer's slice view colours.
+  return this->Orientation == 0   ? QColor(0xf3, 0x4a, 0x33)
+         : this->Orientation == 1 ? QColor(0x6e, 0xb0, 0x4b)
+                                  : QColor(0xed, 0xd5, 0x4c);
+}
+
+QString qSlicerReposeSliceView::orientationName() const {
+  return this->Orientation == 0 ? "Axial" : this->Orientation == 1 ? "Coronal" : "Sagittal";
+}
+
+void qSlicerReposeSliceView::setPositionMm(double position) {
+  this->PositionMm = position;
+  this->update();
+}
+
+void qSlicerReposeSliceView::setLabelOpacity(double opacity) {
+  this->LabelOpacity = std::clamp(opacity, 0.0, 1.0);
+}
+
+void qSlicerReposeSliceView::setSlice(vtkImageData* labels, vtkLookupTable* lut,
+                                      vtkImageData* image) {
+  this->Image = QImage();
+  this->Labels.clear();
+  this->Shown = labels;
+  this->Width = this->Height = 0;
+  vtkDataArray* values = labels ? labels->GetPointData()->GetScalars() : nullptr;
+  if (!values) {
+    this->update();
+    return;
+  }
+  int dims[3];
+  labels->GetDimensions(dims);
+  // The Logic's slices are (u, v, 1): u and v the plane's RAS axes, increasing to the patient's
+  // right/anterior and anterior/superior. Drawn as Slicer does: patient's right on the screen's
+  // left, anterior on the left in sagittal views, superior (anterior in axial views) up.
+  const int w = dims[0], h = dims[1];
+  double spacing[3];
+  labels->GetSpacing(spacing);
+  this->AspectMm = spacing[0] > 0 ? spacing[1] / spacing[0] : 1;
+  vtkDataArray* grey = image ? image->GetPointData()->GetScalars() : nullptr;
+  if (grey && grey->GetNumberOfTuples() != values->GetNumberOfTuples()) grey = nullptr;
+  double range[2] = {0, 1};
+  if (grey) grey->GetRange(range);
+  const double span = range[1] > range[0] ? range[1] - range[0] : 1;
+  this->Image = QImage(w, h, QImage::Format_RGB32);
+  this->Labels.assign(std::size_t(w) * std::size_t(h), 0);
+  this->Width = w, this->Height = h;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) {
+      const vtkIdType at = vtkIdType(i) + vtkIdType(w) * j;
+      const int label = int(values->GetTuple1(at));
+      const double g = grey ? (grey->GetTuple1(at) - range[0]) / span : 0.0;
+      double rgb[3] = {g, g, g};
+      if (label != 0 && lut) {
+        double c[3];
+        lut->GetColor(label, c);
+        for (int k = 0; k < 3; ++k)
+          rgb[k] = (1 - this->LabelOpacity) * rgb[k] + this->LabelOpacity * c[k];
+      }
+      const int x = w - 1 - i, y = h - 1 - j;
+      this->Labels[std::size_t(x) + std::size_t(w) * std::size_t(y)] = label;
+      this->Image.setPixel(x, y,
+                           qRgb(int(std::lround(255 * std::clamp(rgb[0], 0.0, 1.0))),
+                                int(std::lround(255 * std::clamp(rgb[1], 0.0, 1.0))),
+                                int(std::lround(255 * std::clamp(rgb[2], 0.0, 1.0)))));
+    }
+  this->update();
+}
+
+int qSlicerReposeSliceView::labelAt(int x, int y) const {
+  if (x < 0 || y < 0 || x >= this->Width || y >= this->Height) return -1;
+  return this->Labels[std::size_t(x) + std::size_t(this->Width) * std::size_t(y)];
+}
+
+int qSlicerReposeSliceView::labelAtRas(double r, double a, double s) const {
+  if (!this->Shown || this->Image.isNull()) return -1;
+  const double ras[3] = {r, a, s};
+  double ijk[3];
+  this->Shown->TransformPhysicalPointToContinuousIndex(ras, ijk);
+  const int i = int(std::lround(ijk[0])), j = int(std::lround(ijk[1]));
+  if (i < 0 || j < 0 || i >= this->Width || j >= this->Height || std::fabs(ijk[2]) > 0.5) return -1;
+  return this->labelAt(this->Width - 1 - i, this->Height - 1 - j);
+}
+
+int qSlicerReposeSliceView::labelsShown() const {
+  std::set<int> shown(this->Labels.begin(), this->Labels.end());
+  shown.erase(0);
+  return int(shown.size());
+}
+
+void qSlicerReposeSliceView::paintEvent(QPaintEvent*) {
+  QPainter painter(this);
+  painter.fillRect(this->rect(), Qt::black);
+  const int bar = 18;
+  painter.fillRect(QRect(0, 0, this->width(), bar), this->viewColor());
+  painter.setPen(Qt::black);
+  painter.drawText(QRect(6, 0, this->width() - 12, bar), Qt::AlignVCenter | Qt::AlignLeft,
+                   QString("%1  %2  %3 mm")
+                       .arg(this->viewName(), this->orientationName())
+                       .arg(this->PositionMm, 0, 'f', 1));
+  if (this->Image.isNull()) {
+    painter.setPen(Qt::gray);
+    painter.drawText(this->rect().adjusted(0, bar, 0, 0), Qt::AlignCenter, "no live pose");
+    return;
+  }
+  // Fit the slice with its physical aspect into the area below the bar.
+  const QRect area = this->rect().adjusted(2, bar + 2, -2, -2);
+  const double w = this->Width, h = this->Height * this->AspectMm;
+  const double scale = std::min(area.width() / w, area.height() / h);
+  const QSizeF size(w * scale, h * scale);
+  const QRectF target(area.x() + (area.width() - size.width()) / 2,
+                      area.y() + (area.height() - size.height()) / 2, size.width(), size.height());
+  painter.setRenderHint(QPainter::SmoothPixmapTransform, false);  // labels stay crisp
+  painter.drawImage(target, this->Image);
+  painter.setPen(this->viewColor());
+  painter.drawRect(target);
+}

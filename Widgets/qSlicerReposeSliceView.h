@@ -1,0 +1,61 @@
+// qSlicerReposeSliceView: one slice view of the module (Slicer's red, yellow or green view): the
+// label map on that plane drawn with its colour table at an opacity over the image (grey), with
+// the view's colour bar and name. Pure Qt painting of a QImage, so it draws the same on screen,
+// under xvfb and with the offscreen platform.
+#pragma once
+
+#include "qSlicerReposeModuleWidgetsExport.h"
+
+#include <QColor>
+#include <QImage>
+#include <QWidget>
+
+#include <vtkImageData.h>
+#include <vtkSmartPointer.h>
+
+class vtkLookupTable;
+
+class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidget {
+  Q_OBJECT
+ public:
+  // orientation: 0 axial (Red), 1 coronal (Green), 2 sagittal (Yellow), as Slicer names them.
+  explicit qSlicerReposeSliceView(int orientation, QWidget* parent = nullptr);
+
+  int orientation() const { return this->Orientation; }
+  QString viewName() const;         // "Red", "Green", "Yellow"
+  QColor viewColor() const;         // Slicer's view colours
+  QString orientationName() const;  // "Axial", "Coronal", "Sagittal"
+
+  // The labels on the plane (one voxel thick, RAS-aligned, as the Logic's live slices) and an
+  // optional image on the same grid; the lookup table maps label values to colours.
+  void setSlice(vtkImageData* labels, vtkLookupTable* lut, vtkImageData* image = nullptr);
+  void setPositionMm(double position);
+  double positionMm() const { return this->PositionMm; }
+  void setLabelOpacity(double opacity);
+  double labelOpacity() const { return this->LabelOpacity; }
+
+  // What is drawn, at the slice's own resolution (screen right = patient left for axial and
+  // coronal views, as radiologists read them; superior up).
+  const QImage& sliceImage() const { return this->Image; }
+  // The label value shown at a pixel of sliceImage() (-1 outside).
+  int labelAt(int x, int y) const;
+  // Distinct non-zero labels on the slice.
+  int labelsShown() const;
+  // The label shown at a RAS point of the plane (nearest pixel; -1 off the slice).
+  int labelAtRas(double r, double a, double s) const;
+
+  QSize sizeHint() const override { return {320, 320}; }
+
+ protected:
+  void paintEvent(QPaintEvent* event) override;
+
+ private:
+  int Orientation;
+  double PositionMm = 0;
+  double LabelOpacity = 0.8;
+  QImage Image;                         // RGB of the slice, rows top = superior (or anterior)
+  std::vector<int> Labels;              // label per pixel of Image
+  vtkSmartPointer<vtkImageData> Shown;  // the slice drawn (its geometry maps RAS to pixels)
+  int Width = 0, Height = 0;
+  double AspectMm = 1;  // pixel height / width in mm
+};

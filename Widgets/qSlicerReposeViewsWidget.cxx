@@ -1,0 +1,208 @@
+// qSlicerReposeViewsWidget: layout, the 3D view's actors, and the refresh from the Logic.
+#include "qSlicerReposeViewsWidget.h"
+
+#include "qSlicerReposeSliceView.h"
+#include "vtkMRMLReposeParametersNode.h"
+#include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeVolumeConversion.h"
+
+#include <QVTKOpenGLNativeWidget.h>
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCommand.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkLookupTable.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
+
+#include <QGridLayout>
+#include <QPainter>
+
+#include <cmath>
+#include <limits>
+
+class qSlicerReposeViewsWidgetPrivate {
+ public:
+  vtkSmartPointer<vtkSlicerReposeLogic> Logic;
+  unsigned long LogicObserverTag = 0;
+  vtkSmartPointer<vtkMRMLReposeParametersNode> Parameters;  // the logic's, for the opacity
+  unsigned long ParametersObserverTag = 0;
+  QVTKOpenGLNativeWidget* View3D = nullptr;
+  vtkSmartPointer<vtkGenericOpenGLRenderWindow> RenderWindow;
+  vtkSmartPointer<vtkRenderer> Renderer;
+  vtkSmartPointer<vtkActor> BodyActor, CageActor, CageVertexActor;
+  vtkSmartPointer<vtkPolyDataMapper> BodyMapper, CageMapper, CageVertexMapper;
+  qSlicerReposeSliceView* Slices[3] = {nullptr, nullptr, nullptr};
+  double Positions[3] = {std::numeric_limits<double>::quiet_NaN(),
+                         std::numeric_limits<double>::quiet_NaN(),
+                         std::numeric_limits<double>::quiet_NaN()};
+  int Pixels = 256;
+  double SliceMilliseconds = 0;
+  vtkMRMLReposePoseNode* CameraResetFor = nullptr;
+  vtkSmartPointer<vtkLookupTable> Lookup;
+  vtkMRMLReposePoseNode* LookupFor = nullptr;
+};
+
+qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
+    : QWidget(parent), d_ptr(new qSlicerReposeViewsWidgetPrivate) {
+  Q_D(qSlicerReposeViewsWidget);
+  this->setObjectName("ReposeViews");
+  auto* grid = new QGridLayout(this);
+  grid->setContentsMargins(0, 0, 0, 0);
+  grid->setSpacing(2);
+  d->View3D = new QVTKOpenGLNativeWidget(this);
+  d->View3D->setObjectName("ThreeDView");
+  d->RenderWindow = vtkSmartPointer<vtkGenericOpenGLRenderWindow>::New();
+  d->View3D->setRenderWindow(d->RenderWindow);
+  d->Renderer = vtkSmartPointer<vtkRenderer>::New();
+  d->Renderer->SetBackground(0.76, 0.76, 0.87);  // Slicer's 3D view blue-grey
+  d->Renderer->SetBackground2(0.29, 0.29, 0.43);
+  d->Renderer->GradientBackgroundOn();
+  d->RenderWindow->AddRenderer(d->Renderer);
+  auto actor = [&](vtkSmartPointer<vtkActor>& a, vtkSmartPointer<vtkPolyDataMapper>& m) {
+    m = vtkSmartPointer<vtkPolyDataMapper>::New();
+    a = vtkSmartPointer<vtkActor>::New();
+    a->SetMapper(m);
+    a->VisibilityOff();
+    d->Renderer->AddActor(a);
+  };
+  actor(d->BodyActor, d->BodyMapper);
+  d->BodyActor->GetProperty()->SetColor(0.89, 0.72, 0.62);  // skin
+  d->BodyActor->GetProperty()->SetOpacity(0.6);
+  actor(d->CageActor, d->CageMapper);
+  d->CageActor->GetProperty()->SetRepresentationToWireframe();
+  d->CageActor->GetProperty()->SetColor(1.0, 0.55, 0.1);
+  d->CageActor->GetProperty()->LightingOff();
+  actor(d->CageVertexActor, d->CageVertexMapper);
+  d->CageVertexActor->GetProperty()->SetRepresentationToPoints();
+  d->CageVertexActor->GetProperty()->SetPointSize(5);
+  d->CageVertexActor->GetProperty()->SetColor(1.0, 0.9, 0.2);
+  d->CageVertexActor->GetProperty()->LightingOff();
+  for (int o = 0; o < 3; ++o) d->Slices[o] = new qSlicerReposeSliceView(o, this);
+  // Slicer's Four-Up: Red | 3D over Yellow | Green.
+  grid->addWidget(d->Slices[0], 0, 0);
+  grid->addWidget(d->View3D, 0, 1);
+  grid->addWidget(d->Slices[2], 1, 0);
+  grid->addWidget(d->Slices[1], 1, 1);
+}
+
+qSlicerReposeViewsWidget::~qSlicerReposeViewsWidget() {
+  this->setLogic(nullptr);
+}
+
+void qSlicerReposeViewsWidget::setLogic(vtkSlicerReposeLogic* logic) {
+  Q_D(qSlicerReposeViewsWidget);
+  if (d->Logic == logic) return;
+  if (d->Logic) d->Logic->RemoveObserver(d->LogicObserverTag);
+  if (d->Parameters) d->Parameters->RemoveObserver(d->ParametersObserverTag);
+  d->Logic = logic;
+  d->Parameters = logic ? logic->GetParameterNode() : nullptr;
+  if (logic)
+    d->LogicObserverTag =
+        logic->AddObserver(vtkCommand::ModifiedEvent, this, &qSlicerReposeViewsWidget::refresh);
+  if (d->Parameters)
+    d->ParametersObserverTag = d->Parameters->AddObserver(vtkCommand::ModifiedEvent, this,
+                                                          &qSlicerReposeViewsWidget::refresh);
+  this->refresh();
+}
+
+vtkSlicerReposeLogic* qSlicerReposeViewsWidget::logic() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->Logic;
+}
+
+qSlicerReposeSliceView* qSlicerReposeViewsWidget::sliceView(int orientation) const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return orientation >= 0 && orientation < 3 ? d->Slices[orientation] : nullptr;
+}
+
+void qSlicerReposeViewsWidget::setSlicePosition(int orientation, double positionMm) {
+  Q_D(qSlicerReposeViewsWidget);
+  if (orientation < 0 || orientation > 2) return;
+  d->Positions[orientation] = positionMm;
+  this->refresh();
+}
+
+void qSlicerReposeViewsWidget::setSliceResolution(int pixels) {
+  Q_D(qSlicerReposeViewsWidget);
+  d->Pixels = std::max(16, pixels);
+  this->refresh();
+}
+
+vtkRenderer* qSlicerReposeViewsWidget::renderer3D() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->Renderer;
+}
+
+double qSlicerReposeViewsWidget::lastSliceMilliseconds() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->SliceMilliseconds;
+}
+
+void qSlicerReposeViewsWidget::refresh() {
+  Q_D(qSlicerReposeViewsWidget);
+  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLivePose() : nullptr;
+  d->BodyActor->SetVisibility(pose != nullptr);
+  d->CageActor->SetVisibility(pose != nullptr);
+  d->CageVertexActor->SetVisibility(pose != nullptr);
+  d->SliceMilliseconds = 0;
+  if (!pose) {
+    for (qSlicerReposeSliceView* view : d->Slices) view->setSlice(nullptr, nullptr);
+    d->CameraResetFor = nullptr;
+    d->RenderWindow->Render();
+    return;
+  }
+  d->BodyMapper->SetInputData(d->Logic->GetLiveBodySurface());
+  d->CageMapper->SetInputData(d->Logic->GetLiveCage());
+  d->CageVertexMapper->SetInputData(d->Logic->GetLiveCage());
+  // Label colours of G, once per live pose.
+  if (d->LookupFor != pose) {
+    d->LookupFor = pose;
+    d->Lookup = nullptr;
+    auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
+        d->Logic->GetScene()->GetReferencedNode(pose, "segmentation"));
+    if (seg && seg->GetLabelMap())
+      d->Lookup = vtkSlicerReposeVolumeConversion::ToLookupTable(
+          vtkSlicerReposeVolumeConversion::GetLabelTable(seg->GetLabelMap()));
+  }
+  const std::array<double, 3> centre = d->Logic->GetLiveRestCenter();
+  for (int o = 0; o < 3; ++o) {
+    const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;  // axial: S, coronal: A, sagittal: R
+    if (std::isnan(d->Positions[o])) d->Positions[o] = centre[std::size_t(axis)];
+    double ms = 0;
+    vtkSmartPointer<vtkImageData> slice =
+        d->Logic->ComputeLiveSlice(o, d->Positions[o], d->Pixels, &ms);
+    d->SliceMilliseconds += ms;
+    d->Slices[o]->setPositionMm(d->Positions[o]);
+    if (vtkMRMLReposeParametersNode* p = d->Logic->GetParameterNode())
+      d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());
+    d->Slices[o]->setSlice(slice, d->Lookup);
+  }
+  if (d->CameraResetFor != pose) {
+    d->CameraResetFor = pose;
+    vtkCamera* camera = d->Renderer->GetActiveCamera();
+    camera->SetFocalPoint(0, 0, 0);
+    camera->SetPosition(0, 1, 0);  // looking at the patient's face: anterior view
+    camera->SetViewUp(0, 0, 1);
+    d->Renderer->ResetCamera();
+  }
+  d->RenderWindow->Render();
+  d->View3D->update();
+}
+
+QImage qSlicerReposeViewsWidget::renderViews() {
+  Q_D(qSlicerReposeViewsWidget);
+  d->RenderWindow->Render();
+  QImage out(this->size(), QImage::Format_RGB32);
+  out.fill(Qt::black);
+  QPainter painter(&out);
+  for (qSlicerReposeSliceView* view : d->Slices)
+    painter.drawImage(view->geometry().topLeft(), view->grab().toImage());
+  painter.drawImage(d->View3D->geometry(), d->View3D->grabFramebuffer());
+  return out;
+}

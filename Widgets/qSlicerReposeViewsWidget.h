@@ -1,0 +1,47 @@
+// qSlicerReposeViewsWidget: the module's four-up view layout, as Slicer's: Red (axial) and the 3D
+// view on top, Yellow (sagittal) and Green (coronal) below. The 3D view draws the posed cage as a
+// wireframe with its vertices and the posed body surface; the slice views draw the live frame's
+// labels, recomputed from the Logic on every change of the live pose (a handle moved, undo, a
+// keyframe), so they follow a drag.
+#pragma once
+
+#include "qSlicerReposeModuleWidgetsExport.h"
+
+#include <QScopedPointer>
+#include <QWidget>
+
+class qSlicerReposeSliceView;
+class qSlicerReposeViewsWidgetPrivate;
+class vtkRenderer;
+class vtkSlicerReposeLogic;
+
+class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeViewsWidget : public QWidget {
+  Q_OBJECT
+ public:
+  explicit qSlicerReposeViewsWidget(QWidget* parent = nullptr);
+  ~qSlicerReposeViewsWidget() override;
+
+  void setLogic(vtkSlicerReposeLogic* logic);
+  vtkSlicerReposeLogic* logic() const;
+
+  // orientation 0 axial (Red), 1 coronal (Green), 2 sagittal (Yellow).
+  qSlicerReposeSliceView* sliceView(int orientation) const;
+  // A slice's position along its normal (RAS mm); until set, the centre of the live body.
+  void setSlicePosition(int orientation, double positionMm);
+  // Pixels across a live slice (the larger in-plane side of the body's box).
+  void setSliceResolution(int pixels);
+  vtkRenderer* renderer3D() const;
+
+  // Recomputes the slices and redraws every view from the Logic's live pose (called on every
+  // Logic change). The slices' rasterization time of the last refresh, all three, in ms.
+  void refresh();
+  double lastSliceMilliseconds() const;
+
+  // The four views as one picture (the 3D view read back from its framebuffer).
+  QImage renderViews();
+
+ private:
+  QScopedPointer<qSlicerReposeViewsWidgetPrivate> d_ptr;
+  Q_DECLARE_PRIVATE(qSlicerReposeViewsWidget)
+  Q_DISABLE_COPY(qSlicerReposeViewsWidget)
+};
