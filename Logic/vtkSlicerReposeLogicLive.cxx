@@ -8,6 +8,7 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeJob.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicInputs.h"
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
@@ -74,31 +75,16 @@ void setPoints(vtkPolyData* poly, const Eigen::MatrixX3d& positions) {
 bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
   this->LastErrorMessage.clear();
   try {
-    if (!poseNode) throw repose::Error("no pose");
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
-    auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
-        this->Scene->GetReferencedNode(poseNode, "segmentation"));
-    auto* cageNode =
-        vtkMRMLReposeCageNode::SafeDownCast(this->Scene->GetReferencedNode(poseNode, "cage"));
-    auto* meshNode = vtkMRMLReposeTransferMeshNode::SafeDownCast(
-        this->Scene->GetReferencedNode(poseNode, "transfer_mesh"));
-    if (!seg || !seg->GetLabelMap() || !cageNode || !meshNode)
-      throw repose::Error("pose " + poseNode->GetName() +
-                          " has no segmentation, cage and transfer mesh yet (build the rig)");
+    const auto nodes = vtkSlicerReposeLogicInputs::Resolve(this->Scene, poseNode);
     // Converted here, on the caller's thread: the worker never touches the nodes.
-    auto G = std::make_shared<const repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
-    repose::LabelTable partLabels;
-    if (seg->GetBodyPartMap()) {
-      partLabels = Conversion::GetLabelTable(seg->GetBodyPartMap());
-    } else {  // as the rig job: the body mask of G is the one part
-      repose::Label body;
-      body.value = 1;
-      body.name = "body";
-      partLabels.set(body);
-    }
+    auto G = std::make_shared<const repose::Volume>(
+        Conversion::FromImageData(nodes.Segmentation->GetLabelMap()));
+    const repose::LabelTable partLabels =
+        vtkSlicerReposeLogicInputs::BodyPartLabels(nodes.Segmentation);
     repose::RigGeometry geometry{
-        vtkSlicerReposeMeshConversion::FromPolyData(cageNode->GetMesh()),
-        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
+        vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()),
+        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(nodes.TransferMesh->GetMesh())};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(

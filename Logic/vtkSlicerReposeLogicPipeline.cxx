@@ -10,6 +10,7 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeJob.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicInputs.h"
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
@@ -65,12 +66,7 @@ repose::Volume partsOf(vtkMRMLReposeSegmentationNode* seg) {
     for (std::int64_t v = 0; v < G.numVoxels(); ++v)
       mask.data<std::uint8_t>()[v] = G.data<T>()[v] != 0;
   });
-  repose::LabelTable t;
-  repose::Label body;
-  body.value = 1;
-  body.name = "body";
-  t.set(body);
-  mask.labels() = t;
+  mask.labels() = vtkSlicerReposeLogicInputs::BodyPartLabels(seg);
   mask.setLabelMap(true);
   return mask;
 }
@@ -84,6 +80,35 @@ std::string readText(const std::string& path) {
 }
 
 }  // namespace
+
+namespace vtkSlicerReposeLogicInputs {
+
+PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose) {
+  if (!pose) throw repose::Error("no pose");
+  PoseNodes nodes;
+  nodes.Segmentation =
+      vtkMRMLReposeSegmentationNode::SafeDownCast(scene->GetReferencedNode(pose, "segmentation"));
+  nodes.Cage = vtkMRMLReposeCageNode::SafeDownCast(scene->GetReferencedNode(pose, "cage"));
+  nodes.TransferMesh =
+      vtkMRMLReposeTransferMeshNode::SafeDownCast(scene->GetReferencedNode(pose, "transfer_mesh"));
+  if (!nodes.Segmentation || !nodes.Segmentation->GetLabelMap() || !nodes.Cage ||
+      !nodes.TransferMesh)
+    throw repose::Error("pose " + pose->GetName() +
+                        " has no segmentation, cage and transfer mesh yet (build the rig)");
+  return nodes;
+}
+
+repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg) {
+  if (seg->GetBodyPartMap()) return Conversion::GetLabelTable(seg->GetBodyPartMap());
+  repose::LabelTable table;
+  repose::Label body;
+  body.value = 1;
+  body.name = "body";
+  table.set(body);
+  return table;
+}
+
+}  // namespace vtkSlicerReposeLogicInputs
 
 void vtkSlicerReposeLogic::SetScene(vtkMRMLReposeScene* scene) {
   if (!scene || scene == this->Scene) return;
@@ -204,17 +229,11 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
                                           const std::string& outputFolder) {
   this->LastErrorMessage.clear();
   try {
-    if (!poseNode) throw repose::Error("no pose");
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
-    auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
-        this->Scene->GetReferencedNode(poseNode, "segmentation"));
-    auto* cageNode =
-        vtkMRMLReposeCageNode::SafeDownCast(this->Scene->GetReferencedNode(poseNode, "cage"));
-    auto* meshNode = vtkMRMLReposeTransferMeshNode::SafeDownCast(
-        this->Scene->GetReferencedNode(poseNode, "transfer_mesh"));
-    if (!seg || !cageNode || !meshNode)
-      throw repose::Error("pose " + poseNode->GetName() +
-                          " has no segmentation, cage and transfer mesh yet (build the rig)");
+    const auto nodes = vtkSlicerReposeLogicInputs::Resolve(this->Scene, poseNode);
+    auto* seg = nodes.Segmentation;
+    auto* cageNode = nodes.Cage;
+    auto* meshNode = nodes.TransferMesh;
     if (!outputFolder.empty() && !fs::is_directory(fs::absolute(outputFolder).parent_path()))
       throw repose::Error(outputFolder + ": its parent folder does not exist");
     auto G = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
