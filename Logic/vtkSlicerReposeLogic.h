@@ -105,6 +105,29 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
                              const std::array<double, 3>& axis, double angleDeg,
                              const std::array<double, 3>& pivot,
                              const std::array<double, 3>& translation);
+  // The group's transform in the pose's current keyframe (its base transform where the keyframe
+  // does not name it). False for an unknown or fixed group.
+  bool GetPoseGroupTransform(vtkMRMLReposePoseNode* pose, const std::string& group,
+                             std::array<double, 3>& axis, double& angleDeg,
+                             std::array<double, 3>& pivot,
+                             std::array<double, 3>& translation) const;
+  // The same transform as a 4x4 matrix (rest RAS mm -> posed RAS mm), and setting it from one
+  // (the 3D view's transform widget): the group keeps its pivot and its axis direction. False
+  // with a message when the matrix is not a rigid motion.
+  bool GetPoseGroupMatrix(vtkMRMLReposePoseNode* pose, const std::string& group,
+                          vtkMatrix4x4* matrix) const;
+  bool SetPoseGroupMatrix(vtkMRMLReposePoseNode* pose, const std::string& group,
+                          vtkMatrix4x4* matrix);
+  // A new pose node with the one fixed group "rest" (every cage vertex): a pose built up from
+  // selections in the 3D view.
+  vtkMRMLReposePoseNode* NewPose(const std::string& name);
+  // A new handle group of the live pose, undoable: the given cage vertices, or with bodyPart > 0
+  // that part of S (its cage vertices and its tissue). It takes its vertices from "the rest" and
+  // from groups of listed vertices; overlapping a group that selects by region or part is refused.
+  // Returns the new group's name ("group N"), or "" with a message. The live pose re-prepares
+  // itself for the new groups (a job).
+  std::string AddPoseGroup(vtkMRMLReposePoseNode* pose, const std::vector<int>& cageVertices,
+                           int bodyPart = 0);
   // A drag: the edits between Begin and End are one undo step (each still re-solves live).
   void BeginPoseInteraction();
   void EndPoseInteraction();
@@ -139,6 +162,13 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // RAS box (xmin, xmax, ymin, ymax, zmin, zmax) of the rest and posed body together, where the
   // views place their slices.
   std::array<double, 6> GetLiveBounds() const;
+  // The live rig's cage at rest (RAS mm, one entry per cage vertex), the cage vertices a group
+  // of the live pose moves, the cage vertices of a body part of S (as a group selecting that part
+  // would move), and S's parts (label, name).
+  std::vector<std::array<double, 3>> GetLiveRestCage() const;
+  std::vector<int> GetLiveGroupVertices(const std::string& group) const;
+  std::vector<int> GetLiveCageVerticesOfPart(int label) const;
+  std::vector<std::pair<int, std::string>> GetLiveBodyParts() const;
   // The centre of the rest body's box (where the views' slices start).
   std::array<double, 3> GetLiveRestCenter() const;
   // The live frame's labels of G on the slice plane through `positionMm` (orientation 0 axial,
@@ -155,6 +185,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   void OnParameterNodeModified();
   void OnLivePoseModified();
   void ReleaseLivePose();  // StopLivePose without the ModifiedEvent
+  // Pushes an undo step (or extends the current drag's) and sets the pose node's JSON.
+  void RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after);
 
  private:
   vtkSlicerReposeLogic(const vtkSlicerReposeLogic&) = delete;

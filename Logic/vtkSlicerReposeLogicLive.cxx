@@ -31,6 +31,7 @@ struct vtkSlicerReposeLogic::LiveSession {
   unsigned long PoseObserverTag = 0;
   std::shared_ptr<const repose::Volume> Labels;  // G
   std::shared_ptr<const repose::PoseRig> Rig;
+  repose::LabelTable PartLabels;  // S's, for groups selecting parts
   std::vector<std::uint8_t> OuterFaces;
   Eigen::MatrixX3d Deformed;  // the live frame's TM vertices
   Eigen::Vector3d Lo{0, 0, 0}, Hi{0, 0, 0};
@@ -96,6 +97,7 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           session->Labels = G;
           session->Rig =
               std::make_shared<const repose::PoseRig>(std::move(geometry), pose, partLabels);
+          session->PartLabels = partLabels;
           session->OuterFaces = repose::outerFaces(session->Rig->mesh());
           session->Cage = vtkSlicerReposeMeshConversion::ToPolyData(session->Rig->cage());
           session->Body = bodySurface(session->Rig->mesh(), session->OuterFaces);
@@ -118,6 +120,21 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
 }
 
 void vtkSlicerReposeLogic::OnLivePoseModified() {
+  if (!this->Live) return;
+  // New or changed handle groups (a group made from a selection, or its undo) need the rig
+  // prepared again: a job, after which the frame is solved. Until then the last frame stays.
+  try {
+    const repose::Pose pose =
+        repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName());
+    if (!repose::sameHandleGroups(pose, this->Live->Rig->pose())) {
+      if (!this->StartLivePose(this->Live->Pose)) this->Modified();
+      return;
+    }
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    this->Modified();
+    return;
+  }
   this->UpdateLiveFrame();
 }
 
@@ -176,6 +193,49 @@ vtkPolyData* vtkSlicerReposeLogic::GetLiveCage() const {
 
 vtkPolyData* vtkSlicerReposeLogic::GetLiveBodySurface() const {
   return this->Live ? this->Live->Body.GetPointer() : nullptr;
+}
+
+std::vector<std::array<double, 3>> vtkSlicerReposeLogic::GetLiveRestCage() const {
+  std::vector<std::array<double, 3>> out;
+  if (!this->Live) return out;
+  const Eigen::MatrixX3d& v = this->Live->Rig->cage().vertices;
+  out.reserve(std::size_t(v.rows()));
+  for (Eigen::Index i = 0; i < v.rows(); ++i) out.push_back({v(i, 0), v(i, 1), v(i, 2)});
+  return out;
+}
+
+std::vector<int> vtkSlicerReposeLogic::GetLiveGroupVertices(const std::string& group) const {
+  if (!this->Live) return {};
+  const repose::Pose& pose = this->Live->Rig->pose();
+  for (std::size_t g = 0; g < pose.groups.size(); ++g)
+    if (pose.groups[g].name == group) return this->Live->Rig->handles().at(g).cageVertices;
+  return {};
+}
+
+std::vector<int> vtkSlicerReposeLogic::GetLiveCageVerticesOfPart(int label) const {
+  if (!this->Live || label <= 0) return {};
+  // As a group selecting the part would: resolved by the same Core function as a pose file's.
+  repose::Pose probe;
+  repose::PoseGroup group;
+  group.name = "part";
+  group.select.parts = {label};
+  probe.groups.push_back(group);
+  try {
+    return repose::resolveHandles(probe, this->Live->Rig->cage(), this->Live->Rig->mesh(),
+                                  this->Live->PartLabels)
+        .front()
+        .cageVertices;
+  } catch (const repose::Error&) {
+    return {};  // a part too small to reach the cage
+  }
+}
+
+std::vector<std::pair<int, std::string>> vtkSlicerReposeLogic::GetLiveBodyParts() const {
+  std::vector<std::pair<int, std::string>> parts;
+  if (!this->Live) return parts;
+  for (const repose::Label& l : this->Live->PartLabels.labels())
+    if (l.value > 0) parts.emplace_back(l.value, l.name);
+  return parts;
 }
 
 std::array<double, 3> vtkSlicerReposeLogic::GetLiveRestCenter() const {

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -28,6 +29,7 @@ void vtkMRMLReposeParametersNode::ForEachField(F&& f) {
   f("PosePath", &Self::PosePath, &Self::SetPosePath);
   f("ActivePoseNodeID", &Self::ActivePoseNodeID, &Self::SetActivePoseNodeID);
   f("ActiveGroup", &Self::ActiveGroup, &Self::SetActiveGroup);
+  f("SelectedCageVertices", &Self::SelectedCageVertices, &Self::SetSelectedCageVertices);
   f("LabelOpacity", &Self::LabelOpacity, &Self::SetLabelOpacity);
 }
 
@@ -66,6 +68,17 @@ void vtkMRMLReposeParametersNode::SetTransferMeshSizeMm(double mm) {
 }
 void vtkMRMLReposeParametersNode::SetOutputMemoryBudgetMB(int mib) {
   if (clampAssign(this->OutputMemoryBudgetMB, mib, 64, 1 << 20)) this->Modified();
+}
+
+void vtkMRMLReposeParametersNode::SetSelectedCageVertices(const std::vector<int>& vertices) {
+  std::vector<int> v;
+  std::copy_if(vertices.begin(), vertices.end(), std::back_inserter(v),
+               [](int i) { return i >= 0; });
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  if (v == this->SelectedCageVertices) return;
+  this->SelectedCageVertices = std::move(v);
+  this->Modified();
 }
 
 void vtkMRMLReposeParametersNode::SetLabelOpacity(double opacity) {
@@ -121,6 +134,10 @@ bool vtkMRMLReposeParametersNode::ReadJSON(const std::string& text, std::string*
       const auto& v = item.value();
       if constexpr (std::is_same_v<T, std::string>)
         typeOk = v.is_string();
+      else if constexpr (std::is_same_v<T, std::vector<int>>)
+        typeOk = v.is_array() && std::all_of(v.begin(), v.end(), [](const nlohmann::json& e) {
+                   return e.is_number_integer();
+                 });
       else if constexpr (std::is_integral_v<T>)
         typeOk = v.is_number_integer();
       else
@@ -136,7 +153,11 @@ bool vtkMRMLReposeParametersNode::ReadJSON(const std::string& text, std::string*
     if (it == json.end()) return;
     if constexpr (std::is_integral_v<T>)
       (this->*setter)(saturatedInt(*it));
-    else
+    else if constexpr (std::is_same_v<T, std::vector<int>>) {
+      std::vector<int> v;
+      for (const auto& e : *it) v.push_back(saturatedInt(e));
+      (this->*setter)(v);
+    } else
       (this->*setter)(it->template get<T>());
   });
   this->EndModify(state);
@@ -146,6 +167,13 @@ bool vtkMRMLReposeParametersNode::ReadJSON(const std::string& text, std::string*
 void vtkMRMLReposeParametersNode::PrintSelf(ostream& os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
   ForEachField([&](const char* name, auto member, auto) {
-    os << indent << name << ": " << this->*member << "\n";
+    using T = std::decay_t<decltype(this->*member)>;
+    os << indent << name << ":";
+    if constexpr (std::is_same_v<T, std::vector<int>>) {
+      for (int v : this->*member) os << " " << v;
+    } else {
+      os << " " << this->*member;
+    }
+    os << "\n";
   });
 }

@@ -7,6 +7,7 @@
 #include <vtkObject.h>
 
 #include <string>
+#include <vector>
 
 class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public vtkObject {
  public:
@@ -69,6 +70,10 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   const std::string& GetActivePoseNodeID() const { return this->ActivePoseNodeID; }
   vtkSetMacro(ActiveGroup, std::string);
   const std::string& GetActiveGroup() const { return this->ActiveGroup; }
+  // The cage vertices selected in the 3D view (indices, sorted, no repeats; negatives dropped):
+  // what "New group from selection" makes a handle group of.
+  void SetSelectedCageVertices(const std::vector<int>& vertices);
+  const std::vector<int>& GetSelectedCageVertices() const { return this->SelectedCageVertices; }
   // Opacity of the labels over the image in the slice views, clamped to [0, 1].
   void SetLabelOpacity(double opacity);
   double GetLabelOpacity() const { return this->LabelOpacity; }
@@ -94,6 +99,7 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   std::string PosePath;
   std::string ActivePoseNodeID;
   std::string ActiveGroup;
+  std::vector<int> SelectedCageVertices;
   double LabelOpacity = 0.8;
 
  private:

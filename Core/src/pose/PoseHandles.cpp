@@ -60,6 +60,23 @@ std::vector<LimbSeparation> resolveSeparations(const Pose& pose, const LabelTabl
   return out;
 }
 
+bool sameHandleGroups(const Pose& a, const Pose& b) {
+  auto sameRegion = [](const std::optional<Region>& x, const std::optional<Region>& y) {
+    if (x.has_value() != y.has_value()) return false;
+    return !x || (x->shape == y->shape && x->a == y->a && x->b == y->b);
+  };
+  return a.groups.size() == b.groups.size() &&
+         std::equal(a.groups.begin(), a.groups.end(), b.groups.begin(),
+                    [&](const PoseGroup& x, const PoseGroup& y) {
+                      return x.name == y.name && x.fixed == y.fixed &&
+                             x.select.cageVertices == y.select.cageVertices &&
+                             sameRegion(x.select.region, y.select.region) &&
+                             x.select.parts == y.select.parts &&
+                             x.select.partNames == y.select.partNames &&
+                             x.select.rest == y.select.rest;
+                    });
+}
+
 std::vector<RigidHandle> resolveHandles(const Pose& pose, const TriangleMesh& cage,
                                         const TransferMesh& mesh, const LabelTable& partLabels) {
   const Eigen::Index nc = cage.vertices.rows();

@@ -151,11 +151,7 @@ PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision) const
 
 PoseRig::Frame PoseRig::frame(const Pose& edited, std::size_t index,
                               GreenPrecision precision) const {
-  bool same = edited.groups.size() == pose_.groups.size();
-  for (std::size_t g = 0; same && g < edited.groups.size(); ++g)
-    same = edited.groups[g].name == pose_.groups[g].name &&
-           edited.groups[g].fixed == pose_.groups[g].fixed;
-  if (!same)
+  if (!sameHandleGroups(edited, pose_))
     throw Error("pose " + edited.name + ": its groups are not those the rig was prepared for");
   const auto frames = edited.frames();
   if (index >= frames.size())

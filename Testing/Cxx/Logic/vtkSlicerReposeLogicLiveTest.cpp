@@ -13,8 +13,11 @@
 #include <gtest/gtest.h>
 
 #include <vtkNew.h>
+#include <vtkMatrix4x4.h>
 #include <vtkPointData.h>
+#include <vtkTransform.h>
 
+#include <cmath>
 #include <cstring>
 
 using namespace repose::test;
@@ -109,4 +112,114 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
   logic->StopLivePose();
   EXPECT_EQ(logic->GetLivePose(), nullptr);
   EXPECT_FALSE(logic->ComputeLiveSlice(1, y, 128));
+}
+
+// A pose made in the 3D view: a new pose (everything fixed), a group from the cage vertices
+// around the left hand, moved by a 4x4 motion as the transform widget gives it. The live rig
+// re-prepares for the new group, the body surface follows the hand and only near it, and undo
+// removes the group again.
+TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
+  ScratchDir dir("live-selection");
+  repose::PhantomOptions po;
+  po.voxelMm = 8;
+  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+  repose::writeVolume(organs, dir.file("G.nii.gz"));
+  repose::writeVolume(parts, dir.file("S.nii.gz"));
+
+  vtkNew<vtkSlicerReposeLogic> logic;
+  auto* seg = logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"));
+  ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
+  vtkMRMLReposePoseNode* pose = logic->NewPose("from the view");
+  ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(logic->AddPoseGroup(pose, {0, 1}).empty());  // not live yet
+  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  ASSERT_EQ(logic->GetLivePose(), pose);
+  EXPECT_FALSE(logic->GetPoseGroupMatrix(pose, "rest", vtkNew<vtkMatrix4x4>()));  // fixed
+
+  // The cage vertices of the left hand part, found by name among S's parts.
+  int hand = 0;
+  for (const auto& [label, name] : logic->GetLiveBodyParts())
+    if (name == "hand_left") hand = label;
+  ASSERT_GT(hand, 0);
+  const std::vector<int> selection = logic->GetLiveCageVerticesOfPart(hand);
+  ASSERT_FALSE(selection.empty());
+  const auto rest = logic->GetLiveRestCage();
+  std::array<double, 3> handCentre{0, 0, 0};
+  for (int v : selection)
+    for (int k = 0; k < 3; ++k) handCentre[k] += rest[std::size_t(v)][k] / double(selection.size());
+  const double handZ = handCentre[2];
+
+  const std::string group = logic->AddPoseGroup(pose, selection);
+  ASSERT_EQ(group, "group 1") << logic->GetLastErrorMessage();
+  // The groups changed: the live pose re-prepares on the worker, then serves the new group.
+  ASSERT_TRUE(logic->IsJobRunning());
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  ASSERT_EQ(logic->GetLivePose(), pose);
+  EXPECT_EQ(logic->GetLiveGroupVertices(group), selection);
+
+  // Lift the hand 60 mm and turn it 30 degrees about A, as one drag of the transform widget.
+  vtkNew<vtkMatrix4x4> start;
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, group, start));
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) EXPECT_NEAR(start->GetElement(i, j), i == j ? 1 : 0, 1e-12);
+  vtkPolyData* body = logic->GetLiveBodySurface();
+  std::vector<std::array<double, 3>> before(std::size_t(body->GetNumberOfPoints()));
+  for (vtkIdType i = 0; i < body->GetNumberOfPoints(); ++i)
+    body->GetPoint(i, before[std::size_t(i)].data());
+  vtkNew<vtkTransform> motion;
+  motion->PostMultiply();  // turn 30 degrees about A through the hand, then lift 60 mm
+  motion->Translate(-handCentre[0], -handCentre[1], -handCentre[2]);
+  motion->RotateY(30);
+  motion->Translate(handCentre[0], handCentre[1], handCentre[2] + 60);
+  logic->BeginPoseInteraction();
+  ASSERT_TRUE(logic->SetPoseGroupMatrix(pose, group, motion->GetMatrix()))
+      << logic->GetLastErrorMessage();
+  logic->EndPoseInteraction();
+  vtkNew<vtkMatrix4x4> after;
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, group, after));
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      EXPECT_NEAR(after->GetElement(i, j), motion->GetMatrix()->GetElement(i, j), 1e-9);
+  // The body surface moved near the hand and stayed put far from it (the head).
+  body = logic->GetLiveBodySurface();
+  double movedNearHand = 0, movedAtHead = 0;
+  for (vtkIdType i = 0; i < body->GetNumberOfPoints(); ++i) {
+    double p[3];
+    body->GetPoint(i, p);
+    const auto& q = before[std::size_t(i)];
+    const double d = std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                               (p[2] - q[2]) * (p[2] - q[2]));
+    if (std::abs(q[2] - handZ) < 40) movedNearHand = std::max(movedNearHand, d);
+    if (q[2] > 1500) movedAtHead = std::max(movedAtHead, d);
+  }
+  EXPECT_GT(movedNearHand, 40.0);
+  EXPECT_LT(movedAtHead, 1e-6);
+  // A non-rigid matrix is refused with a message, and changes nothing.
+  vtkNew<vtkMatrix4x4> scaled;
+  scaled->SetElement(0, 0, 2);
+  EXPECT_FALSE(logic->SetPoseGroupMatrix(pose, group, scaled));
+  EXPECT_NE(logic->GetLastErrorMessage().find("not a rigid"), std::string::npos);
+
+  // A group by body part over the same hand overlaps group 1 (listed vertices): it takes them,
+  // and group 1, left empty, goes. A further selection overlapping that part group is refused.
+  const std::string byPart = logic->AddPoseGroup(pose, {}, hand);
+  ASSERT_EQ(byPart, "group 1") << logic->GetLastErrorMessage();  // the name is free again
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  EXPECT_TRUE(logic->AddPoseGroup(pose, {selection.front()}).empty());
+  EXPECT_NE(logic->GetLastErrorMessage().find("by region or body part"), std::string::npos)
+      << logic->GetLastErrorMessage();
+
+  // Undo twice: the part group, then the move; three times: the selection group too.
+  ASSERT_TRUE(logic->Undo());
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  ASSERT_TRUE(logic->Undo());
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, group, after));
+  EXPECT_NEAR(after->GetElement(2, 3), 0, 1e-12);
+  ASSERT_TRUE(logic->Undo());
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  EXPECT_TRUE(logic->GetLiveGroupVertices(group).empty());
+  EXPECT_EQ(logic->GetLivePose(), pose);
 }

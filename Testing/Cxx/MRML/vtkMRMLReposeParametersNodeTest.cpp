@@ -40,6 +40,7 @@ void fillNonDefault(vtkMRMLReposeParametersNode* node) {
   node->SetPosePath("/poses/elbow90.pose.json");
   node->SetActivePoseNodeID("vtkMRMLReposePoseNode1");
   node->SetActiveGroup("left forearm and hand");
+  node->SetSelectedCageVertices({12, 3, 7, 3});
   node->SetLabelOpacity(0.35);
 }
 
@@ -56,6 +57,7 @@ void expectEqualFields(vtkMRMLReposeParametersNode* a, vtkMRMLReposeParametersNo
   EXPECT_EQ(a->GetPosePath(), b->GetPosePath());
   EXPECT_EQ(a->GetActivePoseNodeID(), b->GetActivePoseNodeID());
   EXPECT_EQ(a->GetActiveGroup(), b->GetActiveGroup());
+  EXPECT_EQ(a->GetSelectedCageVertices(), b->GetSelectedCageVertices());
   EXPECT_EQ(a->GetLabelOpacity(), b->GetLabelOpacity());
 }
 
@@ -71,6 +73,7 @@ const char* const kFieldNames[] = {"InputSegmentationNodeID",
                                    "PosePath",
                                    "ActivePoseNodeID",
                                    "ActiveGroup",
+                                   "SelectedCageVertices",
                                    "LabelOpacity"};
 
 }  // namespace
@@ -112,6 +115,9 @@ TEST(vtkMRMLReposeParametersNode, ClampsToRanges) {
   EXPECT_EQ(node->GetLabelOpacity(), 1.0);
   node->SetLabelOpacity(-0.5);
   EXPECT_EQ(node->GetLabelOpacity(), 0.0);
+  // A selection is a set of indices: sorted, no repeats, no negatives.
+  node->SetSelectedCageVertices({9, -1, 2, 9, 4});
+  EXPECT_EQ(node->GetSelectedCageVertices(), (std::vector<int>{2, 4, 9}));
   // NaN and infinity are refused: the value stays.
   node->SetCageDilationMm(3.0);
   node->SetCageDilationMm(std::nan(""));
@@ -196,6 +202,8 @@ TEST(vtkMRMLReposeParametersNode, ReadJsonPartialClampsAndRejectsBadInput) {
   EXPECT_FALSE(node->ReadJSON(R"({"ImagePath": "c", "CageVertexCount": "many"})", &error));
   EXPECT_NE(error.find("CageVertexCount"), std::string::npos) << error;
   EXPECT_FALSE(node->ReadJSON(R"({"CageVertexCount": 3.5})", &error));
+  EXPECT_FALSE(node->ReadJSON(R"({"SelectedCageVertices": [1, "two"]})", &error));
+  EXPECT_NE(error.find("SelectedCageVertices"), std::string::npos) << error;
   EXPECT_FALSE(node->ReadJSON(R"({"ImagePath": "c", "CageVertexCont": 7})", &error));
   EXPECT_NE(error.find("CageVertexCont"), std::string::npos) << error;
   EXPECT_EQ(error.find('\n'), std::string::npos);

@@ -64,6 +64,9 @@ struct Pose {
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames() const;
 };
 
+// Whether two poses have the same handle groups (names, fixed, selections) in the same order:
+// a rig prepared for one solves frames of the other.
+bool sameHandleGroups(const Pose& a, const Pose& b);
 // Throws repose::Error "<source>: <field>: <problem>" naming the offending field, e.g.
 // "elbow.pose.json: groups[0].rotation.angle_deg: expected a number".
 Pose parsePose(const std::string& jsonText, const std::string& source);

@@ -1,0 +1,31 @@
+// What a pose node needs from the scene before a job can use it: its segmentation, cage and
+// transfer mesh, and the body-part labels S carries. Shared by the pipeline and the live half of
+// vtkSlicerReposeLogic, so both refuse an unrigged pose with the same message.
+#ifndef vtkSlicerReposeLogicInputs_h
+#define vtkSlicerReposeLogicInputs_h
+
+#include <repose/volume/LabelTable.h>
+
+class vtkMRMLReposeCageNode;
+class vtkMRMLReposePoseNode;
+class vtkMRMLReposeScene;
+class vtkMRMLReposeSegmentationNode;
+class vtkMRMLReposeTransferMeshNode;
+
+namespace vtkSlicerReposeLogicInputs {
+
+struct PoseNodes {
+  vtkMRMLReposeSegmentationNode* Segmentation = nullptr;
+  vtkMRMLReposeCageNode* Cage = nullptr;
+  vtkMRMLReposeTransferMeshNode* TransferMesh = nullptr;
+};
+
+// The nodes the pose references; throws repose::Error naming the pose when one is missing.
+PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose);
+
+// S's label table, or the one-label table of the body mask when the segmentation has no S.
+repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg);
+
+}  // namespace vtkSlicerReposeLogicInputs
+
+#endif

@@ -1,0 +1,312 @@
+// vtkSlicerReposeLogic, the pose edits: a group's transform set from the panel's controls or from
+// the 3D view's transform widget (a 4x4 motion), new handle groups from a selection of cage
+// vertices or a body part, new poses, and the undo/redo stacks they all share. Every edit is a
+// new pose JSON on the pose node, so undo is restoring a string and the live frame follows the
+// node's Modified.
+#include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
+#include "vtkSlicerReposeLogic.h"
+
+#include <repose/pose/Pose.h>
+#include <repose/util/Error.h>
+
+#include <vtkMatrix4x4.h>
+
+#include <algorithm>
+#include <set>
+
+namespace {
+
+repose::PoseGroup& findGroup(repose::Pose& pose, const std::string& group,
+                             const std::string& poseName) {
+  const auto it = std::find_if(pose.groups.begin(), pose.groups.end(),
+                               [&](const repose::PoseGroup& g) { return g.name == group; });
+  if (it == pose.groups.end())
+    throw repose::Error("pose " + poseName + ": no group \"" + group + "\"");
+  return *it;
+}
+
+// The keyframe an edit applies to: the node's current one, or none (the base pose).
+repose::PoseKeyframe* editedKeyframe(repose::Pose& pose, vtkMRMLReposePoseNode* node) {
+  if (pose.keyframes.empty()) return nullptr;
+  return &pose.keyframes[std::min<std::size_t>(std::size_t(std::max(0, node->GetCurrentFrame())),
+                                               pose.keyframes.size() - 1)];
+}
+
+// The group's transform in the edited frame (its base transform where the keyframe is silent).
+repose::PoseTransform currentTransform(repose::Pose& pose, vtkMRMLReposePoseNode* node,
+                                       const repose::PoseGroup& group) {
+  if (repose::PoseKeyframe* k = editedKeyframe(pose, node))
+    for (const auto& [name, t] : k->transforms)
+      if (name == group.name) return t;
+  return group.transform;
+}
+
+void setCurrentTransform(repose::Pose& pose, vtkMRMLReposePoseNode* node, repose::PoseGroup& group,
+                         const repose::PoseTransform& t) {
+  repose::PoseKeyframe* k = editedKeyframe(pose, node);
+  if (!k) {
+    group.transform = t;
+    return;
+  }
+  auto entry = std::find_if(k->transforms.begin(), k->transforms.end(),
+                            [&](const auto& e) { return e.first == group.name; });
+  if (entry == k->transforms.end())
+    k->transforms.emplace_back(group.name, t);
+  else
+    entry->second = t;
+}
+
+}  // namespace
+
+void vtkSlicerReposeLogic::RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after) {
+  const std::string before = node->GetPoseJSON();
+  if (after == before) return;
+  if (this->Interacting && this->InteractionRecorded && !this->UndoStack.empty() &&
+      this->UndoStack.back().nodeID == node->GetID())
+    this->UndoStack.back().after = after;  // the same drag: one step
+  else
+    this->UndoStack.push_back({node->GetID(), before, after});
+  this->InteractionRecorded = this->Interacting;
+  this->RedoStack.clear();
+  node->SetPoseJSON(after);
+}
+
+void vtkSlicerReposeLogic::BeginPoseInteraction() {
+  this->Interacting = true;
+  this->InteractionRecorded = false;
+}
+
+void vtkSlicerReposeLogic::EndPoseInteraction() {
+  this->Interacting = false;
+  this->InteractionRecorded = false;
+}
+
+bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
+                                                 const std::string& group,
+                                                 const std::array<double, 3>& axis, double angleDeg,
+                                                 const std::array<double, 3>& pivot,
+                                                 const std::array<double, 3>& translation) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!node) throw repose::Error("no pose");
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    repose::PoseGroup& g = findGroup(pose, group, node->GetName());
+    if (g.fixed)
+      throw repose::Error("pose " + node->GetName() + ": group \"" + group + "\" is fixed");
+    repose::PoseTransform t;
+    t.axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
+    if (!(t.axis.norm() > 0) || !t.axis.allFinite())
+      throw repose::Error("the rotation axis is zero");
+    t.axis.normalize();
+    t.angleDeg = angleDeg;
+    t.pivot = Eigen::Vector3d(pivot[0], pivot[1], pivot[2]);
+    t.translation = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+    if (!std::isfinite(angleDeg) || !t.pivot.allFinite() || !t.translation.allFinite())
+      throw repose::Error("the transform of group \"" + group + "\" is not finite");
+    setCurrentTransform(pose, node, g, t);
+    this->RecordPoseEdit(node, repose::poseToJson(pose));
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::GetPoseGroupTransform(vtkMRMLReposePoseNode* node,
+                                                 const std::string& group,
+                                                 std::array<double, 3>& axis, double& angleDeg,
+                                                 std::array<double, 3>& pivot,
+                                                 std::array<double, 3>& translation) const {
+  if (!node) return false;
+  try {
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    const repose::PoseGroup& g = findGroup(pose, group, node->GetName());
+    if (g.fixed) return false;
+    const repose::PoseTransform t = currentTransform(pose, node, g);
+    axis = {t.axis.x(), t.axis.y(), t.axis.z()};
+    angleDeg = t.angleDeg;
+    pivot = {t.pivot.x(), t.pivot.y(), t.pivot.z()};
+    translation = {t.translation.x(), t.translation.y(), t.translation.z()};
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::GetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
+                                              vtkMatrix4x4* matrix) const {
+  std::array<double, 3> axis, pivot, translation;
+  double angle = 0;
+  if (!matrix || !this->GetPoseGroupTransform(node, group, axis, angle, pivot, translation))
+    return false;
+  repose::PoseTransform t;
+  t.axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
+  t.angleDeg = angle;
+  t.pivot = Eigen::Vector3d(pivot[0], pivot[1], pivot[2]);
+  t.translation = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  const Eigen::Matrix4d m = t.isometry().matrix();
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) matrix->SetElement(r, c, m(r, c));
+  return true;
+}
+
+bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
+                                              vtkMatrix4x4* matrix) {
+  this->LastErrorMessage.clear();
+  std::array<double, 3> oldAxis, pivot, oldTranslation;
+  double oldAngle = 0;
+  if (!matrix ||
+      !this->GetPoseGroupTransform(node, group, oldAxis, oldAngle, pivot, oldTranslation)) {
+    this->LastErrorMessage = "pose group \"" + group + "\" cannot be moved (unknown or fixed)";
+    return false;
+  }
+  Eigen::Matrix3d R;
+  Eigen::Vector3d shift;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R(r, c) = matrix->GetElement(r, c);
+    shift[r] = matrix->GetElement(r, 3);
+  }
+  if (!R.allFinite() || !shift.allFinite() ||
+      !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0) {
+    this->LastErrorMessage = "pose group \"" + group + "\": the motion is not a rigid one";
+    return false;
+  }
+  // x' = R (x - p) + p + T with the group's own pivot p: T = shift + R p - p. The axis keeps the
+  // direction it had, so the panel's angle control still turns the same way after a drag.
+  const Eigen::Vector3d p(pivot[0], pivot[1], pivot[2]);
+  const Eigen::Vector3d oldA(oldAxis[0], oldAxis[1], oldAxis[2]);
+  Eigen::AngleAxisd aa(R);
+  Eigen::Vector3d axis = aa.axis();
+  double angle = aa.angle() * 180.0 / M_PI;
+  if (std::abs(angle) < 1e-9) {
+    axis = oldA;
+    angle = 0;
+  } else if (axis.dot(oldA) < 0) {
+    axis = -axis;
+    angle = -angle;
+  }
+  const Eigen::Vector3d T = shift + R * p - p;
+  return this->SetPoseGroupTransform(node, group, {axis.x(), axis.y(), axis.z()}, angle, pivot,
+                                     {T.x(), T.y(), T.z()});
+}
+
+vtkMRMLReposePoseNode* vtkSlicerReposeLogic::NewPose(const std::string& name) {
+  this->LastErrorMessage.clear();
+  try {
+    repose::Pose pose;
+    pose.name = name.empty() ? "pose" : name;
+    repose::PoseGroup rest;
+    rest.name = "rest";
+    rest.select.rest = true;
+    rest.fixed = true;
+    pose.groups.push_back(rest);
+    auto node = vtkSmartPointer<vtkMRMLReposePoseNode>::New();
+    node->SetName(pose.name);
+    node->SetPoseJSON(repose::poseToJson(pose));
+    this->Scene->AddNode(node);
+    return node;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return nullptr;
+  }
+}
+
+std::string vtkSlicerReposeLogic::AddPoseGroup(vtkMRMLReposePoseNode* node,
+                                               const std::vector<int>& cageVertices, int bodyPart) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!node) throw repose::Error("no pose");
+    if (node != this->GetLivePose())
+      throw repose::Error("pose " + node->GetName() +
+                          " is not being posed live (build the cage and mesh first)");
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    const std::vector<std::array<double, 3>> rest = this->GetLiveRestCage();
+    std::vector<int> vertices =
+        bodyPart > 0 ? this->GetLiveCageVerticesOfPart(bodyPart) : cageVertices;
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    if (vertices.empty()) throw repose::Error("the selection has no cage vertex");
+    for (int v : vertices)
+      if (v < 0 || std::size_t(v) >= rest.size())
+        throw repose::Error("cage vertex " + std::to_string(v) + " out of range (the cage has " +
+                            std::to_string(rest.size()) + ")");
+    // The new group takes its vertices from the groups that had them: from "the rest" silently,
+    // from a group of listed vertices by removing them (a group left empty goes, with its
+    // keyframe entries). A group that selects by region or body part cannot give some away.
+    const std::set<int> taken(vertices.begin(), vertices.end());
+    std::vector<std::string> emptied;
+    for (std::size_t g = 0; g < pose.groups.size(); ++g) {
+      repose::PoseGroup& group = pose.groups[g];
+      if (group.select.rest) continue;
+      const std::vector<int> owned = this->GetLiveGroupVertices(group.name);
+      const bool overlaps =
+          std::any_of(owned.begin(), owned.end(), [&](int v) { return taken.count(v) > 0; });
+      if (!overlaps) continue;
+      if (group.select.region || !group.select.parts.empty() || !group.select.partNames.empty())
+        throw repose::Error("the selection overlaps group \"" + group.name +
+                            "\", which selects by region or body part; edit that group instead");
+      auto& own = group.select.cageVertices;
+      own.erase(std::remove_if(own.begin(), own.end(), [&](int v) { return taken.count(v) > 0; }),
+                own.end());
+      if (own.empty()) emptied.push_back(group.name);
+    }
+    for (const std::string& name : emptied) {
+      pose.groups.erase(std::find_if(pose.groups.begin(), pose.groups.end(),
+                                     [&](const repose::PoseGroup& g) { return g.name == name; }));
+      for (repose::PoseKeyframe& k : pose.keyframes)
+        k.transforms.erase(std::remove_if(k.transforms.begin(), k.transforms.end(),
+                                          [&](const auto& e) { return e.first == name; }),
+                           k.transforms.end());
+    }
+    repose::PoseGroup group;
+    for (int n = 1; group.name.empty(); ++n) {
+      const std::string candidate = "group " + std::to_string(n);
+      if (std::none_of(pose.groups.begin(), pose.groups.end(),
+                       [&](const repose::PoseGroup& g) { return g.name == candidate; }))
+        group.name = candidate;
+    }
+    if (bodyPart > 0)
+      group.select.parts = {bodyPart};
+    else
+      group.select.cageVertices = vertices;
+    // Pivot: the selection's centre at rest, where a rotation of the handle turns it in place.
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (int v : vertices) centre += Eigen::Vector3d(rest[v][0], rest[v][1], rest[v][2]);
+    group.transform.pivot = centre / double(vertices.size());
+    group.transform.axis = Eigen::Vector3d::UnitX();
+    pose.groups.push_back(group);
+    this->RecordPoseEdit(node, repose::poseToJson(pose));
+    return group.name;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return "";
+  }
+}
+
+bool vtkSlicerReposeLogic::CanUndo() const {
+  return !this->UndoStack.empty();
+}
+bool vtkSlicerReposeLogic::CanRedo() const {
+  return !this->RedoStack.empty();
+}
+
+bool vtkSlicerReposeLogic::Undo() {
+  if (this->UndoStack.empty()) return false;
+  const PoseEdit edit = this->UndoStack.back();
+  this->UndoStack.pop_back();
+  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(edit.nodeID)))
+    node->SetPoseJSON(edit.before);
+  this->RedoStack.push_back(edit);
+  return true;
+}
+
+bool vtkSlicerReposeLogic::Redo() {
+  if (this->RedoStack.empty()) return false;
+  const PoseEdit edit = this->RedoStack.back();
+  this->RedoStack.pop_back();
+  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(edit.nodeID)))
+    node->SetPoseJSON(edit.after);
+  this->UndoStack.push_back(edit);
+  return true;
+}
