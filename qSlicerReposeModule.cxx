@@ -71,11 +71,21 @@ QWidget* qSlicerReposeModule::createWidgetRepresentation(QWidget* parent) {
   auto* widget = new qSlicerReposeModuleWidget(parent);
   widget->setLogic(this->Logic);
   widget->setParameterNode(this->ParameterNode);
+  this->Panel = widget;
   return widget;
 }
 
 QStringList qSlicerReposeModule::fileFilters() const {
-  return qSlicerReposeModuleWidget::inputFileFilters();
+  return qSlicerReposeModuleWidget::inputFileFilters() << "Pose files (*.pose.json)";
+}
+
+bool qSlicerReposeModule::exportResults(const QString& folder, QString* errorMessage) {
+  this->setup();
+  this->ParameterNode->SetOutputFolder(folder.toStdString());
+  const bool ok = this->Panel && this->Panel->exportPose();
+  if (!ok && errorMessage)
+    *errorMessage = this->Panel ? this->Panel->jobStatusText() : QString("the module has no panel");
+  return ok;
 }
 
 bool qSlicerReposeModule::openFile(const QString& path, QString* errorMessage) {
@@ -83,6 +93,13 @@ bool qSlicerReposeModule::openFile(const QString& path, QString* errorMessage) {
   const QString clean = QDir::cleanPath(path);
   if (QFileInfo(clean).isDir() && QFileInfo(clean + "/scene.json").exists())
     return this->openScene(clean, errorMessage);
+  if (clean.endsWith(".pose.json")) {  // a pose: loaded into a pose node, made the active one
+    const bool ok = this->Panel && this->Panel->setPosePath(clean);
+    if (!ok && errorMessage)
+      *errorMessage = this->Panel ? QString::fromStdString(this->Logic->GetLastErrorMessage())
+                                  : QString("the module has no panel to open a pose in");
+    return ok;
+  }
   // The logic writes the path to the parameter node, so every panel showing it updates.
   const bool ok = this->Logic->LoadVolume(clean.toStdString());
   if (!ok && errorMessage)

@@ -7,8 +7,10 @@
 #include <vtkSmartPointer.h>
 
 #include <QObject>
+#include <QPointer>
 
 class vtkMRMLReposeParametersNode;
+class qSlicerReposeModuleWidget;
 class vtkSlicerReposeLogic;
 
 class qSlicerReposeModule : public QObject, public qSlicerAbstractReposeModule {
@@ -35,6 +37,7 @@ class qSlicerReposeModule : public QObject, public qSlicerAbstractReposeModule {
   QWidget* createViewRepresentation(QWidget* parent) override;
   bool saveScene(const QString& folder, QString* errorMessage) override;
   bool isBusy() const override;
+  bool exportResults(const QString& folder, QString* errorMessage) override;
 
   vtkSlicerReposeLogic* logic() const;
   vtkMRMLReposeParametersNode* parameterNode() const;
@@ -43,4 +46,5 @@ class qSlicerReposeModule : public QObject, public qSlicerAbstractReposeModule {
   bool openScene(const QString& folder, QString* errorMessage);
   vtkSmartPointer<vtkSlicerReposeLogic> Logic;
   vtkSmartPointer<vtkMRMLReposeParametersNode> ParameterNode;
+  QPointer<qSlicerReposeModuleWidget> Panel;  // the last panel made: File actions go through it
 };

@@ -79,11 +79,24 @@ qReposeMainWindow::qReposeMainWindow(qReposeModuleDiscovery* discovery, QWidget*
   QAction* openAction = fileMenu->addAction("&Open...");
   openAction->setShortcut(QKeySequence::Open);
   connect(openAction, &QAction::triggered, this, &qReposeMainWindow::onOpenTriggered);
+  QAction* openDicomAction = fileMenu->addAction("Open &DICOM Folder...");
+  connect(openDicomAction, &QAction::triggered, this, [this] {
+    const QString folder = QFileDialog::getExistingDirectory(this, "Open a DICOM series folder");
+    if (!folder.isEmpty()) this->openFile(folder);
+  });
   QAction* openSceneAction = fileMenu->addAction("Open &Scene Folder...");
   connect(openSceneAction, &QAction::triggered, this, &qReposeMainWindow::onOpenSceneTriggered);
   QAction* saveSceneAction = fileMenu->addAction("Save Scene &As...");
   saveSceneAction->setShortcut(QKeySequence::SaveAs);
   connect(saveSceneAction, &QAction::triggered, this, &qReposeMainWindow::onSaveSceneTriggered);
+  fileMenu->addSeparator();
+  QAction* exportAction = fileMenu->addAction("&Export Posed Volumes...");
+  exportAction->setObjectName("ExportAction");
+  connect(exportAction, &QAction::triggered, this, [this] {
+    const QString folder = QFileDialog::getExistingDirectory(
+        this, "Export the posed volumes and the transform into a folder");
+    if (!folder.isEmpty()) this->exportResults(folder);
+  });
   fileMenu->addSeparator();
   QAction* quitAction = fileMenu->addAction("&Quit");
   quitAction->setShortcut(QKeySequence::Quit);
@@ -152,6 +165,18 @@ bool qReposeMainWindow::saveScene(const QString& folder) {
   const bool ok = m ? m->module->saveScene(folder, &error) : false;
   if (!m) error = "no module is loaded to save a scene";
   const QString message = ok ? "Saved the scene to " + folder : "Error: " + error;
+  this->logMessage(message);
+  this->statusBar()->showMessage(message, 10000);
+  return ok;
+}
+
+bool qReposeMainWindow::exportResults(const QString& folder) {
+  const qReposeModuleDiscovery::Module* m = this->Discovery->findModule(this->currentModuleName());
+  QString error;
+  const bool ok = m ? m->module->exportResults(folder, &error) : false;
+  if (!m) error = "no module is loaded to export from";
+  const QString message =
+      ok ? "Exporting to " + folder + " (progress in the module panel)" : "Error: " + error;
   this->logMessage(message);
   this->statusBar()->showMessage(message, 10000);
   return ok;

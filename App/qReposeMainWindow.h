@@ -24,6 +24,8 @@ class qReposeMainWindow : public QMainWindow {
   // goes to the log and the status bar.
   bool openFile(const QString& path);
   bool saveScene(const QString& folder);
+  // File > Export: the current module's results into `folder` (started in the background).
+  bool exportResults(const QString& folder);
   // Lets the current module's background work finish (processing events), at most `seconds`.
   // False if it was still busy then.
   bool waitWhileBusy(double seconds);

@@ -39,7 +39,11 @@ class qSlicerAbstractReposeModule {
   virtual bool saveScene(const QString& folder, QString* errorMessage) = 0;
   // True while the module runs background work (the host waits for it before a screenshot).
   virtual bool isBusy() const = 0;
+  // File > Export: the module's results written to a folder (for Repose, the posed volumes and
+  // the transform), in the background with the panel's progress bar and Cancel. False with a
+  // message when it cannot start.
+  virtual bool exportResults(const QString& folder, QString* errorMessage) = 0;
 };
 
-#define qSlicerAbstractReposeModule_iid "org.repose.qSlicerAbstractReposeModule/1.1"
+#define qSlicerAbstractReposeModule_iid "org.repose.qSlicerAbstractReposeModule/1.2"
 Q_DECLARE_INTERFACE(qSlicerAbstractReposeModule, qSlicerAbstractReposeModule_iid)

@@ -65,9 +65,13 @@ int runPhantom(const Args& args) {
   parser.option("out", "DIR", "output folder (created if missing; its parent must exist)")
       .option("voxel", "MM", "isotropic voxel size in mm (1 mm gives ~160M voxels)", "2")
       .flag("arms-touching", "hands pressed against the hips (the limb-separation case)")
+      .flag("image",
+            "also a CT-like image <P>CT.<ext> (int16 HU per tissue, small fixed noise) to pose "
+            "alongside G and show under the labels")
       .option("margin", "MM", "empty border around the body in mm", "10")
       .option("format", "EXT", "nii.gz or nii", "nii.gz")
-      .option("prefix", "P", "file name prefix: <P>G.<ext>, <P>S.<ext>, <P>skeleton.json")
+      .option("prefix", "P",
+              "file name prefix: <P>G.<ext>, <P>S.<ext>, <P>skeleton.json, <P>CT.<ext>")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("json", "print a JSON summary on stdout");
   if (!parser.parse(args)) return 0;
@@ -96,7 +100,8 @@ int runPhantom(const Args& args) {
 
   const Phantom phantom(options);
   const VolumeGeometry& g = phantom.geometry();
-  const double rawBytes = 2.0 * g.numVoxels();
+  const bool image = parser.has("image");
+  const double rawBytes = (image ? 4.0 : 2.0) * g.numVoxels();
   // Label maps of smooth shapes gzip about 40:1; the estimate only has to be the right size.
   const double estimate = format == "nii" ? rawBytes : rawBytes / 40;
   prepareOutputFolder(out);
@@ -112,25 +117,30 @@ int runPhantom(const Args& args) {
               << out << std::endl;
 
   const auto start = std::chrono::steady_clock::now();
-  const PhantomFiles files = writePhantom(phantom, out, "." + format, terminalProgress(), prefix);
+  const PhantomFiles files =
+      writePhantom(phantom, out, "." + format, terminalProgress(), prefix, image);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::uintmax_t written = 0;
-  for (const auto& f : {files.organs, files.parts, files.skeleton}) written += fs::file_size(f, ec);
+  for (const auto& f : {files.organs, files.parts, files.skeleton, files.image})
+    if (!f.empty()) written += fs::file_size(f, ec);
 
   if (json) {
     const Eigen::Vector3d o = g.origin();
-    nlohmann::json doc = {
-        {"files", {{"organs", files.organs}, {"parts", files.parts}, {"skeleton", files.skeleton}}},
-        {"dims", g.dims},
-        {"voxelMm", options.voxelMm},
-        {"originRas", {o.x(), o.y(), o.z()}},
-        {"numVoxels", g.numVoxels()},
-        {"armsTouching", options.armsTouching},
-        {"bytesWritten", written},
-        {"seconds", seconds},
-        {"organLabels", labelsJson(phantom.organLabels())},
-        {"partLabels", labelsJson(phantom.partLabels())}};
+    nlohmann::json doc = {{"files",
+                           {{"organs", files.organs},
+                            {"parts", files.parts},
+                            {"skeleton", files.skeleton},
+                            {"image", files.image}}},
+                          {"dims", g.dims},
+                          {"voxelMm", options.voxelMm},
+                          {"originRas", {o.x(), o.y(), o.z()}},
+                          {"numVoxels", g.numVoxels()},
+                          {"armsTouching", options.armsTouching},
+                          {"bytesWritten", written},
+                          {"seconds", seconds},
+                          {"organLabels", labelsJson(phantom.organLabels())},
+                          {"partLabels", labelsJson(phantom.partLabels())}};
     std::cout << doc.dump(2) << "\n";
   } else {
     std::cout << "wrote " << files.organs << "\n      " << files.parts << "\n      "

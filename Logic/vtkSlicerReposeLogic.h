@@ -20,6 +20,10 @@
 #include <string>
 #include <vector>
 
+namespace repose {
+struct RigSettings;
+class Volume;
+}  // namespace repose
 class vtkMRMLReposeCageNode;
 class vtkMRMLReposeNode;
 class vtkMRMLReposePoseNode;
@@ -85,6 +89,17 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // referring to its source and pose; with an output folder also posed_G.nii.gz, posed_S.nii.gz
   // (posed_image.nii.gz), transform.nrrd and report.json written there.
   bool StartApplyPose(vtkMRMLReposePoseNode* pose, const std::string& outputFolder = "");
+  // The live pose's transfer mesh refined for its current frame (seed §4.2: smaller tets where the
+  // Green deformation distorts most), with the rig's whole pieces and separations: a new
+  // transfer-mesh node the pose then refers to (the old one stays in the scene). Start live
+  // posing again afterwards to use it.
+  // `iterations`: rounds of mesh, measure, shrink (each finer where the error is above the mean).
+  bool StartRefineMesh(vtkMRMLReposePoseNode* pose, int iterations = 3);
+  // One line on the last refinement: rounds, vertices before and after, maximum error (e^G).
+  const std::string& GetLastRefinementSummary() const { return this->LastRefinementSummary; }
+  // Per round of the last refinement: its mesh's vertices and maximum error e^G.
+  const std::vector<int>& GetLastRefinementVertices() const { return this->RefinementVertices; }
+  const std::vector<double>& GetLastRefinementMaxErrors() const { return this->RefinementErrors; }
   bool IsJobRunning() const;
   double GetJobProgress() const;
   std::string GetJobStage() const;
@@ -128,6 +143,11 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // itself for the new groups (a job).
   std::string AddPoseGroup(vtkMRMLReposePoseNode* pose, const std::vector<int>& cageVertices,
                            int bodyPart = 0);
+  // A limb separation added to the pose, undoable: parts by name or label of S, the region as
+  // "box:x0,y0,z0,x1,y1,z1" or "sphere:x,y,z,r" (RAS mm). The rig built next makes it (an inset
+  // cage between the parts, the transfer mesh cut along their border). False with a message.
+  bool AddPoseSeparation(vtkMRMLReposePoseNode* pose, const std::string& partA,
+                         const std::string& partB, const std::string& region);
   // A drag: the edits between Begin and End are one undo step (each still re-solves live).
   void BeginPoseInteraction();
   void EndPoseInteraction();
@@ -178,6 +198,14 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // (optional) receives the rasterization time.
   vtkSmartPointer<vtkImageData> ComputeLiveSlice(int orientation, double positionMm, int pixels,
                                                  double* milliseconds = nullptr);
+  // The segmentation's image (CT, MR) on the same plane and grid as ComputeLiveSlice, posed the
+  // same way (trilinear at the rest position; the image's minimum where no tissue is). Null when
+  // the segmentation has no image or there is no live pose.
+  vtkSmartPointer<vtkImageData> ComputeLiveImageSlice(int orientation, double positionMm,
+                                                      int pixels);
+  // A grey window for that image: a soft-tissue CT window (W 400, L 40) for a CT in Hounsfield
+  // units, else the 1st..99th percentile of the image's voxels. False without a live image.
+  bool GetLiveImageWindow(double& window, double& level) const;
 
  protected:
   vtkSlicerReposeLogic();
@@ -185,6 +213,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   void OnParameterNodeModified();
   void OnLivePoseModified();
   void ReleaseLivePose();  // StopLivePose without the ModifiedEvent
+  repose::RigSettings RigSettingsFor(const repose::Volume& G) const;
   // Pushes an undo step (or extends the current drag's) and sets the pose node's JSON.
   void RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after);
 
@@ -204,6 +233,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
 
   vtkSmartPointer<vtkMRMLReposeScene> Scene;
   std::string TissueTablePath;
+  std::string LastRefinementSummary;
+  std::vector<int> RefinementVertices;
+  std::vector<double> RefinementErrors;
   std::unique_ptr<vtkSlicerReposeJob> Job;
   vtkSmartPointer<vtkMRMLReposeSegmentationNode> LastPosedSegmentation;
   struct PoseEdit {

@@ -30,6 +30,8 @@ struct vtkSlicerReposeLogic::LiveSession {
   vtkSmartPointer<vtkMRMLReposePoseNode> Pose;
   unsigned long PoseObserverTag = 0;
   std::shared_ptr<const repose::Volume> Labels;  // G
+  std::shared_ptr<const repose::Volume> Image;   // the segmentation's image, if any
+  double ImageBackground = 0, ImageWindow = 0, ImageLevel = 0;
   std::shared_ptr<const repose::PoseRig> Rig;
   repose::LabelTable PartLabels;  // S's, for groups selecting parts
   std::vector<std::uint8_t> OuterFaces;
@@ -62,6 +64,30 @@ vtkSmartPointer<vtkPolyData> bodySurface(const repose::TransferMesh& mesh,
   return poly;
 }
 
+// The image's background (its minimum) and a grey window: CT's soft-tissue window when the
+// values are Hounsfield units (air near -1000), else the 1st..99th percentile of a sample.
+void imageWindow(const repose::Volume& image, double& background, double& window, double& level) {
+  std::vector<double> sample;
+  const std::int64_t n = image.numVoxels();
+  const std::int64_t stride = std::max<std::int64_t>(1, n / 200000);
+  repose::dispatchScalar(image.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const T* v = image.data<T>();
+    for (std::int64_t i = 0; i < n; i += stride) sample.push_back(double(v[i]));
+  });
+  if (sample.empty()) return;
+  std::sort(sample.begin(), sample.end());
+  background = sample.front();
+  const double lo = sample[sample.size() / 100], hi = sample[sample.size() * 99 / 100];
+  if (background <= -900 && background >= -1100 && hi > 0) {
+    window = 400;
+    level = 40;
+  } else {
+    window = std::max(hi - lo, 1e-6);
+    level = (hi + lo) / 2;
+  }
+}
+
 void setPoints(vtkPolyData* poly, const Eigen::MatrixX3d& positions) {
   vtkPoints* points = poly->GetPoints();
   points->SetNumberOfPoints(positions.rows());
@@ -83,6 +109,10 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
         Conversion::FromImageData(nodes.Segmentation->GetLabelMap()));
     const repose::LabelTable partLabels =
         vtkSlicerReposeLogicInputs::BodyPartLabels(nodes.Segmentation);
+    std::shared_ptr<const repose::Volume> image;
+    if (nodes.Segmentation->GetImage())
+      image = std::make_shared<const repose::Volume>(
+          Conversion::FromImageData(nodes.Segmentation->GetImage()));
     repose::RigGeometry geometry{
         vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()),
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(nodes.TransferMesh->GetMesh())};
@@ -95,6 +125,11 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           repose::reportProgress(progress, 0, "embedding");
           auto session = std::make_shared<LiveSession>();
           session->Labels = G;
+          if (image) {
+            session->Image = image;
+            imageWindow(*image, session->ImageBackground, session->ImageWindow,
+                        session->ImageLevel);
+          }
           session->Rig =
               std::make_shared<const repose::PoseRig>(std::move(geometry), pose, partLabels);
           session->PartLabels = partLabels;
@@ -252,6 +287,23 @@ std::array<double, 6> vtkSlicerReposeLogic::GetLiveBounds() const {
   return {l.Lo.x(), l.Hi.x(), l.Lo.y(), l.Hi.y(), l.Lo.z(), l.Hi.z()};
 }
 
+namespace {
+// The plane through the live box: square pixels, `pixels` across the box's larger in-plane side
+// and only as many as the box needs across the other.
+repose::VolumeGeometry liveSliceGrid(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                     int orientation, double positionMm, int pixels) {
+  repose::VolumeGeometry grid = repose::slicePlaneGrid(
+      static_cast<repose::SliceOrientation>(orientation), positionMm, lo, hi, pixels);
+  const int u = orientation == 2 ? 1 : 0, v = orientation == 0 ? 1 : 2;
+  const double pixel = grid.ijkToRas.block<3, 1>(0, 0).norm();
+  grid.dims[0] =
+      std::clamp<std::int64_t>(std::int64_t(std::ceil((hi[u] - lo[u]) / pixel)), 1, pixels);
+  grid.dims[1] =
+      std::clamp<std::int64_t>(std::int64_t(std::ceil((hi[v] - lo[v]) / pixel)), 1, pixels);
+  return grid;
+}
+}  // namespace
+
 vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orientation,
                                                                      double positionMm, int pixels,
                                                                      double* milliseconds) {
@@ -260,15 +312,8 @@ vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orienta
     return nullptr;
   const LiveSession& live = *this->Live;
   const auto start = std::chrono::steady_clock::now();
-  repose::VolumeGeometry grid = repose::slicePlaneGrid(
-      static_cast<repose::SliceOrientation>(orientation), positionMm, live.Lo, live.Hi, pixels);
-  // Square pixels across the larger side; the smaller side only as long as the box.
-  const int u = orientation == 2 ? 1 : 0, v = orientation == 0 ? 1 : 2;
-  const double pixel = grid.ijkToRas.block<3, 1>(0, 0).norm();
-  grid.dims[0] = std::clamp<std::int64_t>(
-      std::int64_t(std::ceil((live.Hi[u] - live.Lo[u]) / pixel)), 1, pixels);
-  grid.dims[1] = std::clamp<std::int64_t>(
-      std::int64_t(std::ceil((live.Hi[v] - live.Lo[v]) / pixel)), 1, pixels);
+  const repose::VolumeGeometry grid =
+      liveSliceGrid(live.Lo, live.Hi, orientation, positionMm, pixels);
   repose::RasterOptions options;
   options.outerFaces = &live.OuterFaces;
   const repose::Volume slice =
@@ -277,4 +322,26 @@ vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orienta
     *milliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return Conversion::ToImageData(slice);
+}
+
+vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveImageSlice(int orientation,
+                                                                          double positionMm,
+                                                                          int pixels) {
+  if (!this->Live || !this->Live->Image || this->Live->Deformed.rows() == 0 || orientation < 0 ||
+      orientation > 2 || pixels < 2)
+    return nullptr;
+  const LiveSession& live = *this->Live;
+  repose::RasterOptions options;
+  options.outerFaces = &live.OuterFaces;
+  return Conversion::ToImageData(
+      repose::rasterizeImage(*live.Image, live.Rig->mesh(), live.Deformed,
+                             liveSliceGrid(live.Lo, live.Hi, orientation, positionMm, pixels),
+                             live.ImageBackground, options));
+}
+
+bool vtkSlicerReposeLogic::GetLiveImageWindow(double& window, double& level) const {
+  if (!this->Live || !this->Live->Image) return false;
+  window = this->Live->ImageWindow;
+  level = this->Live->ImageLevel;
+  return true;
 }

@@ -28,6 +28,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <optional>
 #include <sstream>
 
@@ -175,16 +176,7 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::vector<repose::LimbSeparation> separations =
         repose::resolveSeparations(pose, parts->labels());
-    repose::RigSettings settings;
-    if (this->ParameterNode) {
-      settings.cageVertices = this->ParameterNode->GetCageVertexCount();
-      settings.dilateMm = this->ParameterNode->GetCageDilationMm();
-      settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
-    }
-    // Bones (the tissue table's rigid labels) and organs move as whole pieces, as in `repose pose`.
-    if (const auto tissues = tissuesFor(this->TissueTablePath, *G))
-      for (const auto& [label, tissue] : *tissues)
-        if (tissue.rigid) settings.rigidLabels.push_back(label);
+    const repose::RigSettings settings = this->RigSettingsFor(*G);
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start("rig", [=](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
@@ -218,6 +210,83 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
         poseRef->EndModify(state);
       };
     });
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
+repose::RigSettings vtkSlicerReposeLogic::RigSettingsFor(const repose::Volume& G) const {
+  repose::RigSettings settings;
+  if (this->ParameterNode) {
+    settings.cageVertices = this->ParameterNode->GetCageVertexCount();
+    settings.dilateMm = this->ParameterNode->GetCageDilationMm();
+    settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
+  }
+  // Bones (the tissue table's rigid labels) and organs move as whole pieces, as in `repose pose`.
+  if (const auto tissues = tissuesFor(this->TissueTablePath, G))
+    for (const auto& [label, tissue] : *tissues)
+      if (tissue.rigid) settings.rigidLabels.push_back(label);
+  return settings;
+}
+
+bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int iterations) {
+  this->LastErrorMessage.clear();
+  try {
+    if (this->Job->IsRunning()) throw repose::Error("another job is running");
+    const auto nodes = vtkSlicerReposeLogicInputs::Resolve(this->Scene, poseNode);
+    vtkPolyData* posed = this->GetLiveCage();
+    if (poseNode != this->GetLivePose() || !posed)
+      throw repose::Error("pose " + poseNode->GetName() +
+                          " is not being posed live: the refinement adapts to its current frame");
+    auto parts = std::make_shared<repose::Volume>(partsOf(nodes.Segmentation));
+    auto G = std::make_shared<repose::Volume>(
+        Conversion::FromImageData(nodes.Segmentation->GetLabelMap()));
+    const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    const auto separations = repose::resolveSeparations(pose, parts->labels());
+    const repose::RigSettings settings = this->RigSettingsFor(*G);
+    auto cage = std::make_shared<repose::TriangleMesh>(
+        vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()));
+    Eigen::MatrixX3d posedCage(posed->GetNumberOfPoints(), 3);
+    for (vtkIdType v = 0; v < posed->GetNumberOfPoints(); ++v) {
+      double p[3];
+      posed->GetPoint(v, p);
+      posedCage.row(v) << p[0], p[1], p[2];
+    }
+    const int before = int(nodes.TransferMesh->GetMesh()->GetNumberOfPoints());
+    vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
+    vtkSmartPointer<vtkMRMLReposeTransferMeshNode> oldMesh = nodes.TransferMesh;
+    this->Job->Start("refine",
+                     [=](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
+                       auto steps = std::make_shared<std::vector<repose::RefinementStep>>();
+                       auto mesh = std::make_shared<repose::TransferMesh>(
+                           repose::refineRigMesh(*parts, *cage, posedCage, separations, settings,
+                                                 iterations, progress, G.get(), steps.get()));
+                       return [=] {
+                         auto node = vtkSmartPointer<vtkMRMLReposeTransferMeshNode>::New();
+                         node->SetName(oldMesh->GetName() + " refined for " + poseRef->GetName());
+                         node->SetMesh(vtkSlicerReposeMeshConversion::ToUnstructuredGrid(*mesh));
+                         node->SetSizeMm(settings.meshMm);
+                         for (const auto& [role, id] : oldMesh->GetNodeReferences())
+                           node->SetNodeReferenceID(role, id);
+                         this->Scene->AddNode(node);
+                         poseRef->SetNodeReferenceID("transfer_mesh", node->GetID());
+                         std::ostringstream summary;
+                         summary << "refined in " << steps->size() << " rounds: " << before
+                                 << " -> " << mesh->vertices.rows() << " vertices";
+                         if (!steps->empty())
+                           summary << ", maximum error " << std::setprecision(3)
+                                   << steps->front().maxError << " -> " << steps->back().maxError;
+                         this->LastRefinementSummary = summary.str();
+        this->RefinementVertices.clear();
+        this->RefinementErrors.clear();
+        for (const repose::RefinementStep& step : *steps) {
+          this->RefinementVertices.push_back(step.vertices);
+          this->RefinementErrors.push_back(step.maxError);
+        }
+                       };
+                     });
     return true;
   } catch (const std::exception& e) {
     this->LastErrorMessage = e.what();

@@ -284,6 +284,33 @@ std::string vtkSlicerReposeLogic::AddPoseGroup(vtkMRMLReposePoseNode* node,
   }
 }
 
+bool vtkSlicerReposeLogic::AddPoseSeparation(vtkMRMLReposePoseNode* node, const std::string& partA,
+                                             const std::string& partB, const std::string& region) {
+  this->LastErrorMessage.clear();
+  try {
+    if (!node) throw repose::Error("no pose");
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    repose::PoseSeparation separation;
+    const std::string names[2] = {partA, partB};
+    for (int k = 0; k < 2; ++k) {
+      const std::string& n = names[k];
+      if (n.empty()) throw repose::Error("a separation needs two body parts");
+      if (n.find_first_not_of("0123456789") == std::string::npos)
+        separation.parts[std::size_t(k)] = std::stoi(n);
+      else
+        separation.partNames[std::size_t(k)] = n;
+    }
+    if (names[0] == names[1]) throw repose::Error("a part cannot be separated from itself");
+    separation.region = repose::Region::parse(region);
+    pose.separations.push_back(separation);
+    this->RecordPoseEdit(node, repose::poseToJson(pose));
+    return true;
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    return false;
+  }
+}
+
 bool vtkSlicerReposeLogic::CanUndo() const {
   return !this->UndoStack.empty();
 }

@@ -30,6 +30,7 @@ void vtkMRMLReposeParametersNode::ForEachField(F&& f) {
   f("ActivePoseNodeID", &Self::ActivePoseNodeID, &Self::SetActivePoseNodeID);
   f("ActiveGroup", &Self::ActiveGroup, &Self::SetActiveGroup);
   f("SelectedCageVertices", &Self::SelectedCageVertices, &Self::SetSelectedCageVertices);
+  f("SelectedBodyPart", &Self::SelectedBodyPart, &Self::SetSelectedBodyPart);
   f("LabelOpacity", &Self::LabelOpacity, &Self::SetLabelOpacity);
 }
 
@@ -79,6 +80,11 @@ void vtkMRMLReposeParametersNode::SetSelectedCageVertices(const std::vector<int>
   if (v == this->SelectedCageVertices) return;
   this->SelectedCageVertices = std::move(v);
   this->Modified();
+}
+
+void vtkMRMLReposeParametersNode::SetSelectedBodyPart(int label) {
+  if (clampAssign(this->SelectedBodyPart, label, 0, std::numeric_limits<int>::max()))
+    this->Modified();
 }
 
 void vtkMRMLReposeParametersNode::SetLabelOpacity(double opacity) {

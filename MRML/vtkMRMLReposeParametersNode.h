@@ -74,6 +74,10 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   // what "New group from selection" makes a handle group of.
   void SetSelectedCageVertices(const std::vector<int>& vertices);
   const std::vector<int>& GetSelectedCageVertices() const { return this->SelectedCageVertices; }
+  // The body part (label of S) the selection was made from, 0 when it was picked vertex by
+  // vertex: a group made from it selects the part, and so carries the part's tissue too.
+  void SetSelectedBodyPart(int label);
+  int GetSelectedBodyPart() const { return this->SelectedBodyPart; }
   // Opacity of the labels over the image in the slice views, clamped to [0, 1].
   void SetLabelOpacity(double opacity);
   double GetLabelOpacity() const { return this->LabelOpacity; }
@@ -100,6 +104,7 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   std::string ActivePoseNodeID;
   std::string ActiveGroup;
   std::vector<int> SelectedCageVertices;
+  int SelectedBodyPart = 0;
   double LabelOpacity = 0.8;
 
  private:

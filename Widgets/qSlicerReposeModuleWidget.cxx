@@ -8,11 +8,13 @@
 #include "vtkMRMLReposePoseNode.h"
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
 
 #include <repose/pose/Pose.h>
 
 #include <vtkCommand.h>
+#include <vtkUnstructuredGrid.h>
 #include <vtkSmartPointer.h>
 
 #include <QApplication>
@@ -25,26 +27,7 @@
 #include <cmath>
 #include <optional>
 
-namespace {
-
-// The transform a group has in a keyframe (its base transform where the keyframe does not name
-// it), as the pose's frames() uses.
-std::optional<repose::PoseTransform> groupTransform(const repose::Pose& pose,
-                                                    const std::string& group, int keyframe) {
-  for (const repose::PoseGroup& g : pose.groups) {
-    if (g.name != group || g.fixed) continue;
-    if (!pose.keyframes.empty()) {
-      const auto& k =
-          pose.keyframes[std::size_t(std::clamp<int>(keyframe, 0, int(pose.keyframes.size()) - 1))];
-      for (const auto& [name, t] : k.transforms)
-        if (name == group) return t;
-    }
-    return g.transform;
-  }
-  return std::nullopt;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
  public:
@@ -53,7 +36,7 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   unsigned long LogicObserverTag = 0;
   unsigned long NodeObserverTag = 0;
   QTimer JobTimer;
-  enum class Step { None, Rig, Live, Export } RunningStep = Step::None;
+  enum class Step { None, Rig, Refine, Live, Export } RunningStep = Step::None;
   QString JobStatus = "Idle.";
   bool Updating = false;
 };
@@ -135,6 +118,18 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   connect(d->RedoButton, &QToolButton::clicked, this, [d] {
     if (d->Logic) d->Logic->Redo();
   });
+  connect(d->AddSeparationButton, &QPushButton::clicked, this, [this, d] {
+    this->addSeparation(d->SeparatePartACombo->currentText(), d->SeparatePartBCombo->currentText(),
+                        d->SeparationRegionLineEdit->text());
+  });
+  connect(d->RefineMeshButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::refineMesh);
+  connect(d->NewPoseButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::newPose);
+  connect(d->ClearSelectionButton, &QToolButton::clicked, this,
+          &qSlicerReposeModuleWidget::clearSelection);
+  connect(d->SelectPartButton, &QToolButton::clicked, this,
+          [this, d] { this->selectBodyPart(d->PartComboBox->currentData().toInt()); });
+  connect(d->NewGroupButton, &QPushButton::clicked, this,
+          &qSlicerReposeModuleWidget::newGroupFromSelection);
   connect(d->BuildRigButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::buildRig);
   connect(d->ExportButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::exportPose);
   connect(d->CancelButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::cancelJob);
@@ -231,7 +226,11 @@ bool qSlicerReposeModuleWidget::buildRig() {
   };
   if (d->ParameterNode->GetInputSegmentationPath().empty())
     return fail("choose a segmentation first");
-  if (!pose) return fail("load a pose file first (its groups and separations shape the rig)");
+  if (!pose) {  // no pose file: a new pose, everything fixed until groups are made in the views
+    this->newPose();
+    pose = this->activePose();
+    if (!pose) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
+  }
   // The segmentation node of the current paths (made again when a path changed).
   auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
       d->Logic->GetScene()->GetNodeByID(d->ParameterNode->GetInputSegmentationNodeID()));
@@ -308,11 +307,16 @@ void qSlicerReposeModuleWidget::onJobTimer() {
   const Step finished = d->RunningStep;
   d->RunningStep = Step::None;
   d->JobTimer.stop();
-  if (status == vtkSlicerReposeLogic::JobSucceeded && finished == Step::Rig) {
+  if (status == vtkSlicerReposeLogic::JobSucceeded &&
+      (finished == Step::Rig || finished == Step::Refine)) {
     // The rig is there: prepare live posing at once, so the views follow the pose.
     if (d->Logic->StartLivePose(this->activePose())) {
       d->RunningStep = Step::Live;
-      d->JobStatus = "Preparing live posing...";
+      d->JobStatus = finished == Step::Refine
+                         ? "Transfer mesh " +
+                               QString::fromStdString(d->Logic->GetLastRefinementSummary()) +
+                               "; preparing live posing..."
+                         : QString("Preparing live posing...");
       d->JobTimer.start();
     } else {
       d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
@@ -334,22 +338,118 @@ bool qSlicerReposeModuleWidget::setActiveGroupAngle(double angleDeg) {
   Q_D(qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!pose || !d->Logic) return false;
-  const repose::Pose p = repose::parsePose(pose->GetPoseJSON(), pose->GetName());
-  const auto t = groupTransform(p, d->ParameterNode->GetActiveGroup(), pose->GetCurrentFrame());
-  if (!t) return false;
-  return d->Logic->SetPoseGroupTransform(
-      pose, d->ParameterNode->GetActiveGroup(), {t->axis.x(), t->axis.y(), t->axis.z()}, angleDeg,
-      {t->pivot.x(), t->pivot.y(), t->pivot.z()},
-      {t->translation.x(), t->translation.y(), t->translation.z()});
+  std::array<double, 3> axis, pivot, translation;
+  double angle = 0;
+  const std::string group = d->ParameterNode->GetActiveGroup();
+  if (!d->Logic->GetPoseGroupTransform(pose, group, axis, angle, pivot, translation)) return false;
+  return d->Logic->SetPoseGroupTransform(pose, group, axis, angleDeg, pivot, translation);
 }
 
 double qSlicerReposeModuleWidget::activeGroupAngle() const {
   Q_D(const qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
-  if (!pose || !d->ParameterNode) return 0;
-  const auto t = groupTransform(repose::parsePose(pose->GetPoseJSON(), pose->GetName()),
-                                d->ParameterNode->GetActiveGroup(), pose->GetCurrentFrame());
-  return t ? t->angleDeg : 0;
+  if (!pose || !d->ParameterNode || !d->Logic) return 0;
+  std::array<double, 3> axis, pivot, translation;
+  double angle = 0;
+  return d->Logic->GetPoseGroupTransform(pose, d->ParameterNode->GetActiveGroup(), axis, angle,
+                                         pivot, translation)
+             ? angle
+             : 0;
+}
+
+bool qSlicerReposeModuleWidget::newPose() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return false;
+  vtkMRMLReposePoseNode* previous = this->activePose();
+  vtkMRMLReposePoseNode* pose = d->Logic->NewPose("pose");
+  if (!pose) return false;
+  // The rig of the pose posed so far (segmentation, cage, transfer mesh) serves the new one.
+  if (previous)
+    for (const auto& [role, id] : previous->GetNodeReferences()) pose->SetNodeReferenceID(role, id);
+  const int state = d->ParameterNode->StartModify();
+  d->ParameterNode->SetPosePath("");
+  d->ParameterNode->SetActivePoseNodeID(pose->GetID());
+  d->ParameterNode->SetActiveGroup("");
+  d->ParameterNode->SetSelectedCageVertices({});
+  d->ParameterNode->SetSelectedBodyPart(0);
+  d->ParameterNode->EndModify(state);
+  // A rig already built serves the new pose too (its groups need no separation): go live.
+  if (d->Logic->StartLivePose(pose)) {
+    d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Live;
+    d->JobStatus = "Preparing live posing...";
+    d->JobTimer.start();
+  }
+  this->updateWidgetFromMRML();
+  return true;
+}
+
+int qSlicerReposeModuleWidget::selectBodyPart(int label) {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return 0;
+  const std::vector<int> vertices = d->Logic->GetLiveCageVerticesOfPart(label);
+  const int state = d->ParameterNode->StartModify();
+  d->ParameterNode->SetSelectedCageVertices(vertices);
+  d->ParameterNode->SetSelectedBodyPart(vertices.empty() ? 0 : label);
+  d->ParameterNode->EndModify(state);
+  return int(vertices.size());
+}
+
+void qSlicerReposeModuleWidget::clearSelection() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->ParameterNode) return;
+  const int state = d->ParameterNode->StartModify();
+  d->ParameterNode->SetSelectedCageVertices({});
+  d->ParameterNode->SetSelectedBodyPart(0);
+  d->ParameterNode->EndModify(state);
+}
+
+bool qSlicerReposeModuleWidget::addSeparation(const QString& partA, const QString& partB,
+                                              const QString& region) {
+  Q_D(qSlicerReposeModuleWidget);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  const bool ok =
+      d->Logic && pose &&
+      d->Logic->AddPoseSeparation(pose, partA.trimmed().toStdString(),
+                                  partB.trimmed().toStdString(), region.trimmed().toStdString());
+  d->JobStatus = ok ? QString("Separation added: build the cage and mesh to apply it.")
+                    : "Error: " + (pose ? QString::fromStdString(d->Logic->GetLastErrorMessage())
+                                        : QString("no pose to add the separation to"));
+  this->updateWidgetFromMRML();
+  return ok;
+}
+
+bool qSlicerReposeModuleWidget::refineMesh() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->Logic->StartRefineMesh(this->activePose())) {
+    d->JobStatus = "Error: " + (d->Logic ? QString::fromStdString(d->Logic->GetLastErrorMessage())
+                                         : QString("no logic"));
+    this->updateWidgetFromMRML();
+    return false;
+  }
+  d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Refine;
+  d->JobStatus = "Refining the transfer mesh for this pose...";
+  d->JobTimer.start();
+  this->updateWidgetFromMRML();
+  return true;
+}
+
+QString qSlicerReposeModuleWidget::newGroupFromSelection() {
+  Q_D(qSlicerReposeModuleWidget);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  if (!d->Logic || !d->ParameterNode || !pose) return {};
+  const std::string group = d->Logic->AddPoseGroup(
+      pose, d->ParameterNode->GetSelectedCageVertices(), d->ParameterNode->GetSelectedBodyPart());
+  if (group.empty()) {
+    d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
+    this->updateWidgetFromMRML();
+    return {};
+  }
+  const int state = d->ParameterNode->StartModify();
+  d->ParameterNode->SetActiveGroup(group);
+  d->ParameterNode->SetSelectedCageVertices({});
+  d->ParameterNode->SetSelectedBodyPart(0);
+  d->ParameterNode->EndModify(state);
+  return QString::fromStdString(group);
 }
 
 void qSlicerReposeModuleWidget::onAngleSliderPressed() {
@@ -441,6 +541,61 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   d->UndoButton->setEnabled(d->Logic && d->Logic->CanUndo());
   d->RedoButton->setEnabled(d->Logic && d->Logic->CanRedo());
   const bool live = d->Logic && pose && d->Logic->GetLivePose() == pose;
+  // Selection and body parts (of the live rig's S).
+  const std::size_t selected = node ? node->GetSelectedCageVertices().size() : 0;
+  d->SelectionInfoLabel->setText(
+      selected == 0 ? QString("none (Shift+click or Shift+drag on the cage in the 3D view)")
+      : node->GetSelectedBodyPart() > 0
+          ? QString("%1 cage vertices of part %2").arg(selected).arg(node->GetSelectedBodyPart())
+          : QString("%1 cage vertices").arg(selected));
+  std::vector<std::pair<int, std::string>> parts;
+  if (live) parts = d->Logic->GetLiveBodyParts();
+  if (d->PartComboBox->count() != int(parts.size()) ||
+      (!parts.empty() && d->PartComboBox->itemData(0).toInt() != parts.front().first)) {
+    const QSignalBlocker blocker(d->PartComboBox);
+    d->PartComboBox->clear();
+    for (const auto& [label, name] : parts)
+      d->PartComboBox->addItem(QString("%1 (%2)").arg(QString::fromStdString(name)).arg(label),
+                               label);
+  }
+  // Separation part choices (editable: a name or label can be typed before the rig exists).
+  for (QComboBox* combo : {d->SeparatePartACombo, d->SeparatePartBCombo})
+    if (combo->count() != int(parts.size())) {
+      const QSignalBlocker blocker(combo);
+      const QString typed = combo->currentText();
+      combo->clear();
+      for (const auto& [label, name] : parts) combo->addItem(QString::fromStdString(name));
+      combo->setCurrentText(typed);
+    }
+  QStringList separations;
+  if (pose)
+    for (const repose::PoseSeparation& sep :
+         repose::parsePose(pose->GetPoseJSON(), pose->GetName()).separations) {
+      auto part = [&](int k) {
+        return sep.partNames[std::size_t(k)].empty()
+                   ? QString::number(sep.parts[std::size_t(k)])
+                   : QString::fromStdString(sep.partNames[std::size_t(k)]);
+      };
+      separations << part(0) + " | " + part(1);
+    }
+  d->SeparationsInfoLabel->setText(
+      separations.isEmpty() ? QString("No separation.") : "Separations: " + separations.join(", "));
+  d->AddSeparationButton->setEnabled(pose != nullptr);
+  // The transfer mesh the pose uses.
+  auto* tm = pose ? vtkMRMLReposeTransferMeshNode::SafeDownCast(
+                        d->Logic->GetScene()->GetReferencedNode(pose, "transfer_mesh"))
+                  : nullptr;
+  d->TransferMeshInfoLabel->setText(tm && tm->GetMesh()
+                                        ? QString("%1: %2 vertices, %3 tets")
+                                              .arg(QString::fromStdString(tm->GetName()))
+                                              .arg(tm->GetMesh()->GetNumberOfPoints())
+                                              .arg(tm->GetMesh()->GetNumberOfCells())
+                                        : QString("No transfer mesh yet."));
+  d->PartComboBox->setEnabled(live);
+  d->SelectPartButton->setEnabled(live && !parts.empty());
+  d->ClearSelectionButton->setEnabled(selected > 0);
+  d->NewGroupButton->setEnabled(live && selected > 0);
+  d->NewPoseButton->setEnabled(d->Logic != nullptr);
   d->AngleSlider->setEnabled(pose != nullptr && !groups.isEmpty());
   d->LiveStatusLabel->setText(live ? QString("Live: frame solved in %1 ms")
                                          .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
@@ -456,6 +611,7 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
     d->JobTimer.start();
   }
   d->BuildRigButton->setEnabled(ready && !running);
+  d->RefineMeshButton->setEnabled(live && !running);
   d->ExportButton->setEnabled(ready && !running && pose != nullptr);
   d->CancelButton->setEnabled(running);
   if (!running) d->JobProgressBar->setValue(d->JobStatus.startsWith("Error") ? 0 : 100);

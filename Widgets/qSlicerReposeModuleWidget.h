@@ -50,6 +50,22 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   bool setActiveGroupAngle(double angleDeg);
   double activeGroupAngle() const;
 
+  // A new pose (one fixed "rest" group) made active, posed live at once when the rig is built.
+  bool newPose();
+  // The selection of cage vertices (in the parameter node; the 3D view adds Shift+click and
+  // Shift+drag): a body part's vertices, or none. selectBodyPart returns how many.
+  int selectBodyPart(int label);
+  void clearSelection();
+  // The selection made a handle group of the active pose, which becomes the active group (its
+  // name; empty with the reason in jobStatusText() when refused). The live pose re-prepares.
+  QString newGroupFromSelection();
+
+  // The Cage section's separation row (parts by name or label, the region text) added to the
+  // active pose; Build applies it. False with the reason in jobStatusText().
+  bool addSeparation(const QString& partA, const QString& partB, const QString& region);
+  // The Transfer mesh section's Refine: a job, then live posing on the refined mesh.
+  bool refineMesh();
+
   // File dialog filters for the input (also used by the module's File > Open).
   static QStringList inputFileFilters();
 

@@ -8,6 +8,7 @@
 #include <vtkPointData.h>
 
 #include <QPainter>
+#include <QWheelEvent>
 
 #include <algorithm>
 #include <cmath>
@@ -44,6 +45,17 @@ void qSlicerReposeSliceView::setLabelOpacity(double opacity) {
   this->LabelOpacity = std::clamp(opacity, 0.0, 1.0);
 }
 
+void qSlicerReposeSliceView::setWindowLevel(double window, double level) {
+  this->Window = window;
+  this->Level = level;
+}
+
+void qSlicerReposeSliceView::wheelEvent(QWheelEvent* event) {
+  const int steps = event->angleDelta().y() / 120;
+  if (steps != 0) emit this->scrolled(steps);
+  event->accept();
+}
+
 void qSlicerReposeSliceView::setSlice(vtkImageData* labels, vtkLookupTable* lut,
                                       vtkImageData* image) {
   this->Image = QImage();
@@ -67,7 +79,12 @@ void qSlicerReposeSliceView::setSlice(vtkImageData* labels, vtkLookupTable* lut,
   vtkDataArray* grey = image ? image->GetPointData()->GetScalars() : nullptr;
   if (grey && grey->GetNumberOfTuples() != values->GetNumberOfTuples()) grey = nullptr;
   double range[2] = {0, 1};
-  if (grey) grey->GetRange(range);
+  if (grey && this->Window > 0) {
+    range[0] = this->Level - this->Window / 2;
+    range[1] = this->Level + this->Window / 2;
+  } else if (grey) {
+    grey->GetRange(range);
+  }
   const double span = range[1] > range[0] ? range[1] - range[0] : 1;
   this->Image = QImage(w, h, QImage::Format_RGB32);
   this->Labels.assign(std::size_t(w) * std::size_t(h), 0);
@@ -76,7 +93,7 @@ void qSlicerReposeSliceView::setSlice(vtkImageData* labels, vtkLookupTable* lut,
     for (int i = 0; i < w; ++i) {
       const vtkIdType at = vtkIdType(i) + vtkIdType(w) * j;
       const int label = int(values->GetTuple1(at));
-      const double g = grey ? (grey->GetTuple1(at) - range[0]) / span : 0.0;
+      const double g = grey ? std::clamp((grey->GetTuple1(at) - range[0]) / span, 0.0, 1.0) : 0.0;
       double rgb[3] = {g, g, g};
       if (label != 0 && lut) {
         double c[3];

@@ -33,6 +33,8 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
   double positionMm() const { return this->PositionMm; }
   void setLabelOpacity(double opacity);
   double labelOpacity() const { return this->LabelOpacity; }
+  // The image's grey mapping (Slicer's window/level); window <= 0: the slice's own range.
+  void setWindowLevel(double window, double level);
 
   // What is drawn, at the slice's own resolution (screen right = patient left for axial and
   // coronal views, as radiologists read them; superior up).
@@ -46,13 +48,20 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
 
   QSize sizeHint() const override { return {320, 320}; }
 
+ signals:
+  // The mouse wheel turned over the view: this many slices on (positive: towards superior,
+  // anterior or the patient's left... as the plane's normal axis increases).
+  void scrolled(int steps);
+
  protected:
   void paintEvent(QPaintEvent* event) override;
+  void wheelEvent(QWheelEvent* event) override;
 
  private:
   int Orientation;
   double PositionMm = 0;
   double LabelOpacity = 0.8;
+  double Window = 0, Level = 0;
   QImage Image;                         // RGB of the slice, rows top = superior (or anterior)
   std::vector<int> Labels;              // label per pixel of Image
   vtkSmartPointer<vtkImageData> Shown;  // the slice drawn (its geometry maps RAS to pixels)

@@ -1,6 +1,7 @@
 // qSlicerReposeViewsWidget: layout, the 3D view's actors, and the refresh from the Logic.
 #include "qSlicerReposeViewsWidget.h"
 
+#include "qSlicerReposeCageInteraction.h"
 #include "qSlicerReposeSliceView.h"
 #include "vtkMRMLReposeParametersNode.h"
 #include "vtkMRMLReposePoseNode.h"
@@ -14,6 +15,8 @@
 #include <vtkCamera.h>
 #include <vtkCommand.h>
 #include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkRenderWindowInteractor.h>
 #include <vtkLookupTable.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
@@ -23,6 +26,7 @@
 #include <QGridLayout>
 #include <QPainter>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -44,6 +48,7 @@ class qSlicerReposeViewsWidgetPrivate {
   int Pixels = 256;
   double SliceMilliseconds = 0;
   vtkMRMLReposePoseNode* CameraResetFor = nullptr;
+  qSlicerReposeCageInteraction* CageInteraction = nullptr;
   vtkSmartPointer<vtkLookupTable> Lookup;
   vtkMRMLReposePoseNode* LookupFor = nullptr;
 };
@@ -83,7 +88,24 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
   d->CageVertexActor->GetProperty()->SetPointSize(5);
   d->CageVertexActor->GetProperty()->SetColor(1.0, 0.9, 0.2);
   d->CageVertexActor->GetProperty()->LightingOff();
-  for (int o = 0; o < 3; ++o) d->Slices[o] = new qSlicerReposeSliceView(o, this);
+  // Slicer's 3D view camera: trackball; Shift+mouse selects cage vertices (CageInteraction).
+  d->RenderWindow->GetInteractor()->SetInteractorStyle(
+      vtkSmartPointer<vtkInteractorStyleTrackballCamera>::New());
+  d->CageInteraction =
+      new qSlicerReposeCageInteraction(d->Renderer, d->RenderWindow->GetInteractor(), this);
+  for (int o = 0; o < 3; ++o) {
+    d->Slices[o] = new qSlicerReposeSliceView(o, this);
+    // The wheel steps the slice by one of its pixels, within the live body's box.
+    connect(d->Slices[o], &qSlicerReposeSliceView::scrolled, this, [this, d, o](int steps) {
+      if (!d->Logic || !d->Logic->GetLivePose() || std::isnan(d->Positions[o])) return;
+      const std::array<double, 6> box = d->Logic->GetLiveBounds();
+      const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;
+      const double lo = box[std::size_t(2 * axis)], hi = box[std::size_t(2 * axis + 1)];
+      const double larger = std::max({box[1] - box[0], box[3] - box[2], box[5] - box[4]});
+      const double step = std::max(larger / d->Pixels, 0.1);
+      this->setSlicePosition(o, std::clamp(d->Positions[o] + steps * step, lo, hi));
+    });
+  }
   // Slicer's Four-Up: Red | 3D over Yellow | Green.
   grid->addWidget(d->Slices[0], 0, 0);
   grid->addWidget(d->View3D, 0, 1);
@@ -102,6 +124,7 @@ void qSlicerReposeViewsWidget::setLogic(vtkSlicerReposeLogic* logic) {
   if (d->Parameters) d->Parameters->RemoveObserver(d->ParametersObserverTag);
   d->Logic = logic;
   d->Parameters = logic ? logic->GetParameterNode() : nullptr;
+  d->CageInteraction->setLogic(logic);
   if (logic)
     d->LogicObserverTag =
         logic->AddObserver(vtkCommand::ModifiedEvent, this, &qSlicerReposeViewsWidget::refresh);
@@ -134,6 +157,11 @@ void qSlicerReposeViewsWidget::setSliceResolution(int pixels) {
   this->refresh();
 }
 
+qSlicerReposeCageInteraction* qSlicerReposeViewsWidget::cageInteraction() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->CageInteraction;
+}
+
 vtkRenderer* qSlicerReposeViewsWidget::renderer3D() const {
   Q_D(const qSlicerReposeViewsWidget);
   return d->Renderer;
@@ -154,6 +182,7 @@ void qSlicerReposeViewsWidget::refresh() {
   if (!pose) {
     for (qSlicerReposeSliceView* view : d->Slices) view->setSlice(nullptr, nullptr);
     d->CameraResetFor = nullptr;
+    d->CageInteraction->update();
     d->RenderWindow->Render();
     return;
   }
@@ -178,10 +207,15 @@ void qSlicerReposeViewsWidget::refresh() {
     vtkSmartPointer<vtkImageData> slice =
         d->Logic->ComputeLiveSlice(o, d->Positions[o], d->Pixels, &ms);
     d->SliceMilliseconds += ms;
+    vtkSmartPointer<vtkImageData> image =
+        d->Logic->ComputeLiveImageSlice(o, d->Positions[o], d->Pixels);
+    double window = 0, level = 0;
+    d->Logic->GetLiveImageWindow(window, level);
+    d->Slices[o]->setWindowLevel(window, level);
     d->Slices[o]->setPositionMm(d->Positions[o]);
     if (vtkMRMLReposeParametersNode* p = d->Logic->GetParameterNode())
       d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());
-    d->Slices[o]->setSlice(slice, d->Lookup);
+    d->Slices[o]->setSlice(slice, d->Lookup, image);
   }
   if (d->CameraResetFor != pose) {
     d->CameraResetFor = pose;
@@ -191,6 +225,7 @@ void qSlicerReposeViewsWidget::refresh() {
     camera->SetViewUp(0, 0, 1);
     d->Renderer->ResetCamera();
   }
+  d->CageInteraction->update();
   d->RenderWindow->Render();
   d->View3D->update();
 }

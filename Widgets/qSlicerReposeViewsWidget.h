@@ -10,6 +10,7 @@
 #include <QScopedPointer>
 #include <QWidget>
 
+class qSlicerReposeCageInteraction;
 class qSlicerReposeSliceView;
 class qSlicerReposeViewsWidgetPrivate;
 class vtkRenderer;
@@ -31,6 +32,8 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeViewsWidget : public QWi
   // Pixels across a live slice (the larger in-plane side of the body's box).
   void setSliceResolution(int pixels);
   vtkRenderer* renderer3D() const;
+  // Selection of cage vertices and the active group's transform widget in the 3D view.
+  qSlicerReposeCageInteraction* cageInteraction() const;
 
   // Recomputes the slices and redraws every view from the Logic's live pose (called on every
   // Logic change). The slices' rasterization time of the last refresh, all three, in ms.

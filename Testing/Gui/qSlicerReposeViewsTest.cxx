@@ -5,6 +5,7 @@
 // undo brings the turn back, screenshots of the four views before and after are saved as test
 // artifacts and are not blank, an export cancelled leaves nothing and a finished one writes the
 // posed files; the workbench renders a saved scene to a PNG from the command line.
+#include "qSlicerReposeCageInteraction.h"
 #include "qSlicerReposeModuleWidget.h"
 #include "qSlicerReposeSliceView.h"
 #include "qSlicerReposeViewsWidget.h"
@@ -16,10 +17,21 @@
 #include <repose/io/VolumeIO.h>
 #include <repose/phantom/Phantom.h>
 
+#include <vtkBoxRepresentation.h>
+#include <vtkBoxWidget2.h>
+#include <vtkCommand.h>
+#include <vtkMatrix4x4.h>
 #include <vtkNew.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkTransform.h>
 
 #include <QDir>
+#include <QComboBox>
+#include <QWheelEvent>
 #include <QHBoxLayout>
+#include <QPushButton>
 #include <QProcess>
 #include <QSlider>
 #include <QSurfaceFormat>
@@ -27,6 +39,8 @@
 #include <QToolButton>
 #include <QtTest>
 
+#include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace {
@@ -68,6 +82,8 @@ class qSlicerReposeViewsTest : public QObject {
     const QString G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz");
     repose::writeVolume(organs, G.toStdString());
     repose::writeVolume(parts, S.toStdString());
+    const QString CT = dir.filePath("CT.nii.gz");
+    repose::writeVolume(repose::syntheticCT(organs), CT.toStdString());
 
     vtkNew<vtkSlicerReposeLogic> logic;
     vtkNew<vtkMRMLReposeParametersNode> node;
@@ -87,6 +103,7 @@ class qSlicerReposeViewsTest : public QObject {
     // A user's steps: the segmentation, its body parts, the pose; then Build.
     QVERIFY(panel->setInputPath(G));
     node->SetBodyPartMapPath(S.toStdString());
+    node->SetImagePath(CT.toStdString());
     QVERIFY(panel->setPosePath(QString(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json"));
     QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("left forearm and hand"));
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
@@ -100,6 +117,24 @@ class qSlicerReposeViewsTest : public QObject {
     const qSlicerReposeSliceView* coronal = views->sliceView(1);
     QVERIFY(coronal->labelsShown() > 5);
     const int bent = forearmPixels(coronal);
+    // The CT under the labels: with the labels fully transparent the view shows the image alone,
+    // grey inside the body and black (air) outside.
+    node->SetLabelOpacity(0);
+    int grey = 0, black = 0;
+    for (int y = 0; y < coronal->sliceImage().height(); ++y)
+      for (int x = 0; x < coronal->sliceImage().width(); ++x) {
+        const QRgb c = coronal->sliceImage().pixel(x, y);
+        if (qRed(c) == qGreen(c) && qGreen(c) == qBlue(c)) (qRed(c) > 40 ? grey : black)++;
+      }
+    QVERIFY2(grey > 500 && black > 500,
+             qPrintable(QString("%1 grey, %2 black").arg(grey).arg(black)));
+    node->SetLabelOpacity(0.8);
+    // The mouse wheel steps the slice (one pixel per notch), and back.
+    QWheelEvent wheel(QPointF(50, 50), QPointF(50, 50), QPoint(), QPoint(0, 120), Qt::NoButton,
+                      Qt::NoModifier, Qt::NoScrollPhase, false);
+    QApplication::sendEvent(views->sliceView(1), &wheel);
+    QVERIFY(coronal->positionMm() > -14);
+    views->setSlicePosition(1, -14);
     const QImage before = views->renderViews();
     QVERIFY(before.save(artifact("views_elbow90.png")));
 
@@ -166,6 +201,140 @@ class qSlicerReposeViewsTest : public QObject {
     const QImage shot(png);
     QVERIFY(!shot.isNull());
     QVERIFY(colours(shot, shot.rect()) > 30);
+  }
+
+  // No pose file: Build makes a new pose (everything fixed) and poses it live. In the 3D view,
+  // Shift+click picks a cage vertex and Shift+drag boxes several (interactor events, as the mouse
+  // gives them); the panel selects the left hand's part and makes a group of it; the group's
+  // transform widget then moves the hand outwards in one drag (its interaction events), the
+  // coronal view shows the hand's labels where there was air, and one undo takes it back.
+  void posingWithTheCageInTheThreeDView() {
+    QTemporaryDir dir;
+    repose::PhantomOptions po;
+    po.voxelMm = 8;
+    const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+    const QString G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz");
+    repose::writeVolume(organs, G.toStdString());
+    repose::writeVolume(parts, S.toStdString());
+
+    vtkNew<vtkSlicerReposeLogic> logic;
+    vtkNew<vtkMRMLReposeParametersNode> node;
+    QWidget window;
+    auto* layout = new QHBoxLayout(&window);
+    auto* panel = new qSlicerReposeModuleWidget;
+    auto* views = new qSlicerReposeViewsWidget;
+    layout->addWidget(panel);
+    layout->addWidget(views, 1);
+    panel->setLogic(logic);
+    panel->setParameterNode(node);
+    views->setLogic(logic);
+    window.resize(1400, 900);
+    window.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&window));
+
+    QVERIFY(panel->setInputPath(G));
+    node->SetBodyPartMapPath(S.toStdString());
+    QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() && logic->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
+    qSlicerReposeCageInteraction* cage = views->cageInteraction();
+    QVERIFY(!cage->transformWidget()->GetEnabled());  // no movable group yet
+
+    int hand = 0;
+    for (const auto& [label, name] : logic->GetLiveBodyParts())
+      if (name == "hand_left") hand = label;
+    QVERIFY(hand > 0);
+    const std::vector<int> handVertices = logic->GetLiveCageVerticesOfPart(hand);
+    QVERIFY(handVertices.size() >= 3);
+
+    // Shift+click on a hand vertex as drawn: one vertex selected, drawn within a few pixels.
+    vtkRenderWindowInteractor* interactor = views->renderer3D()->GetRenderWindow()->GetInteractor();
+    auto mouse = [&](unsigned long event, const QPoint& at, bool shift, bool ctrl) {
+      interactor->SetEventInformation(at.x(), at.y(), ctrl ? 1 : 0, shift ? 1 : 0);
+      interactor->InvokeEvent(event);
+    };
+    const QPoint target = cage->vertexDisplayPosition(handVertices.front());
+    QVERIFY(target.x() >= 0);
+    mouse(vtkCommand::LeftButtonPressEvent, target, true, false);
+    mouse(vtkCommand::LeftButtonReleaseEvent, target, true, false);
+    QCOMPARE(int(node->GetSelectedCageVertices().size()), 1);
+    const QPoint picked = cage->vertexDisplayPosition(node->GetSelectedCageVertices().front());
+    QVERIFY((picked - target).manhattanLength() <= 16);
+    // Ctrl+Shift+click on it again takes it out.
+    mouse(vtkCommand::LeftButtonPressEvent, picked, true, true);
+    mouse(vtkCommand::LeftButtonReleaseEvent, picked, true, true);
+    QVERIFY(node->GetSelectedCageVertices().empty());
+
+    // Shift+drag a band around every hand vertex as drawn: all of them are in the selection.
+    QRect band;
+    for (int v : handVertices) band |= QRect(cage->vertexDisplayPosition(v), QSize(1, 1));
+    band.adjust(-3, -3, 3, 3);
+    mouse(vtkCommand::LeftButtonPressEvent, band.topLeft(), true, false);
+    mouse(vtkCommand::MouseMoveEvent, band.center(), true, false);
+    mouse(vtkCommand::LeftButtonReleaseEvent, band.bottomRight(), true, false);
+    const std::vector<int> boxed = node->GetSelectedCageVertices();
+    for (int v : handVertices)
+      QVERIFY2(std::binary_search(boxed.begin(), boxed.end(), v), qPrintable(QString::number(v)));
+
+    // The panel: select the part, make it a group; the live rig re-prepares for it.
+    auto* combo = panel->findChild<QComboBox*>("PartComboBox");
+    QVERIFY(combo && combo->count() > 1);
+    combo->setCurrentIndex(combo->findData(hand));
+    panel->findChild<QToolButton*>("SelectPartButton")->click();
+    QCOMPARE(node->GetSelectedCageVertices(), handVertices);
+    QCOMPARE(node->GetSelectedBodyPart(), hand);
+    panel->findChild<QPushButton*>("NewGroupButton")->click();
+    QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("group 1"));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY(node->GetSelectedCageVertices().empty());
+    vtkBoxWidget2* box = cage->transformWidget();
+    QVERIFY(box->GetEnabled());
+
+    // Where the hand will go: 60 mm further out to the patient's left (-R), in air at rest.
+    const auto rest = logic->GetLiveRestCage();
+    double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
+    for (int v : handVertices)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], rest[std::size_t(v)][k]);
+        hi[k] = std::max(hi[k], rest[std::size_t(v)][k]);
+      }
+    const double handA = (lo[1] + hi[1]) / 2;
+    views->setSlicePosition(1, handA);
+    const qSlicerReposeSliceView* coronal = views->sliceView(1);
+    auto outside = [&] {
+      int n = 0;
+      for (double s = lo[2]; s <= hi[2]; s += 4)
+        for (double r = lo[0] - 60; r <= lo[0] - 15; r += 4)
+          n += coronal->labelAtRas(r, handA, s) > 0;
+      return n;
+    };
+    const int before = outside();
+
+    // One drag of the box: five steps of 12 mm each.
+    auto* rep = vtkBoxRepresentation::SafeDownCast(box->GetRepresentation());
+    QVERIFY(rep);
+    box->InvokeEvent(vtkCommand::StartInteractionEvent);
+    for (int step = 1; step <= 5; ++step) {
+      vtkNew<vtkTransform> t;
+      t->Translate(-12.0 * step, 0, 0);
+      rep->SetTransform(t);
+      box->InvokeEvent(vtkCommand::InteractionEvent);
+    }
+    box->InvokeEvent(vtkCommand::EndInteractionEvent);
+    const int moved = outside();
+    qInfo("hand labels beside the hand in the coronal view: %d at rest, %d moved; frame %.1f ms",
+          before, moved, logic->GetLiveFrameMilliseconds());
+    QVERIFY2(moved > before + 10, qPrintable(QString("%1 vs %2").arg(moved).arg(before)));
+    vtkNew<vtkMatrix4x4> m;
+    QVERIFY(logic->GetPoseGroupMatrix(panel->activePose(), "group 1", m));
+    QVERIFY(std::abs(m->GetElement(0, 3) + 60) < 1e-6);
+    QVERIFY(views->renderViews().save(artifact("views_hand_moved.png")));
+
+    // The drag is one undo step.
+    panel->findChild<QToolButton*>("UndoButton")->click();
+    QCOMPARE(outside(), before);
   }
 };
 

@@ -63,6 +63,7 @@ RefinementResult refineTransferMesh(const Volume& parts, const TriangleMesh& cag
     reportProgress(options.progress, double(it) / options.maxIterations, "refinement");
     TransferMeshOptions tmo;
     tmo.sizing = &field;
+    tmo.rigidTissue = options.rigidTissue;
     TransferMesh mesh = buildTransferMesh(parts, tmo);
     if (mesh.vertices.rows() > options.maxVertices && it > 0)
       break;  // keep the last mesh in budget

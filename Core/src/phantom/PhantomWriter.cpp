@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <memory>
 #include <vector>
 
 namespace repose {
@@ -22,7 +23,7 @@ constexpr std::int64_t kSlabBytes = 32ll << 20;
 }  // namespace
 
 PhantomFiles writePhantom(const Phantom& phantom, const std::string& outDir, const std::string& ext,
-                          const ProgressFn& progress, const std::string& prefix) {
+                          const ProgressFn& progress, const std::string& prefix, bool image) {
   if (ext != ".nii.gz" && ext != ".nii")
     throw Error("phantom: unsupported output extension '" + ext + "' (use .nii.gz or .nii)");
   if (prefix.find('/') != std::string::npos)
@@ -35,6 +36,7 @@ PhantomFiles writePhantom(const Phantom& phantom, const std::string& outDir, con
   files.organs = (dir / (prefix + "G" + ext)).string();
   files.parts = (dir / (prefix + "S" + ext)).string();
   files.skeleton = (dir / (prefix + "skeleton.json")).string();
+  if (image) files.image = (dir / (prefix + "CT" + ext)).string();
 
   // The skeleton is staged first and committed last, so a failed run leaves no new file at all
   // unless the voxel maps were complete.
@@ -50,23 +52,35 @@ PhantomFiles writePhantom(const Phantom& phantom, const std::string& outDir, con
   const int version = big ? 2 : 1;
   NiftiSlabWriter organs(files.organs, g, ScalarType::UInt8, phantom.organLabels(), true, version);
   NiftiSlabWriter parts(files.parts, g, ScalarType::UInt8, phantom.partLabels(), true, version);
+  std::unique_ptr<NiftiSlabWriter> ct;
+  if (image)
+    ct = std::make_unique<NiftiSlabWriter>(files.image, g, ScalarType::Int16, LabelTable(), false,
+                                           version);
 
   const std::int64_t sliceVoxels = g.dims[0] * g.dims[1];
   const std::int64_t slab = std::clamp<std::int64_t>(kSlabBytes / sliceVoxels, 1, g.dims[2]);
   std::vector<std::uint8_t> organBuf(static_cast<std::size_t>(slab * sliceVoxels));
   std::vector<std::uint8_t> partBuf(organBuf.size());
+  std::vector<std::int16_t> ctBuf(image ? organBuf.size() : 0);
   reportProgress(progress, 0.0, "phantom");
   for (std::int64_t k = 0; k < g.dims[2]; k += slab) {
     const std::int64_t n = std::min(slab, g.dims[2] - k);
     phantom.fillSlices(k, k + n, organBuf.data(), partBuf.data());
     // The two gzip streams are independent: compress them side by side.
-    auto partsDone = std::async(std::launch::async, [&] { parts.writeSlices(partBuf.data(), n); });
+    auto partsDone = std::async(std::launch::async, [&] {
+      parts.writeSlices(partBuf.data(), n);
+      if (ct) {
+        syntheticCTVoxels(organBuf.data(), ctBuf.data(), n * sliceVoxels, k * sliceVoxels);
+        ct->writeSlices(ctBuf.data(), n);
+      }
+    });
     organs.writeSlices(organBuf.data(), n);
     partsDone.get();
     reportProgress(progress, double(k + n) / g.dims[2], "phantom");
   }
   organs.finish();
   parts.finish();
+  if (ct) ct->finish();
   skeleton.commit();
   return files;
 }

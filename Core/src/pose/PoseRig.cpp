@@ -2,6 +2,7 @@
 
 #include "repose/util/Error.h"
 
+#include <algorithm>
 #include <map>
 #include <optional>
 #include <set>
@@ -128,6 +129,34 @@ RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparati
   for (const LimbSeparation& s : separations) separateLabels(g.mesh, s.labelA, s.labelB, s.region);
   reportProgress(progress, 1, "rig built");
   return g;
+}
+
+TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
+                           const Eigen::MatrixX3d& posedCage,
+                           const std::vector<LimbSeparation>& separations,
+                           const RigSettings& settings, int iterations, const ProgressFn& progress,
+                           const Volume* organs, std::vector<RefinementStep>* steps) {
+  if (posedCage.rows() != cage.vertices.rows())
+    throw Error("refining the transfer mesh: the posed cage has " +
+                std::to_string(posedCage.rows()) + " vertices, the cage " +
+                std::to_string(cage.vertices.rows()));
+  RefinementOptions ro;
+  ro.initialSizeMm = settings.meshMm;
+  ro.threads = settings.threads;
+  ro.progress = progress;
+  ro.maxIterations = std::max(1, iterations);
+  ro.uniformity = 0;  // every round asked for
+  std::optional<Volume> pieces;
+  if (organs) {
+    pieces = wholePieceMap(*organs, parts, settings);
+    if (pieces->numVoxels() > 0) ro.rigidTissue = &*pieces;
+  }
+  RefinementResult result = refineTransferMesh(parts, cage, posedCage, ro);
+  demotePiecesAcrossJoints(result.mesh);
+  for (const LimbSeparation& s : separations)
+    separateLabels(result.mesh, s.labelA, s.labelB, s.region);
+  if (steps) *steps = result.steps;
+  return std::move(result.mesh);
 }
 
 PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads,

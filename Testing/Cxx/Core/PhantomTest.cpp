@@ -421,6 +421,45 @@ TEST(Phantom, WritesFilesThatReadBackIdentically) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 3);
 }
 
+// The CT-like image: streamed slab by slab it is the image of the whole G (the noise depends on
+// the voxel index only), each tissue within the noise of its value, air exactly -1000, and
+// lung darker than fat darker than soft tissue darker than bone.
+TEST(Phantom, WritesASyntheticCTOfG) {
+  test::ScratchDir dir;
+  PhantomOptions o;
+  o.voxelMm = 6;
+  const Phantom p(o);
+  const Maps m = p.makeVolumes();
+  const PhantomFiles files = writePhantom(p, dir.path().string(), ".nii.gz", {}, "x_", true);
+  EXPECT_EQ(files.image, dir.file("x_CT.nii.gz"));
+  const Volume ct = readVolume(files.image);
+  ASSERT_EQ(ct.scalarType(), ScalarType::Int16);
+  EXPECT_FALSE(ct.isLabelMap());
+  EXPECT_TRUE(ct.geometry().ijkToRas.isApprox(m.first.geometry().ijkToRas, 1e-6));
+  const Volume whole = syntheticCT(m.first);
+  ASSERT_EQ(ct.bytes(), whole.bytes());
+  const auto* g = m.first.data<std::uint8_t>();
+  const auto* hu = ct.data<std::int16_t>();
+  for (std::int64_t v = 0; v < ct.numVoxels(); ++v) {
+    if (g[v] == 0) {
+      ASSERT_EQ(hu[v], -1000) << v;
+    } else {
+      ASSERT_LE(std::abs(hu[v] - phantomHounsfield(g[v])), 12) << v;
+    }
+  }
+  const LabelTable organLabels = p.organLabels();  // kept: labels() refers into it
+  auto value = [&](const std::string& name) {
+    for (const Label& l : organLabels.labels())
+      if (l.name == name) return phantomHounsfield(l.value);
+    ADD_FAILURE() << name;
+    return std::int16_t(0);
+  };
+  EXPECT_LT(value("lung_left"), value("subcutaneous_fat"));
+  EXPECT_LT(value("subcutaneous_fat"), value("muscle"));
+  EXPECT_LT(value("muscle"), value("femur"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 4);
+}
+
 TEST(Phantom, CancelledOrFailedWritesLeaveNothing) {
   test::ScratchDir dir;
   const Phantom p(PhantomOptions{6.0});

@@ -2,23 +2,29 @@
 // re-solves the frame on this thread; the live slice through the left forearm shows G as it is at
 // rest when the elbow is straight, changes when it bends, and undo brings back the same voxels.
 #include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
+#include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
 
 #include "TestPaths.h"
 
 #include <repose/io/VolumeIO.h>
+#include <repose/pose/Pose.h>
 #include <repose/phantom/Phantom.h>
 
 #include <gtest/gtest.h>
 
 #include <vtkNew.h>
 #include <vtkMatrix4x4.h>
+#include <vtkCellData.h>
 #include <vtkPointData.h>
+#include <vtkUnstructuredGrid.h>
 #include <vtkTransform.h>
 
 #include <cmath>
 #include <cstring>
+#include <iostream>
 
 using namespace repose::test;
 
@@ -125,9 +131,11 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
   const auto [organs, parts] = repose::Phantom(po).makeVolumes();
   repose::writeVolume(organs, dir.file("G.nii.gz"));
   repose::writeVolume(parts, dir.file("S.nii.gz"));
+  repose::writeVolume(repose::syntheticCT(organs), dir.file("CT.nii.gz"));
 
   vtkNew<vtkSlicerReposeLogic> logic;
-  auto* seg = logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"));
+  auto* seg =
+      logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"), dir.file("CT.nii.gz"));
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
   vtkMRMLReposePoseNode* pose = logic->NewPose("from the view");
   ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
@@ -138,6 +146,41 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
   ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
   ASSERT_EQ(logic->GetLivePose(), pose);
   EXPECT_FALSE(logic->GetPoseGroupMatrix(pose, "rest", vtkNew<vtkMatrix4x4>()));  // fixed
+
+  // The image under the labels: the same plane and grid, CT values that agree with the labels
+  // (air -1000 exactly, lung dark, bone bright), and a soft-tissue window for it.
+  {
+    vtkSmartPointer<vtkImageData> labels = logic->ComputeLiveSlice(1, 0, 96);
+    vtkSmartPointer<vtkImageData> image = logic->ComputeLiveImageSlice(1, 0, 96);
+    ASSERT_TRUE(labels && image);
+    ASSERT_EQ(image->GetNumberOfPoints(), labels->GetNumberOfPoints());
+    double window = 0, level = 0;
+    ASSERT_TRUE(logic->GetLiveImageWindow(window, level));
+    EXPECT_EQ(window, 400);
+    EXPECT_EQ(level, 40);
+    const repose::Volume table = repose::readVolume(dir.file("G.nii.gz"));
+    auto labelOf = [&](const std::string& name) {
+      for (const repose::Label& l : table.labels().labels())
+        if (l.name == name) return l.value;
+      return -1;
+    };
+    vtkDataArray* lv = labels->GetPointData()->GetScalars();
+    vtkDataArray* iv = image->GetPointData()->GetScalars();
+    int air = 0, lung = 0, bone = 0, airOk = 0, lungOk = 0, boneOk = 0;
+    for (vtkIdType p = 0; p < lv->GetNumberOfTuples(); ++p) {
+      const int l = int(lv->GetTuple1(p));
+      const double hu = iv->GetTuple1(p);
+      if (l == 0) air++, airOk += hu == -1000;
+      if (l == labelOf("lung_left")) lung++, lungOk += hu < -500;
+      if (l == labelOf("femur") || l == labelOf("pelvis")) bone++, boneOk += hu > 300;
+    }
+    EXPECT_GT(air, 100);
+    EXPECT_GT(lung, 10);
+    EXPECT_GT(bone, 5);
+    EXPECT_GT(airOk, air * 3 / 4);  // pixels next to the skin mix (trilinear, 8 mm voxels)
+    EXPECT_GT(lungOk, lung * 8 / 10);
+    EXPECT_GT(boneOk, bone * 7 / 10);
+  }
 
   // The cage vertices of the left hand part, found by name among S's parts.
   int hand = 0;
@@ -222,4 +265,75 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
   ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
   EXPECT_TRUE(logic->GetLiveGroupVertices(group).empty());
   EXPECT_EQ(logic->GetLivePose(), pose);
+}
+
+// The Transfer mesh section's Refine: the live pose's mesh refined for its current frame (the
+// elbow bent 90 degrees) becomes a new node the pose refers to, finer than the first, still with
+// the bones as whole pieces, and live posing continues on it. The Cage section's separation is
+// recorded in the pose (undoable), and a bad region is refused with a message.
+TEST(vtkSlicerReposeLogicLive, RefiningForTheFrameAndAddingASeparation) {
+  ScratchDir dir("live-refine");
+  repose::PhantomOptions po;
+  po.voxelMm = 8;
+  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+  repose::writeVolume(organs, dir.file("G.nii.gz"));
+  repose::writeVolume(parts, dir.file("S.nii.gz"));
+  vtkNew<vtkSlicerReposeLogic> logic;
+  auto* seg = logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"));
+  ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
+  auto* pose = logic->AddPose(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json");
+  ASSERT_TRUE(pose);
+  EXPECT_FALSE(logic->StartRefineMesh(pose));  // nothing to refine before the rig
+  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  EXPECT_FALSE(logic->StartRefineMesh(pose));  // not live yet: no frame to adapt to
+  EXPECT_NE(logic->GetLastErrorMessage().find("live"), std::string::npos);
+  ASSERT_TRUE(logic->StartLivePose(pose));
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+
+  auto meshOf = [&] {
+    return vtkMRMLReposeTransferMeshNode::SafeDownCast(
+        logic->GetScene()->GetReferencedNode(pose, "transfer_mesh"));
+  };
+  vtkMRMLReposeTransferMeshNode* first = meshOf();
+  ASSERT_TRUE(first);
+  const vtkIdType firstVertices = first->GetMesh()->GetNumberOfPoints();
+  ASSERT_TRUE(logic->StartRefineMesh(pose, 2)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  vtkMRMLReposeTransferMeshNode* refined = meshOf();
+  ASSERT_TRUE(refined);
+  EXPECT_NE(refined, first);
+  // The loop's own measure: the last round's mesh has the smaller maximum error, and is the one
+  // the node holds.
+  const std::vector<double>& errors = logic->GetLastRefinementMaxErrors();
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_LT(errors.back(), errors.front());
+  EXPECT_EQ(logic->GetLastRefinementVertices().back(), refined->GetMesh()->GetNumberOfPoints());
+  EXPECT_GT(firstVertices, 0);
+  std::cout << logic->GetLastRefinementSummary() << "\n";
+  EXPECT_NE(logic->GetLastRefinementSummary().find("vertices"), std::string::npos);
+  vtkDataArray* rigid = refined->GetMesh()->GetCellData()->GetArray("rigid");
+  ASSERT_TRUE(rigid);
+  int pieces = 0;
+  for (vtkIdType c = 0; c < rigid->GetNumberOfTuples(); ++c) pieces += rigid->GetTuple1(c) != 0;
+  EXPECT_GT(pieces, 0);
+  ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  EXPECT_EQ(logic->GetLiveBodySurface()->GetNumberOfPoints(),
+            refined->GetMesh()->GetNumberOfPoints());
+
+  // Separations: recorded, undone; refused with the reason.
+  ASSERT_TRUE(
+      logic->AddPoseSeparation(pose, "hand_left", "torso", "box:-300,-100,600,-150,100,900"))
+      << logic->GetLastErrorMessage();
+  auto separations = [&] {
+    return repose::parsePose(pose->GetPoseJSON(), "pose").separations.size();
+  };
+  EXPECT_EQ(separations(), 1u);
+  EXPECT_FALSE(logic->AddPoseSeparation(pose, "hand_left", "torso", "cube:1,2"));
+  EXPECT_FALSE(logic->GetLastErrorMessage().empty());
+  EXPECT_FALSE(logic->AddPoseSeparation(pose, "torso", "torso", "sphere:0,0,0,10"));
+  ASSERT_TRUE(logic->Undo());
+  EXPECT_EQ(separations(), 0u);
 }

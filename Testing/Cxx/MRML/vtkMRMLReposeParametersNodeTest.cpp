@@ -41,6 +41,7 @@ void fillNonDefault(vtkMRMLReposeParametersNode* node) {
   node->SetActivePoseNodeID("vtkMRMLReposePoseNode1");
   node->SetActiveGroup("left forearm and hand");
   node->SetSelectedCageVertices({12, 3, 7, 3});
+  node->SetSelectedBodyPart(5);
   node->SetLabelOpacity(0.35);
 }
 
@@ -58,6 +59,7 @@ void expectEqualFields(vtkMRMLReposeParametersNode* a, vtkMRMLReposeParametersNo
   EXPECT_EQ(a->GetActivePoseNodeID(), b->GetActivePoseNodeID());
   EXPECT_EQ(a->GetActiveGroup(), b->GetActiveGroup());
   EXPECT_EQ(a->GetSelectedCageVertices(), b->GetSelectedCageVertices());
+  EXPECT_EQ(a->GetSelectedBodyPart(), b->GetSelectedBodyPart());
   EXPECT_EQ(a->GetLabelOpacity(), b->GetLabelOpacity());
 }
 
@@ -74,6 +76,7 @@ const char* const kFieldNames[] = {"InputSegmentationNodeID",
                                    "ActivePoseNodeID",
                                    "ActiveGroup",
                                    "SelectedCageVertices",
+                                   "SelectedBodyPart",
                                    "LabelOpacity"};
 
 }  // namespace

@@ -16,6 +16,8 @@ struct RefinementOptions {
   double uniformity = 1.5;   // stop when max(e^G) <= uniformity * mean(e^G)
   int threads = 0;
   ProgressFn progress;
+  // Whole pieces meshed as subdomains of their own (TransferMeshOptions::rigidTissue), each mesh.
+  const Volume* rigidTissue = nullptr;
 };
 
 struct RefinementStep {

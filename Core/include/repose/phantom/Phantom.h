@@ -72,15 +72,28 @@ class Phantom {
   std::unique_ptr<Impl> impl_;
 };
 
+// A CT-like image of the phantom's organ map G (int16, Hounsfield units): each tissue at a
+// typical value (air -1000, lung -820, fat -100, soft tissue 5..60, bone 550..1100) plus a
+// +-12 HU noise that depends only on the voxel index. What the slice views show under the labels
+// and what `--image` paths pose alongside G.
+Volume syntheticCT(const Volume& organs);
+// The same for `count` voxels of G starting at voxel index `firstVoxel` (a slab).
+void syntheticCTVoxels(const std::uint8_t* organs, std::int16_t* ct, std::int64_t count,
+                       std::int64_t firstVoxel);
+// The value a label of G has in the synthetic CT before noise (0 for an unknown label).
+std::int16_t phantomHounsfield(int organLabel);
+
 struct PhantomFiles {
   std::string organs, parts, skeleton;
+  std::string image;  // <prefix>CT<ext> when asked for, else empty
 };
 
 // Streams G and S to outDir (as <prefix>G<ext>, <prefix>S<ext>, <prefix>skeleton.json) slab by
 // slab with bounded memory, so a 1G-voxel phantom never needs to fit in memory. ext is ".nii.gz"
 // or ".nii". Outputs are atomic.
+// With `image`, also <prefix>CT<ext>: the syntheticCT of G, streamed the same way.
 PhantomFiles writePhantom(const Phantom& phantom, const std::string& outDir,
                           const std::string& ext = ".nii.gz", const ProgressFn& progress = {},
-                          const std::string& prefix = "");
+                          const std::string& prefix = "", bool image = false);
 
 }  // namespace repose

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "repose/cage/CageBuilder.h"
+#include "repose/mesh/Refinement.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
 #include "repose/util/Progress.h"
@@ -55,6 +56,17 @@ int demotePiecesAcrossJoints(TransferMesh& mesh);
 RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparation>& separations,
                              const RigSettings& settings, const ProgressFn& progress = {},
                              const Volume* organs = nullptr);
+
+// The transfer mesh of buildRigGeometry (whole pieces, separations) refined for one posed cage
+// by the motion-adaptive loop (seed §4.2, refineTransferMesh): smaller tets where the Green
+// deformation distorts most, for `iterations` rounds of mesh, measure, shrink. `steps` (optional)
+// receives the error of each round's mesh.
+TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
+                           const Eigen::MatrixX3d& posedCage,
+                           const std::vector<LimbSeparation>& separations,
+                           const RigSettings& settings, int iterations,
+                           const ProgressFn& progress = {}, const Volume* organs = nullptr,
+                           std::vector<RefinementStep>* steps = nullptr);
 
 class PoseRig {
  public:
