@@ -279,12 +279,12 @@ bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int 
                            summary << ", maximum error " << std::setprecision(3)
                                    << steps->front().maxError << " -> " << steps->back().maxError;
                          this->LastRefinementSummary = summary.str();
-        this->RefinementVertices.clear();
-        this->RefinementErrors.clear();
-        for (const repose::RefinementStep& step : *steps) {
-          this->RefinementVertices.push_back(step.vertices);
-          this->RefinementErrors.push_back(step.maxError);
-        }
+                         this->RefinementVertices.clear();
+                         this->RefinementErrors.clear();
+                         for (const repose::RefinementStep& step : *steps) {
+                           this->RefinementVertices.push_back(step.vertices);
+                           this->RefinementErrors.push_back(step.maxError);
+                         }
                        };
                      });
     return true;
@@ -316,6 +316,33 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
     const std::shared_ptr<repose::TissueTable> tissues = tissuesFor(this->TissueTablePath, *G);
+    // Memory: the posed G, S and image and the displacement field (3 floats a voxel), refused
+    // above the budget with the numbers: first on the input's grid (here), then on the frame's
+    // (on the worker, before any voxel is written).
+    const double budget =
+        1048576.0 * (this->ParameterNode ? this->ParameterNode->GetOutputMemoryBudgetMB() : 4096);
+    const double bytesPerVoxel = double(repose::scalarSize(G->scalarType())) +
+                                 double(repose::scalarSize(S->scalarType())) + 12 +
+                                 (I ? double(repose::scalarSize(I->scalarType())) : 0);
+    auto checkBudget = [budget, bytesPerVoxel](std::int64_t voxels) {
+      const double need = double(voxels) * bytesPerVoxel;
+      if (need > budget) {
+        std::ostringstream m;
+        m << std::fixed << std::setprecision(2) << "the posed volumes need " << need / 1073741824.0
+          << " GiB for " << voxels << " voxels, more than the memory budget of "
+          << budget / 1073741824.0 << " GiB (Output > Memory budget; out of core: `repose warp`)";
+        throw repose::Error(m.str());
+      }
+    };
+    checkBudget(G->numVoxels());
+    // Where no tissue is, the image's own minimum (air in a CT), not 0.
+    double background = 0;
+    if (I)
+      repose::dispatchScalar(I->scalarType(), [&](auto* tag) {
+        using T = std::remove_pointer_t<decltype(tag)>;
+        const T* v = I->data<T>();
+        background = I->numVoxels() ? double(*std::min_element(v, v + I->numVoxels())) : 0.0;
+      });
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(
@@ -326,6 +353,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           const repose::PoseRig rig(std::move(geometry), pose, S->labels());
           const repose::PoseRig::Frame f = rig.frame(std::min(frame, rig.frameCount() - 1));
           const repose::VolumeGeometry grid = repose::deformedGrid(G->geometry(), f.deformed);
+          checkBudget(grid.numVoxels());
           repose::RasterOptions ro;
           const std::vector<std::uint8_t> outer = repose::outerFaces(rig.mesh());
           ro.outerFaces = &outer;
@@ -342,7 +370,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           std::shared_ptr<repose::Volume> posedI;
           if (I)
             posedI = std::make_shared<repose::Volume>(
-                repose::rasterizeImage(*I, rig.mesh(), f.deformed, grid, 0, ro));
+                repose::rasterizeImage(*I, rig.mesh(), f.deformed, grid, background, ro));
           auto field = std::make_shared<std::vector<float>>(
               repose::rasterizeDisplacement(rig.mesh(), f.deformed, G->geometry(), grid, ro));
           // As `repose pose` does: pockets a bent joint traps inside the body are filled.

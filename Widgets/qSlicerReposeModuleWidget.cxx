@@ -324,7 +324,7 @@ void qSlicerReposeModuleWidget::onJobTimer() {
   } else if (status == vtkSlicerReposeLogic::JobSucceeded) {
     d->JobStatus =
         finished == Step::Live
-            ? "Live: drag the angle, the views follow."
+            ? "Live: drag a handle in the 3D view or the angle; the views follow."
             : "Exported to " + QString::fromStdString(d->ParameterNode->GetOutputFolder());
   } else if (status == vtkSlicerReposeLogic::JobCancelled) {
     d->JobStatus = "Cancelled; nothing was written.";
@@ -544,7 +544,7 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   // Selection and body parts (of the live rig's S).
   const std::size_t selected = node ? node->GetSelectedCageVertices().size() : 0;
   d->SelectionInfoLabel->setText(
-      selected == 0 ? QString("none (Shift+click or Shift+drag on the cage in the 3D view)")
+      selected == 0 ? QString("none: Shift+click or Shift+drag the cage")
       : node->GetSelectedBodyPart() > 0
           ? QString("%1 cage vertices of part %2").arg(selected).arg(node->GetSelectedBodyPart())
           : QString("%1 cage vertices").arg(selected));
@@ -553,10 +553,13 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   if (d->PartComboBox->count() != int(parts.size()) ||
       (!parts.empty() && d->PartComboBox->itemData(0).toInt() != parts.front().first)) {
     const QSignalBlocker blocker(d->PartComboBox);
+    const QVariant chosen = d->PartComboBox->currentData();  // kept across a re-preparation
     d->PartComboBox->clear();
     for (const auto& [label, name] : parts)
       d->PartComboBox->addItem(QString("%1 (%2)").arg(QString::fromStdString(name)).arg(label),
                                label);
+    if (chosen.isValid() && d->PartComboBox->findData(chosen) >= 0)
+      d->PartComboBox->setCurrentIndex(d->PartComboBox->findData(chosen));
   }
   // Separation part choices (editable: a name or label can be typed before the rig exists).
   for (QComboBox* combo : {d->SeparatePartACombo, d->SeparatePartBCombo})

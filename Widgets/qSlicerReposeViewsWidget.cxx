@@ -22,6 +22,8 @@
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
 
 #include <QGridLayout>
 #include <QPainter>
@@ -49,6 +51,7 @@ class qSlicerReposeViewsWidgetPrivate {
   double SliceMilliseconds = 0;
   vtkMRMLReposePoseNode* CameraResetFor = nullptr;
   qSlicerReposeCageInteraction* CageInteraction = nullptr;
+  vtkSmartPointer<vtkTextActor> Timing;  // "frame … ms, slices … ms" in the 3D view's corner
   vtkSmartPointer<vtkLookupTable> Lookup;
   vtkMRMLReposePoseNode* LookupFor = nullptr;
 };
@@ -88,6 +91,12 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
   d->CageVertexActor->GetProperty()->SetPointSize(5);
   d->CageVertexActor->GetProperty()->SetColor(1.0, 0.9, 0.2);
   d->CageVertexActor->GetProperty()->LightingOff();
+  d->Timing = vtkSmartPointer<vtkTextActor>::New();
+  d->Timing->GetTextProperty()->SetFontSize(13);
+  d->Timing->GetTextProperty()->SetColor(0.1, 0.1, 0.2);  // on the light lower part
+  d->Timing->SetPosition(6, 6);
+  d->Timing->VisibilityOff();
+  d->Renderer->AddActor2D(d->Timing);
   // Slicer's 3D view camera: trackball; Shift+mouse selects cage vertices (CageInteraction).
   d->RenderWindow->GetInteractor()->SetInteractorStyle(
       vtkSmartPointer<vtkInteractorStyleTrackballCamera>::New());
@@ -180,6 +189,7 @@ void qSlicerReposeViewsWidget::refresh() {
   d->CageVertexActor->SetVisibility(pose != nullptr);
   d->SliceMilliseconds = 0;
   if (!pose) {
+    d->Timing->VisibilityOff();
     for (qSlicerReposeSliceView* view : d->Slices) view->setSlice(nullptr, nullptr);
     d->CameraResetFor = nullptr;
     d->CageInteraction->update();
@@ -217,6 +227,13 @@ void qSlicerReposeViewsWidget::refresh() {
       d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());
     d->Slices[o]->setSlice(slice, d->Lookup, image);
   }
+  // What a drag costs: the frame's solve (ARAP + Green + rigidity) and the three slices.
+  d->Timing->SetInput(QString("live frame %1 ms + slices %2 ms")
+                          .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
+                          .arg(d->SliceMilliseconds, 0, 'f', 1)
+                          .toUtf8()
+                          .constData());
+  d->Timing->VisibilityOn();
   if (d->CameraResetFor != pose) {
     d->CameraResetFor = pose;
     vtkCamera* camera = d->Renderer->GetActiveCamera();

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# `make demo`: the main job on generated phantoms. Generates the 2 mm phantom (and its
-# arms-touching variant), runs the standard pose suite of bench/poses/ with `repose pose`
-# (the cage and transfer mesh are built once per phantom and reused through a scene folder),
-# plots each report, and prints where everything is and which quality targets were met.
+# `make demo`: the main job on generated phantoms. Generates the 2 mm phantom with its synthetic
+# CT (and its arms-touching variant), runs the standard pose suite of bench/poses/ with
+# `repose pose` (the cage and transfer mesh are built once per phantom and reused through a
+# scene folder), plots each report, renders the workbench on the elbow scene (under xvfb-run),
+# and prints where everything is and which quality targets were met.
 set -euo pipefail
 BUILD_DIR=${1:-build}
 DEMO_DIR=${2:-$BUILD_DIR/demo}
@@ -11,16 +12,17 @@ POSES="$(dirname "$0")/../bench/poses"
 
 mkdir -p "$DEMO_DIR/poses"
 echo "== generating the 2 mm phantom in $DEMO_DIR/phantom"
-"$REPOSE" phantom --voxel 2 --out "$DEMO_DIR/phantom"
+"$REPOSE" phantom --voxel 2 --image --out "$DEMO_DIR/phantom"
 "$REPOSE" info "$DEMO_DIR/phantom/G.nii.gz" | head -8
 echo
 echo "== generating the arms-touching 2 mm phantom in $DEMO_DIR/phantom_touching"
-"$REPOSE" phantom --voxel 2 --arms-touching --out "$DEMO_DIR/phantom_touching"
+"$REPOSE" phantom --voxel 2 --image --arms-touching --out "$DEMO_DIR/phantom_touching"
 
 run_pose() {  # phantom-folder pose-name
   echo
   echo "== pose $2 on $1"
   "$REPOSE" pose --input "$DEMO_DIR/$1/G.nii.gz" --parts "$DEMO_DIR/$1/S.nii.gz" \
+    --image "$DEMO_DIR/$1/CT.nii.gz" --background -1000 \
     --pose "$POSES/$2.pose.json" --scene "$DEMO_DIR/$1/scene" --out "$DEMO_DIR/poses/$2"
 }
 for pose in elbow90 arm_raise90 leg_step30 walk; do run_pose phantom "$pose"; done
@@ -29,6 +31,29 @@ run_pose phantom_touching hand_from_hip
 echo
 echo "== plots"
 find "$DEMO_DIR/poses" -name report.json | sort | xargs /usr/bin/python3 "$(dirname "$0")/plot-report.py" | sed 's/^/  /'
+
+echo
+echo "== the workbench on the elbow scene (four views: slices of the posed labels over the CT, 3D)"
+if command -v xvfb-run >/dev/null; then
+  # The scene folder's pose is the last one posed on this phantom: write the elbow's beside it.
+  cp -r "$DEMO_DIR/phantom/scene" "$DEMO_DIR/scene_elbow90"
+  rm -f "$DEMO_DIR"/scene_elbow90/*.pose.json
+  cp "$POSES/elbow90.pose.json" "$DEMO_DIR/scene_elbow90/"
+  /usr/bin/python3 - "$DEMO_DIR/scene_elbow90/scene.json" <<'PY'
+import json, sys
+scene = json.load(open(sys.argv[1]))
+for node in scene["nodes"]:
+    if node["class"] == "vtkMRMLReposePoseNode":
+        node["FileName"] = "elbow90.pose.json"
+        node["name"] = "elbow90"
+json.dump(scene, open(sys.argv[1], "w"), indent=2)
+PY
+  xvfb-run -a -s "-screen 0 1600x1000x24" "$BUILD_DIR/bin/ReposeWorkbench" \
+    --scene "$DEMO_DIR/scene_elbow90" --screenshot "$DEMO_DIR/workbench_elbow90.png"
+  echo "  $DEMO_DIR/workbench_elbow90.png"
+else
+  echo "  skipped: xvfb-run is not installed (apt-get install xvfb)"
+fi
 
 echo
 echo "== quality targets (docs/QUALITY.md)"
@@ -47,5 +72,5 @@ for f, b, w, d, h, p, i, a in rows:
     print(f"  {f:28} {b:8.3f} {w:14.3f} {d:10.3f} {h:9d} {p:7d} {i:8d}  {'yes' if a else 'no'}")
 PY
 echo
-echo "Demo outputs are in $DEMO_DIR: phantom*/ (G, S, skeleton, scene/ with cage.vtk and tm.vtu),"
+echo "Demo outputs are in $DEMO_DIR: phantom*/ (G, S, CT, skeleton, scene/ with cage.vtk and tm.vtu),"
 echo "poses/<pose>[/<frame>]/ (posed_G.nii.gz, posed_S.nii.gz, transform.nrrd, report.json, *.png)."

@@ -69,13 +69,20 @@ int forearmPixels(const qSlicerReposeSliceView* coronal) {
   return n;
 }
 
+// The phantom of the 3D-view test: 8 mm in `make test`; scripts/guide-screenshots.sh runs it
+// at 4 mm (REPOSE_TEST_PHANTOM_MM) for the user guide's pictures.
+double phantomVoxelMm() {
+  const QByteArray mm = qgetenv("REPOSE_TEST_PHANTOM_MM");
+  return mm.isEmpty() ? 8.0 : std::max(1.0, mm.toDouble());
+}
+
 }  // namespace
 
 class qSlicerReposeViewsTest : public QObject {
   Q_OBJECT
  private slots:
   void posingThroughThePanelUpdatesTheViews() {
-    QTemporaryDir dir;
+    QTemporaryDir dir(QDir::tempPath() + "/phantom-XXXXXX");
     repose::PhantomOptions po;
     po.voxelMm = 8;
     const auto [organs, parts] = repose::Phantom(po).makeVolumes();
@@ -182,6 +189,7 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY2(panel->exportPose(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
     QVERIFY2(panel->jobStatusText().startsWith("Exported"), qPrintable(panel->jobStatusText()));
+    QVERIFY(window.grab().save(artifact("guide_4_exported.png")));
     for (const char* f : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd", "report.json"})
       QVERIFY2(QFileInfo::exists(out + "/" + f), f);
 
@@ -209,13 +217,15 @@ class qSlicerReposeViewsTest : public QObject {
   // transform widget then moves the hand outwards in one drag (its interaction events), the
   // coronal view shows the hand's labels where there was air, and one undo takes it back.
   void posingWithTheCageInTheThreeDView() {
-    QTemporaryDir dir;
+    QTemporaryDir dir(QDir::tempPath() + "/phantom-XXXXXX");
     repose::PhantomOptions po;
-    po.voxelMm = 8;
+    po.voxelMm = phantomVoxelMm();
     const auto [organs, parts] = repose::Phantom(po).makeVolumes();
     const QString G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz");
     repose::writeVolume(organs, G.toStdString());
     repose::writeVolume(parts, S.toStdString());
+    const QString CT = dir.filePath("CT.nii.gz");
+    repose::writeVolume(repose::syntheticCT(organs), CT.toStdString());
 
     vtkNew<vtkSlicerReposeLogic> logic;
     vtkNew<vtkMRMLReposeParametersNode> node;
@@ -234,12 +244,14 @@ class qSlicerReposeViewsTest : public QObject {
 
     QVERIFY(panel->setInputPath(G));
     node->SetBodyPartMapPath(S.toStdString());
+    node->SetImagePath(CT.toStdString());
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
     QVERIFY2(logic->GetLivePose() && logic->GetLivePose() == panel->activePose(),
              qPrintable(panel->jobStatusText()));
     qSlicerReposeCageInteraction* cage = views->cageInteraction();
     QVERIFY(!cage->transformWidget()->GetEnabled());  // no movable group yet
+    QVERIFY(window.grab().save(artifact("guide_1_rig_built.png")));
 
     int hand = 0;
     for (const auto& [label, name] : logic->GetLiveBodyParts())
@@ -284,6 +296,7 @@ class qSlicerReposeViewsTest : public QObject {
     panel->findChild<QToolButton*>("SelectPartButton")->click();
     QCOMPARE(node->GetSelectedCageVertices(), handVertices);
     QCOMPARE(node->GetSelectedBodyPart(), hand);
+    QVERIFY(window.grab().save(artifact("guide_2_part_selected.png")));
     panel->findChild<QPushButton*>("NewGroupButton")->click();
     QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("group 1"));
     panel->waitForJobs();
@@ -331,6 +344,7 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(logic->GetPoseGroupMatrix(panel->activePose(), "group 1", m));
     QVERIFY(std::abs(m->GetElement(0, 3) + 60) < 1e-6);
     QVERIFY(views->renderViews().save(artifact("views_hand_moved.png")));
+    QVERIFY(window.grab().save(artifact("guide_3_hand_moved.png")));
 
     // The drag is one undo step.
     panel->findChild<QToolButton*>("UndoButton")->click();

@@ -3,6 +3,7 @@
 // they were; pose edits undo and redo; a saved scene folder loaded into a new logic poses the
 // body bit for bit as the original did.
 #include "vtkMRMLReposeCageNode.h"
+#include "vtkMRMLReposeParametersNode.h"
 #include "vtkMRMLReposePoseNode.h"
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
@@ -202,4 +203,46 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
   for (const char* key : {"labels", "body", "distortion", "tet_volume_change", "mesh",
                           "rigid_tissues", "holes", "quality"})
     EXPECT_EQ(a[key], b[key]) << key;
+}
+
+// Output > Memory budget: an export whose posed volumes would not fit is refused before any work,
+// with the numbers, and writes nothing. The rig of the 8 mm phantom serves the 3 mm phantom's
+// segmentation (both are in the same RAS millimetres), so the test needs no 3 mm rig.
+TEST(vtkSlicerReposeLogicPipeline, AnExportAboveTheMemoryBudgetIsRefusedWithTheNumbers) {
+  PhantomFiles coarse;
+  repose::PhantomOptions po;
+  po.voxelMm = 3;
+  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+  const std::string G3 = coarse.dir.file("G3.nii.gz"), S3 = coarse.dir.file("S3.nii.gz");
+  repose::writeVolume(organs, G3);
+  repose::writeVolume(parts, S3);
+
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> parameters;
+  logic->SetParameterNode(parameters);
+  auto* seg = logic->AddSegmentation(coarse.G, coarse.S);
+  auto* pose = logic->AddPose(suite("elbow90"));
+  ASSERT_TRUE(seg && pose);
+  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  auto* fine = logic->AddSegmentation(G3, S3);
+  ASSERT_TRUE(fine);
+  pose->SetNodeReferenceID("segmentation", fine->GetID());
+
+  parameters->SetOutputMemoryBudgetMB(64);  // the 3 mm posed maps need about 84 MiB
+  const std::string out = coarse.dir.file("out");
+  EXPECT_FALSE(logic->StartApplyPose(pose, out));
+  const std::string message = logic->GetLastErrorMessage();
+  EXPECT_NE(message.find("memory budget of 0.06 GiB"), std::string::npos) << message;
+  EXPECT_NE(message.find(std::to_string(organs.numVoxels()) + " voxels"), std::string::npos)
+      << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos);
+  EXPECT_FALSE(logic->IsJobRunning());
+  EXPECT_FALSE(std::filesystem::exists(out));
+
+  parameters->SetOutputMemoryBudgetMB(1024);
+  ASSERT_TRUE(logic->StartApplyPose(pose, out)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  EXPECT_TRUE(std::filesystem::exists(out + "/posed_G.nii.gz"));
 }
