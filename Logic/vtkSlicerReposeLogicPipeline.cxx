@@ -153,15 +153,21 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {
   this->LastErrorMessage.clear();
   try {
     const repose::Pose pose = repose::readPoseFile(path);
-    auto node = vtkSmartPointer<vtkMRMLReposePoseNode>::New();
-    node->SetName(pose.name.empty() ? stemOf(path) : pose.name);
-    node->SetPoseJSON(repose::poseToJson(pose));
-    this->Scene->AddNode(node);
-    return node;
+    return this->AddPoseNode(pose.name.empty() ? stemOf(path) : pose.name,
+                             repose::poseToJson(pose));
   } catch (const std::exception& e) {
     this->LastErrorMessage = e.what();
     return nullptr;
   }
+}
+
+vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPoseNode(const std::string& name,
+                                                         const std::string& json) {
+  auto node = vtkSmartPointer<vtkMRMLReposePoseNode>::New();
+  node->SetName(name);
+  node->SetPoseJSON(json);
+  this->Scene->AddNode(node);
+  return node;
 }
 
 bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,

@@ -201,11 +201,7 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::NewPose(const std::string& name) {
     rest.select.rest = true;
     rest.fixed = true;
     pose.groups.push_back(rest);
-    auto node = vtkSmartPointer<vtkMRMLReposePoseNode>::New();
-    node->SetName(pose.name);
-    node->SetPoseJSON(repose::poseToJson(pose));
-    this->Scene->AddNode(node);
-    return node;
+    return this->AddPoseNode(pose.name, repose::poseToJson(pose));
   } catch (const std::exception& e) {
     this->LastErrorMessage = e.what();
     return nullptr;

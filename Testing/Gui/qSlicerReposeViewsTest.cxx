@@ -76,36 +76,55 @@ double phantomVoxelMm() {
   return mm.isEmpty() ? 8.0 : std::max(1.0, mm.toDouble());
 }
 
-}  // namespace
+// A phantom (organs G, parts S, synthetic CT) in a temporary folder, and the panel beside the
+// views, both on one logic and parameter node, as the workbench lays them out.
+struct Session {
+  QTemporaryDir dir{QDir::tempPath() + "/phantom-XXXXXX"};
+  QString G, S, CT;
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> node;
+  QWidget window;
+  qSlicerReposeModuleWidget* panel = new qSlicerReposeModuleWidget;
+  qSlicerReposeViewsWidget* views = new qSlicerReposeViewsWidget;
+  std::pair<repose::Volume, repose::Volume> volumes;
 
-class qSlicerReposeViewsTest : public QObject {
-  Q_OBJECT
- private slots:
-  void posingThroughThePanelUpdatesTheViews() {
-    QTemporaryDir dir(QDir::tempPath() + "/phantom-XXXXXX");
+  explicit Session(double voxelMm) {
     repose::PhantomOptions po;
-    po.voxelMm = 8;
-    const auto [organs, parts] = repose::Phantom(po).makeVolumes();
-    const QString G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz");
-    repose::writeVolume(organs, G.toStdString());
-    repose::writeVolume(parts, S.toStdString());
-    const QString CT = dir.filePath("CT.nii.gz");
-    repose::writeVolume(repose::syntheticCT(organs), CT.toStdString());
-
-    vtkNew<vtkSlicerReposeLogic> logic;
-    vtkNew<vtkMRMLReposeParametersNode> node;
-    QWidget window;
+    po.voxelMm = voxelMm;
+    volumes = repose::Phantom(po).makeVolumes();
+    G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz"), CT = dir.filePath("CT.nii.gz");
+    repose::writeVolume(volumes.first, G.toStdString());
+    repose::writeVolume(volumes.second, S.toStdString());
+    repose::writeVolume(repose::syntheticCT(volumes.first), CT.toStdString());
     auto* layout = new QHBoxLayout(&window);
-    auto* panel = new qSlicerReposeModuleWidget;
-    auto* views = new qSlicerReposeViewsWidget;
     layout->addWidget(panel);
     layout->addWidget(views, 1);
     panel->setLogic(logic);
     panel->setParameterNode(node);
     views->setLogic(logic);
     window.resize(1400, 900);
+  }
+  bool show() {
     window.show();
-    QVERIFY(QTest::qWaitForWindowExposed(&window));
+    return QTest::qWaitForWindowExposed(&window);
+  }
+};
+
+}  // namespace
+
+class qSlicerReposeViewsTest : public QObject {
+  Q_OBJECT
+ private slots:
+  void posingThroughThePanelUpdatesTheViews() {
+    Session session(8);
+    QVERIFY(session.show());
+    const QString &G = session.G, &S = session.S, &CT = session.CT;
+    QTemporaryDir& dir = session.dir;
+    vtkSlicerReposeLogic* logic = session.logic;
+    vtkMRMLReposeParametersNode* node = session.node;
+    QWidget& window = session.window;
+    qSlicerReposeModuleWidget* panel = session.panel;
+    qSlicerReposeViewsWidget* views = session.views;
 
     // A user's steps: the segmentation, its body parts, the pose; then Build.
     QVERIFY(panel->setInputPath(G));
@@ -217,30 +236,14 @@ class qSlicerReposeViewsTest : public QObject {
   // transform widget then moves the hand outwards in one drag (its interaction events), the
   // coronal view shows the hand's labels where there was air, and one undo takes it back.
   void posingWithTheCageInTheThreeDView() {
-    QTemporaryDir dir(QDir::tempPath() + "/phantom-XXXXXX");
-    repose::PhantomOptions po;
-    po.voxelMm = phantomVoxelMm();
-    const auto [organs, parts] = repose::Phantom(po).makeVolumes();
-    const QString G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz");
-    repose::writeVolume(organs, G.toStdString());
-    repose::writeVolume(parts, S.toStdString());
-    const QString CT = dir.filePath("CT.nii.gz");
-    repose::writeVolume(repose::syntheticCT(organs), CT.toStdString());
-
-    vtkNew<vtkSlicerReposeLogic> logic;
-    vtkNew<vtkMRMLReposeParametersNode> node;
-    QWidget window;
-    auto* layout = new QHBoxLayout(&window);
-    auto* panel = new qSlicerReposeModuleWidget;
-    auto* views = new qSlicerReposeViewsWidget;
-    layout->addWidget(panel);
-    layout->addWidget(views, 1);
-    panel->setLogic(logic);
-    panel->setParameterNode(node);
-    views->setLogic(logic);
-    window.resize(1400, 900);
-    window.show();
-    QVERIFY(QTest::qWaitForWindowExposed(&window));
+    Session session(phantomVoxelMm());
+    QVERIFY(session.show());
+    const QString &G = session.G, &S = session.S, &CT = session.CT;
+    vtkSlicerReposeLogic* logic = session.logic;
+    vtkMRMLReposeParametersNode* node = session.node;
+    QWidget& window = session.window;
+    qSlicerReposeModuleWidget* panel = session.panel;
+    qSlicerReposeViewsWidget* views = session.views;
 
     QVERIFY(panel->setInputPath(G));
     node->SetBodyPartMapPath(S.toStdString());

@@ -36,20 +36,33 @@ std::vector<std::uint8_t> voxels(vtkImageData* image) {
   return {p, p + a->GetNumberOfTuples()};
 }
 
+// The 8 mm phantom's G, S and synthetic CT written to a scratch folder.
+struct PhantomFolder {
+  ScratchDir dir;
+  repose::Volume organs;
+  std::string G, S, CT;
+  explicit PhantomFolder(const std::string& name) : dir(name) {
+    repose::PhantomOptions po;
+    po.voxelMm = 8;
+    auto maps = repose::Phantom(po).makeVolumes();
+    organs = std::move(maps.first);
+    G = dir.file("G.nii.gz"), S = dir.file("S.nii.gz"), CT = dir.file("CT.nii.gz");
+    repose::writeVolume(organs, G);
+    repose::writeVolume(maps.second, S);
+    repose::writeVolume(repose::syntheticCT(organs), CT);
+  }
+};
+
+const std::string kElbow = std::string(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json";
+
 }  // namespace
 
 TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
-  ScratchDir dir("live");
-  repose::PhantomOptions po;
-  po.voxelMm = 8;
-  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
-  repose::writeVolume(organs, dir.file("G.nii.gz"));
-  repose::writeVolume(parts, dir.file("S.nii.gz"));
-
+  const PhantomFolder phantom("live");
   vtkNew<vtkSlicerReposeLogic> logic;
-  auto* seg = logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"));
+  auto* seg = logic->AddSegmentation(phantom.G, phantom.S);
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
-  auto* pose = logic->AddPose(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json");
+  auto* pose = logic->AddPose(kElbow);
   ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
   // Before the rig there is nothing to prepare; without a live pose no slice.
   EXPECT_FALSE(logic->StartLivePose(pose));
@@ -97,13 +110,13 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
       double ras[3];
       bent->TransformIndexToPhysicalPoint(i, j, 0, ras);
       EXPECT_NEAR(ras[1], y, 1e-9);
-      const Eigen::Vector3d ijk = organs.geometry().rasToVoxel({ras[0], ras[1], ras[2]});
+      const Eigen::Vector3d ijk = phantom.organs.geometry().rasToVoxel({ras[0], ras[1], ras[2]});
       const std::int64_t a = std::lround(ijk.x()), c = std::lround(ijk.y()),
                          d = std::lround(ijk.z());
-      if (a < 0 || c < 0 || d < 0 || a >= organs.dims()[0] || c >= organs.dims()[1] ||
-          d >= organs.dims()[2])
+      if (a < 0 || c < 0 || d < 0 || a >= phantom.organs.dims()[0] ||
+          c >= phantom.organs.dims()[1] || d >= phantom.organs.dims()[2])
         continue;
-      const int expected = int(organs.valueAsDouble(organs.index(a, c, d)));
+      const int expected = int(phantom.organs.valueAsDouble(phantom.organs.index(a, c, d)));
       const int shown = s[std::size_t(i + dims[0] * j)];
       if (expected == 0 && shown == 0) continue;
       ++body;
@@ -125,17 +138,9 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
 // re-prepares for the new group, the body surface follows the hand and only near it, and undo
 // removes the group again.
 TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
-  ScratchDir dir("live-selection");
-  repose::PhantomOptions po;
-  po.voxelMm = 8;
-  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
-  repose::writeVolume(organs, dir.file("G.nii.gz"));
-  repose::writeVolume(parts, dir.file("S.nii.gz"));
-  repose::writeVolume(repose::syntheticCT(organs), dir.file("CT.nii.gz"));
-
+  const PhantomFolder phantom("live-selection");
   vtkNew<vtkSlicerReposeLogic> logic;
-  auto* seg =
-      logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"), dir.file("CT.nii.gz"));
+  auto* seg = logic->AddSegmentation(phantom.G, phantom.S, phantom.CT);
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
   vtkMRMLReposePoseNode* pose = logic->NewPose("from the view");
   ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
@@ -158,7 +163,7 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
     ASSERT_TRUE(logic->GetLiveImageWindow(window, level));
     EXPECT_EQ(window, 400);
     EXPECT_EQ(level, 40);
-    const repose::Volume table = repose::readVolume(dir.file("G.nii.gz"));
+    const repose::Volume table = repose::readVolume(phantom.G);
     auto labelOf = [&](const std::string& name) {
       for (const repose::Label& l : table.labels().labels())
         if (l.name == name) return l.value;
@@ -272,16 +277,11 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
 // the bones as whole pieces, and live posing continues on it. The Cage section's separation is
 // recorded in the pose (undoable), and a bad region is refused with a message.
 TEST(vtkSlicerReposeLogicLive, RefiningForTheFrameAndAddingASeparation) {
-  ScratchDir dir("live-refine");
-  repose::PhantomOptions po;
-  po.voxelMm = 8;
-  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
-  repose::writeVolume(organs, dir.file("G.nii.gz"));
-  repose::writeVolume(parts, dir.file("S.nii.gz"));
+  const PhantomFolder phantom("live-refine");
   vtkNew<vtkSlicerReposeLogic> logic;
-  auto* seg = logic->AddSegmentation(dir.file("G.nii.gz"), dir.file("S.nii.gz"));
+  auto* seg = logic->AddSegmentation(phantom.G, phantom.S);
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
-  auto* pose = logic->AddPose(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json");
+  auto* pose = logic->AddPose(kElbow);
   ASSERT_TRUE(pose);
   EXPECT_FALSE(logic->StartRefineMesh(pose));  // nothing to refine before the rig
   ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
