@@ -15,8 +15,10 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseFrame.h"
 #include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRig.h"
+#include "repose/pose/SceneFolder.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
@@ -35,10 +37,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-void writeJsonAtomically(const json& j, const std::string& path) {
-  writeTextFileAtomically(path, j.dump(2) + "\n");
-}
-
 // The default tissue table applies only to the phantom: every label of G must carry its name.
 std::optional<TissueTable> defaultTissues(const Volume& organs) {
   const std::string path = std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
@@ -46,71 +44,6 @@ std::optional<TissueTable> defaultTissues(const Volume& organs) {
   TissueTable t = readTissueTable(path);
   if (!tissueTableCovers(t, organs.labels())) return std::nullopt;
   return t;
-}
-
-// What a scene folder holds: the cage and transfer mesh built once for S with these settings.
-json sceneKey(const std::string& partsPath, const Pose& pose, const RigSettings& rs) {
-  json separations = json::parse(poseToJson(pose)).value("separations", json::array());
-  return {{"parts", fs::absolute(partsPath).string()},
-          {"parts_bytes", fs::file_size(partsPath)},
-          {"parts_mtime", fs::last_write_time(partsPath).time_since_epoch().count()},
-          {"cage_vertices", rs.cageVertices},
-          {"dilate_mm", rs.dilateMm},
-          {"mesh_size_mm", rs.meshMm},
-          {"rigid_labels", rs.rigidLabels},
-          {"whole_organs", rs.wholeOrgans},
-          {"separations", separations}};
-}
-
-// The scene folder of the module (docs/FORMATS.md, "Scene folders"): scene.json in the MRML
-// scene format, which the Logic and the workbench load, naming the input volumes where they are
-// (absolute paths: nothing large is copied), the cage, transfer mesh and pose written beside it,
-// and what the rig was built for, so the next run reuses it only for the same S and settings.
-void writeSceneFolder(const fs::path& scene, const PoseRig& rig, const json& key,
-                      const std::string& input, const std::string& parts, const std::string& image,
-                      const RigSettings& rs) {
-  fs::create_directories(scene);
-  writeTriangleMesh(rig.cage(), (scene / "cage.vtk").string());
-  writeTransferMesh(rig.mesh(), (scene / "tm.vtu").string());
-  const std::string poseFile = (rig.pose().name.empty() ? "pose" : rig.pose().name) + ".pose.json";
-  writePoseFile(rig.pose(), (scene / poseFile).string());
-  json groups = json::array();
-  for (std::size_t g = 0; g < rig.handles().size(); ++g)
-    groups.push_back(
-        {{"name", rig.pose().groups[g].name}, {"vertices", rig.handles()[g].cageVertices}});
-  const std::string seg = "vtkMRMLReposeSegmentationNode1", cage = "vtkMRMLReposeCageNode1",
-                    mesh = "vtkMRMLReposeTransferMeshNode1";
-  const json nodes = json::array(
-      {{{"class", "vtkMRMLReposeSegmentationNode"},
-        {"id", seg},
-        {"name", fs::path(input).filename().string()},
-        {"references", json::object()},
-        {"LabelMapFileName", fs::absolute(input).string()},
-        {"BodyPartMapFileName", fs::absolute(parts).string()},
-        {"ImageFileName", image.empty() ? "" : fs::absolute(image).string()}},
-       {{"class", "vtkMRMLReposeCageNode"},
-        {"id", cage},
-        {"name", "cage"},
-        {"references", {{"segmentation", seg}}},
-        {"FileName", "cage.vtk"},
-        {"TargetVertexCount", rs.cageVertices},
-        {"DilationMm", rs.dilateMm},
-        {"HandleGroups", groups}},
-       {{"class", "vtkMRMLReposeTransferMeshNode"},
-        {"id", mesh},
-        {"name", "transfer mesh"},
-        {"references", {{"cage", cage}, {"segmentation", seg}}},
-        {"FileName", "tm.vtu"},
-        {"SizeMm", rs.meshMm}},
-       {{"class", "vtkMRMLReposePoseNode"},
-        {"id", "vtkMRMLReposePoseNode1"},
-        {"name", rig.pose().name},
-        {"references", {{"cage", cage}, {"segmentation", seg}, {"transfer_mesh", mesh}}},
-        {"FileName", poseFile},
-        {"CurrentFrame", 0}}});
-  writeJsonAtomically(
-      {{"format", "repose-scene"}, {"version", 2}, {"nodes", nodes}, {"built_for", key}},
-      (scene / "scene.json").string());
 }
 
 }  // namespace
@@ -208,32 +141,15 @@ int runPose(const Args& args) {
       if (tissue.rigid) rs.rigidLabels.push_back(label);
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
   const std::vector<LimbSeparation> separations = resolveSeparations(pose, parts.labels());
-  const json key = sceneKey(p.get("parts"), pose, rs);
+  const std::string key = sceneRigKey(p.get("parts"), pose, rs);
+  std::optional<RigGeometry> fromScene;
+  if (p.has("scene")) fromScene = readSceneRig(p.get("scene"), key);
+  const bool reused = fromScene.has_value();
   RigGeometry geometry;
-  bool reused = false;
-  if (p.has("scene")) {
-    const fs::path scene = p.get("scene");
-    std::ifstream f(scene / "scene.json");
-    if (f) {
-      const json saved = json::parse(f, nullptr, false);
-      if (!saved.is_discarded() && saved.value("built_for", json()) == key) {
-        std::string cageFile, meshFile;
-        for (const json& node : saved.value("nodes", json::array())) {
-          if (node.value("class", "") == "vtkMRMLReposeCageNode")
-            cageFile = node.value("FileName", "");
-          if (node.value("class", "") == "vtkMRMLReposeTransferMeshNode")
-            meshFile = node.value("FileName", "");
-        }
-        if (!cageFile.empty() && !meshFile.empty()) {
-          geometry.cage = readTriangleMesh((scene / cageFile).string());
-          geometry.mesh = readTransferMesh((scene / meshFile).string());
-          reused = true;
-          say("reusing the cage and transfer mesh of " + scene.string());
-        }
-      }
-    }
-  }
-  if (!reused) {
+  if (reused) {
+    geometry = std::move(*fromScene);
+    say("reusing the cage and transfer mesh of " + p.get("scene"));
+  } else {
     say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
     geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress(),
                                 &organs);
@@ -241,93 +157,41 @@ int runPose(const Args& args) {
   say("embedding the mesh in the cage");
   const PoseRig rig(std::move(geometry), pose, parts.labels(), threads, jointRings);
   if (p.has("scene") && !reused)
-    writeSceneFolder(p.get("scene"), rig, key, p.get("input"), p.get("parts"),
-                     p.has("image") ? p.get("image") : "", rs);
-  const TriangleMesh& cage = rig.cage();
-  const TransferMesh& mesh = rig.mesh();
-  std::vector<std::string> groupNames;
-  for (const PoseGroup& g : pose.groups) groupNames.push_back(g.name);
-
-  // The whole pieces of the mesh (bones, organs), for the report.
-  std::set<int> pieceLabels;
-  std::int64_t pieceTets = 0;
-  for (const int label : mesh.rigid)
-    if (label != 0) pieceLabels.insert(label), ++pieceTets;
+    writeSceneFolder(p.get("scene"), rig, key,
+                     {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""}, rs);
   const bool oneFrame = rig.frameCount() == 1;
-  const std::vector<std::uint8_t> outer = outerFaces(mesh);  // the rest mesh's: once per job
   fs::create_directories(outDir);
+  PoseFrameOptions fo;
+  fo.image = image ? &*image : nullptr;
+  fo.background = p.getDouble("background");
+  fo.tissues = tissues ? &*tissues : nullptr;
+  fo.tissueTableName = p.has("tissues") ? p.get("tissues") : "phantom default";
+  fo.fillPockets = !p.has("keep-pockets");
+  fo.threads = threads;
   json summary = json::array();
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {
-    const PoseRig::Frame frame = rig.frame(index);
-    const std::string& frameName = frame.name;
-    const Eigen::MatrixX3d& deformed = frame.deformed;
-    const VolumeGeometry grid = deformedGrid(organs.geometry(), deformed);
-    // Memory: the posed G and S, the image and the field (3 floats per voxel) beside the inputs.
-    const double outVoxels = double(grid.numVoxels());
-    const double need = outVoxels * (double(scalarSize(organs.scalarType())) +
-                                     double(scalarSize(parts.scalarType())) + 12 +
-                                     (image ? double(scalarSize(image->scalarType())) : 0));
-    if (peakResidentBytes() + need > budget)
-      throw Error(outDir + ": frame " + frameName + " needs " + gib(need) + " for " +
-                  std::to_string(grid.numVoxels()) + " output voxels beyond the " +
-                  gib(peakResidentBytes()) + " in use, more than the budget of " + gib(budget) +
-                  " (out-of-core posing: `repose warp`)");
+    const std::string frameName = rig.frameName(index);
+    // Memory: the posed G and S, the image and the field beside the inputs, refused above the
+    // budget before anything is allocated.
+    fo.checkGrid = [&](const VolumeGeometry& grid) {
+      const double need = double(grid.numVoxels()) * posedBytesPerVoxel(organs, parts, fo.image);
+      if (peakResidentBytes() + need > budget)
+        throw Error(outDir + ": frame " + frameName + " needs " + gib(need) + " for " +
+                    std::to_string(grid.numVoxels()) + " output voxels beyond the " +
+                    gib(peakResidentBytes()) + " in use, more than the budget of " + gib(budget) +
+                    " (out-of-core posing: `repose warp`)");
+      say("frame " + frameName + ": " + std::to_string(grid.dims[0]) + " x " +
+          std::to_string(grid.dims[1]) + " x " + std::to_string(grid.dims[2]) + " voxels");
+    };
+    fo.progress = quiet ? ProgressFn{} : terminalProgress();
+    PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
+    json report = json::parse(posed.reportJson);
+    report["input"] = p.get("input");
+    report["scene_reused"] = reused;
+    report["joint_rings"] = jointRings;
+    posed.reportJson = report.dump();
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
-    fs::create_directories(dir);
-    say("frame " + frameName + ": " + std::to_string(grid.dims[0]) + " x " +
-        std::to_string(grid.dims[1]) + " x " + std::to_string(grid.dims[2]) + " voxels");
-    RasterOptions ro;
-    ro.threads = threads;
-    ro.progress = quiet ? ProgressFn{} : terminalProgress();
-    ro.outerFaces = &outer;
-    RasterReport raster;
-    Volume posedOrgans = rasterizeLabels(organs, mesh, deformed, grid, ro, &raster);
-    ro.progress = {};
-    Volume posedParts = rasterizeLabels(parts, mesh, deformed, grid, ro);
-    const std::vector<float> field =
-        rasterizeDisplacement(mesh, deformed, organs.geometry(), grid, ro);
-    PocketReport pockets;
-    if (!p.has("keep-pockets")) pockets = fillPosePockets(posedOrgans, organs, field, &posedParts);
-    writeVolume(posedOrgans, (dir / "posed_G.nii.gz").string());
-    writeVolume(posedParts, (dir / "posed_S.nii.gz").string());
-    if (image)
-      writeVolume(rasterizeImage(*image, mesh, deformed, grid, p.getDouble("background"), ro),
-                  (dir / "posed_image.nii.gz").string());
-    writeDisplacementFieldNrrd(field, grid, (dir / "transform.nrrd").string());
-
-    PoseReportInput ri;
-    ri.organs = &organs, ri.parts = &parts;
-    ri.posedOrgans = &posedOrgans, ri.posedParts = &posedParts;
-    ri.mesh = &mesh, ri.tetMaps = &frame.tetMaps, ri.handles = &frame.handles;
-    ri.groupNames = groupNames;
-    ri.tissues = tissues ? &*tissues : nullptr;
-    ri.outlierVertices = rig.deformation().embedding().outliers();
-    ri.rigidVertices = rig.influence().rigidVertices();
-    json report = {{"pose", pose.name},
-                   {"frame", frameName},
-                   {"input", p.get("input")},
-                   {"outputs",
-                    {{"posed_labels", "posed_G.nii.gz"},
-                     {"posed_parts", "posed_S.nii.gz"},
-                     {"transform", "transform.nrrd"}}},
-                   {"grid",
-                    {{"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}},
-                     {"spacing_mm", {grid.spacing()[0], grid.spacing()[1], grid.spacing()[2]}}}},
-                   {"cage_vertices", cage.vertices.rows()},
-                   {"scene_reused", reused},
-                   {"joint_rings", jointRings},
-                   {"whole_pieces", {{"labels", pieceLabels}, {"tets", pieceTets}}},
-                   {"tissue_table",
-                    tissues ? (p.has("tissues") ? p.get("tissues") : "phantom default") : "none"},
-                   {"voxels_in_shell", raster.shellVoxels},
-                   {"raster_inverted_tets", raster.invertedTets},
-                   {"pockets",
-                    {{"filled_voxels", pockets.filled},
-                     {"kept_cavity_voxels", pockets.keptCavities},
-                     {"filled", !p.has("keep-pockets")}}}};
-    report.update(json::parse(poseReportJson(ri)));
-    if (image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
-    writeJsonAtomically(report, (dir / "report.json").string());
+    writePosedFrame(posed, dir.string());
     const json& q = report["quality"];
     say("  body volume " + std::to_string(report["body"]["volume_change_percent"].get<double>()) +
         " %, worst label " +

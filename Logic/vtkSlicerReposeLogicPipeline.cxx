@@ -18,6 +18,7 @@
 #include <repose/io/MeshIO.h>
 #include <repose/io/NrrdIO.h>
 #include <repose/io/VolumeIO.h>
+#include <repose/pose/PoseFrame.h>
 #include <repose/pose/PoseReport.h>
 #include <repose/pose/PoseRig.h>
 #include <repose/raster/PocketFilling.h>
@@ -322,14 +323,14 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
     const std::shared_ptr<repose::TissueTable> tissues = tissuesFor(this->TissueTablePath, *G);
+    const std::string tissueTableName =
+        this->TissueTablePath.empty() ? "phantom default" : this->TissueTablePath;
     // Memory: the posed G, S and image and the displacement field (3 floats a voxel), refused
     // above the budget with the numbers: first on the input's grid (here), then on the frame's
     // (on the worker, before any voxel is written).
     const double budget =
         1048576.0 * (this->ParameterNode ? this->ParameterNode->GetOutputMemoryBudgetMB() : 4096);
-    const double bytesPerVoxel = double(repose::scalarSize(G->scalarType())) +
-                                 double(repose::scalarSize(S->scalarType())) + 12 +
-                                 (I ? double(repose::scalarSize(I->scalarType())) : 0);
+    const double bytesPerVoxel = repose::posedBytesPerVoxel(*G, *S, I.get());
     auto checkBudget = [budget, bytesPerVoxel](std::int64_t voxels) {
       const double need = double(voxels) * bytesPerVoxel;
       if (need > budget) {
@@ -357,67 +358,35 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
             const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
           repose::reportProgress(progress, 0, "embedding");
           const repose::PoseRig rig(std::move(geometry), pose, S->labels());
-          const repose::PoseRig::Frame f = rig.frame(std::min(frame, rig.frameCount() - 1));
-          const repose::VolumeGeometry grid = repose::deformedGrid(G->geometry(), f.deformed);
-          checkBudget(grid.numVoxels());
-          repose::RasterOptions ro;
-          const std::vector<std::uint8_t> outer = repose::outerFaces(rig.mesh());
-          ro.outerFaces = &outer;
-          ro.progress = [&](double x, const std::string& stage) {
-            return progress(0.1 + 0.6 * x, stage);
+          // The frame as `repose pose` poses it (one implementation: repose::poseFrame).
+          repose::PoseFrameOptions fo;
+          fo.image = I.get();
+          fo.background = background;
+          fo.tissues = tissues.get();
+          fo.tissueTableName = tissueTableName;
+          fo.checkGrid = [&](const repose::VolumeGeometry& grid) { checkBudget(grid.numVoxels()); };
+          fo.progress = [&](double x, const std::string& stage) {
+            return progress(0.1 + 0.8 * x, stage);
           };
-          auto posedG = std::make_shared<repose::Volume>(
-              repose::rasterizeLabels(*G, rig.mesh(), f.deformed, grid, ro));
-          ro.progress = [&](double x, const std::string& stage) {
-            return progress(0.7 + 0.1 * x, stage);
-          };
-          auto posedS = std::make_shared<repose::Volume>(
-              repose::rasterizeLabels(*S, rig.mesh(), f.deformed, grid, ro));
-          std::shared_ptr<repose::Volume> posedI;
-          if (I)
-            posedI = std::make_shared<repose::Volume>(
-                repose::rasterizeImage(*I, rig.mesh(), f.deformed, grid, background, ro));
-          auto field = std::make_shared<std::vector<float>>(
-              repose::rasterizeDisplacement(rig.mesh(), f.deformed, G->geometry(), grid, ro));
-          // As `repose pose` does: pockets a bent joint traps inside the body are filled.
-          const repose::PocketReport pockets =
-              repose::fillPosePockets(*posedG, *G, *field, posedS.get());
-          // The report `repose pose` writes, for the same frame.
-          auto report = std::make_shared<std::string>();
+          auto f = std::make_shared<repose::PosedFrame>(
+              repose::poseFrame(rig, std::min(frame, rig.frameCount() - 1), *G, *S, fo));
+          // Written here, on the worker: past the rasterization nothing can cancel the job, and
+          // the files are atomic, so a cancelled export still leaves the folder as it was.
           if (!outputFolder.empty()) {
-            repose::PoseReportInput ri;
-            ri.organs = G.get(), ri.parts = S.get();
-            ri.posedOrgans = posedG.get(), ri.posedParts = posedS.get();
-            ri.mesh = &rig.mesh(), ri.tetMaps = &f.tetMaps, ri.handles = &f.handles;
-            for (const repose::PoseGroup& g : pose.groups) ri.groupNames.push_back(g.name);
-            ri.tissues = tissues ? tissues.get() : nullptr;
-            ri.outlierVertices = rig.deformation().embedding().outliers();
-            ri.rigidVertices = rig.influence().rigidVertices();
-            nlohmann::json j = {{"pose", pose.name},
-                                {"frame", f.name},
-                                {"grid", {{"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}}}},
-                                {"pockets",
-                                 {{"filled_voxels", pockets.filled},
-                                  {"kept_cavity_voxels", pockets.keptCavities}}}};
-            j.update(nlohmann::json::parse(repose::poseReportJson(ri)));
-            *report = j.dump(2) + "\n";
+            nlohmann::json report = nlohmann::json::parse(f->reportJson);
+            report["input"] = segRef->GetLabelMapFileName();
+            report["scene_reused"] = true;  // the rig of the scene's nodes
+            report["joint_rings"] = pose.jointRings;
+            f->reportJson = report.dump();
+            repose::writePosedFrame(*f, outputFolder);
           }
           repose::reportProgress(progress, 1, "posed");
           return [=] {
-            if (!outputFolder.empty()) {
-              fs::create_directories(outputFolder);
-              const fs::path out = outputFolder;
-              repose::writeVolume(*posedG, (out / "posed_G.nii.gz").string());
-              repose::writeVolume(*posedS, (out / "posed_S.nii.gz").string());
-              if (posedI) repose::writeVolume(*posedI, (out / "posed_image.nii.gz").string());
-              repose::writeDisplacementFieldNrrd(*field, grid, (out / "transform.nrrd").string());
-              repose::writeTextFileAtomically((out / "report.json").string(), *report);
-            }
             auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
-            node->SetName(segRef->GetName() + " " + f.name);
-            node->SetLabelMap(Conversion::ToImageData(*posedG));
-            node->SetBodyPartMap(Conversion::ToImageData(*posedS));
-            if (posedI) node->SetImage(Conversion::ToImageData(*posedI));
+            node->SetName(segRef->GetName() + " " + f->name);
+            node->SetLabelMap(Conversion::ToImageData(f->organs));
+            node->SetBodyPartMap(Conversion::ToImageData(f->parts));
+            if (f->image) node->SetImage(Conversion::ToImageData(*f->image));
             node->SetNodeReferenceID("source", segRef->GetID());
             node->SetNodeReferenceID("pose", poseRef->GetID());
             this->Scene->AddNode(node);

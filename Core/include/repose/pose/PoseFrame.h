@@ -1,0 +1,56 @@
+// One frame of a rigged pose at full resolution — what `repose pose`, the module's export and the
+// Python bindings all produce: the posed organ map G and body-part map S (and image) on a grid that
+// holds the posed body, the displacement field (output -> input), background pockets a bent joint
+// trapped filled, and the frame's report (report.json, docs/FORMATS.md).
+#pragma once
+
+#include "repose/pose/PoseRig.h"
+#include "repose/util/Progress.h"
+#include "repose/volume/TissueTable.h"
+#include "repose/volume/Volume.h"
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace repose {
+
+struct PoseFrameOptions {
+  const Volume* image = nullptr;         // on G's grid, posed alongside (trilinear)
+  double background = 0;                 // the image's value where no tissue is
+  const TissueTable* tissues = nullptr;  // densities and rigid labels; null: no masses
+  std::string tissueTableName = "none";  // how the report names the table
+  bool fillPockets = true;               // docs/QUALITY.md
+  double spacingMm = 0;                  // output voxel size; 0: the input's spacing
+  int threads = 0;
+  ProgressFn progress;  // rasterizing G (the long part); may cancel
+  // Called with the output grid before anything is allocated for it: a memory budget's check
+  // (throw to refuse the frame).
+  std::function<void(const VolumeGeometry& grid)> checkGrid;
+};
+
+struct PosedFrame {
+  std::string name;
+  VolumeGeometry grid;
+  Volume organs, parts;
+  std::optional<Volume> image;
+  std::vector<float> field;  // 3 floats a voxel, RAS mm from the voxel to its rest position
+  std::string reportJson;    // the report.json object (the caller may add what it knows)
+};
+
+// Bytes a posed frame holds per output voxel (G, S, image, field): budgets check this times the
+// grid's voxels before posing.
+double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volume* image);
+
+// The frame `index` of the rig, posed. G and S are the rig's inputs at rest (S's labels name the
+// parts). Throws repose::Error, or Cancelled when the progress callback says so.
+PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs,
+                     const Volume& parts, const PoseFrameOptions& options = {});
+
+// Writes the frame into `folder` (created; its parent must exist): posed_G.nii.gz,
+// posed_S.nii.gz, posed_image.nii.gz (with an image), transform.nrrd and report.json, each
+// atomically.
+void writePosedFrame(const PosedFrame& frame, const std::string& folder);
+
+}  // namespace repose
