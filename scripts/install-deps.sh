@@ -9,6 +9,7 @@ PACKAGES=(
   libnifti2-dev libteem-dev libgdcm-dev
   libvtk9-dev libvtk9-qt-dev qtbase5-dev
   nlohmann-json3-dev libgtest-dev libbenchmark-dev
+  python3-dev pybind11-dev
   python3-numpy python3-nibabel python3-pytest python3-matplotlib python3-jsonschema
   xvfb xauth
 )

@@ -1,0 +1,394 @@
+// Poses, rigs and posed frames in Python: pose files read, edited and written; a rig (cage and
+// transfer mesh, built or taken from a scene folder) prepared for a pose; each frame posed in
+// core (PosedFrame: volumes, field, report) or its labels streamed out of core to a NIfTI file.
+#include "PythonCommon.h"
+
+#include "repose/io/MeshIO.h"
+#include "repose/io/SliceCache.h"
+#include "repose/io/VolumeIO.h"
+#include "repose/pose/Pose.h"
+#include "repose/pose/PoseFrame.h"
+#include "repose/pose/PoseReport.h"
+#include "repose/pose/PoseRig.h"
+#include "repose/pose/SceneFolder.h"
+#include "repose/raster/Rasterizer.h"
+#include "repose/util/Error.h"
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <filesystem>
+#include <optional>
+
+namespace repose::python {
+
+namespace {
+
+// A rig as Python holds it: the prepared PoseRig and what it was built with.
+struct Rig {
+  std::unique_ptr<PoseRig> rig;
+  RigSettings settings;
+  std::optional<TissueTable> tissues;
+  std::string tissueTableName = "none";
+  int jointRings = -1;
+};
+
+// Runs `work` with the GIL released and the callback bridged; a cancellation raised by the
+// callback (or Ctrl+C) comes back as that Python exception, else as repose.Cancelled.
+template <class F>
+auto withProgress(const py::object& progress, F&& work) {
+  PythonProgress p(progress);
+  try {
+    py::gil_scoped_release release;
+    return work(p.fn());
+  } catch (const Cancelled&) {
+    p.rethrow();
+    throw;
+  }
+}
+
+PoseTransform transformFrom(const py::dict& t, const PoseTransform& base) {
+  PoseTransform out = base;
+  if (t.contains("axis")) out.axis = t["axis"].cast<Eigen::Vector3d>();
+  if (t.contains("angle_deg")) out.angleDeg = t["angle_deg"].cast<double>();
+  if (t.contains("pivot")) out.pivot = t["pivot"].cast<Eigen::Vector3d>();
+  if (t.contains("translation")) out.translation = t["translation"].cast<Eigen::Vector3d>();
+  if (!(out.axis.norm() > 0) || !out.axis.allFinite()) throw Error("the rotation axis is zero");
+  out.axis.normalize();
+  return out;
+}
+
+py::dict transformTo(const PoseTransform& t) {
+  py::dict d;
+  d["axis"] = Eigen::Vector3d(t.axis);
+  d["angle_deg"] = t.angleDeg;
+  d["pivot"] = Eigen::Vector3d(t.pivot);
+  d["translation"] = Eigen::Vector3d(t.translation);
+  return d;
+}
+
+PoseGroup& groupNamed(Pose& pose, const std::string& name) {
+  for (PoseGroup& g : pose.groups)
+    if (g.name == name) return g;
+  throw Error("pose " + pose.name + ": no group \"" + name + "\"");
+}
+
+PoseKeyframe* keyframeNamed(Pose& pose, const py::object& keyframe) {
+  if (keyframe.is_none()) return nullptr;
+  if (py::isinstance<py::int_>(keyframe)) {
+    const int k = keyframe.cast<int>();
+    if (k < 0 || std::size_t(k) >= pose.keyframes.size())
+      throw Error("pose " + pose.name + " has " + std::to_string(pose.keyframes.size()) +
+                  " keyframes, not " + std::to_string(k + 1));
+    return &pose.keyframes[std::size_t(k)];
+  }
+  const std::string name = keyframe.cast<std::string>();
+  for (PoseKeyframe& k : pose.keyframes)
+    if (k.name == name) return &k;
+  throw Error("pose " + pose.name + ": no keyframe \"" + name + "\"");
+}
+
+Eigen::MatrixX3d verticesOf(const Eigen::MatrixX3d& v) {
+  return v;
+}
+
+// The tissue table of a rig: the file at `path`, used only when it covers G's labels if
+// `ifCovering` (the phantom's default table); its rigid labels become whole pieces.
+void applyTissues(Rig& r, const Volume& organs, const std::string& path, bool ifCovering) {
+  if (path.empty()) return;
+  TissueTable t = readTissueTable(path);
+  if (ifCovering && !tissueTableCovers(t, organs.labels())) return;
+  r.tissues = std::move(t);
+  r.tissueTableName = ifCovering ? "phantom default" : path;
+  r.settings.rigidLabels.clear();
+  for (const auto& [label, tissue] : *r.tissues)
+    if (tissue.rigid) r.settings.rigidLabels.push_back(label);
+}
+
+}  // namespace
+
+void bindPoses(py::module_& m) {
+  py::class_<Pose>(m, "Pose", R"doc(
+A pose file (docs/POSES.md): named handle groups of the cage, each a rigid transform or fixed,
+optional keyframes and limb separations. Read with Pose.read or Pose.from_json; edit with
+set_transform; write with write.)doc")
+      .def_static("read", &readPoseFile, py::arg("path"),
+                  "Reads and validates a .pose.json (repose.Error names the field on failure).")
+      .def_static(
+          "from_json",
+          [](const std::string& text, const std::string& source) {
+            return parsePose(text, source);
+          },
+          py::arg("text"), py::arg("source") = "pose")
+      .def("to_json", &poseToJson)
+      .def(
+          "write", [](const Pose& p, const std::string& path) { writePoseFile(p, path); },
+          py::arg("path"), "Writes the pose (atomically).")
+      .def_property_readonly("name", [](const Pose& p) { return p.name; })
+      .def_property_readonly(
+          "groups",
+          [](const Pose& p) {
+            std::vector<std::string> names;
+            for (const PoseGroup& g : p.groups) names.push_back(g.name);
+            return names;
+          },
+          "The handle groups' names, in order.")
+      .def_property_readonly("keyframes",
+                             [](const Pose& p) {
+                               std::vector<std::string> names;
+                               for (const PoseKeyframe& k : p.keyframes) names.push_back(k.name);
+                               return names;
+                             })
+      .def_property_readonly(
+          "frame_names",
+          [](const Pose& p) {
+            std::vector<std::string> names;
+            for (const auto& f : p.frames()) names.push_back(f.first);
+            return names;
+          },
+          "One name per frame: the keyframes', or the pose's own.")
+      .def(
+          "transform",
+          [](Pose& p, const std::string& group, const py::object& keyframe) {
+            PoseGroup& g = groupNamed(p, group);
+            if (PoseKeyframe* k = keyframeNamed(p, keyframe))
+              for (const auto& [name, t] : k->transforms)
+                if (name == group) return transformTo(t);
+            return transformTo(g.transform);
+          },
+          py::arg("group"), py::arg("keyframe") = py::none(),
+          "The group's transform {axis, angle_deg, pivot, translation} (in a keyframe, or the "
+          "base pose).")
+      .def(
+          "set_transform",
+          [](Pose& p, const std::string& group, const py::object& keyframe, const py::kwargs& kw) {
+            PoseGroup& g = groupNamed(p, group);
+            if (g.fixed) throw Error("pose " + p.name + ": group \"" + group + "\" is fixed");
+            PoseKeyframe* k = keyframeNamed(p, keyframe);
+            if (!k) {
+              g.transform = transformFrom(kw, g.transform);
+              return;
+            }
+            for (auto& [name, t] : k->transforms)
+              if (name == group) {
+                t = transformFrom(kw, t);
+                return;
+              }
+            k->transforms.emplace_back(group, transformFrom(kw, g.transform));
+          },
+          py::arg("group"), py::arg("keyframe") = py::none(),
+          "Sets any of axis=, angle_deg=, pivot=, translation= of the group's transform (in a "
+          "keyframe by index or name, or the base pose).")
+      .def("__repr__", [](const Pose& p) {
+        return "<repose.Pose " + p.name + ": " + std::to_string(p.groups.size()) + " groups, " +
+               std::to_string(p.frames().size()) + " frames>";
+      });
+
+  py::class_<PosedFrame>(m, "PosedFrame", R"doc(
+One frame posed at full resolution: `organs` (posed G), `parts` (posed S), `image` (or None),
+`field` (the displacement field, output -> input, RAS mm, shape (I, J, K, 3)), `report` (the
+report.json dict: volumes, masses, distortion, bone rigidity, quality targets).)doc")
+      .def_readonly("name", &PosedFrame::name)
+      .def_readonly("organs", &PosedFrame::organs)
+      .def_readonly("parts", &PosedFrame::parts)
+      .def_property_readonly("image",
+                             [](const PosedFrame& f) -> py::object {
+                               return f.image ? py::cast(*f.image) : py::none();
+                             })
+      .def_property_readonly("field",
+                             [](py::object self) {
+                               auto& f = self.cast<PosedFrame&>();
+                               const auto& d = f.grid.dims;
+                               const py::ssize_t s = sizeof(float);
+                               return py::array_t<float>(
+                                   {d[0], d[1], d[2], std::int64_t(3)},
+                                   {3 * s, 3 * s * d[0], 3 * s * d[0] * d[1], s}, f.field.data(),
+                                   self);
+                             })
+      .def_property_readonly("report",
+                             [](const PosedFrame& f) {
+                               return py::module_::import("json").attr("loads")(f.reportJson);
+                             })
+      .def(
+          "write",
+          [](const PosedFrame& f, const std::string& folder) {
+            py::gil_scoped_release release;
+            writePosedFrame(f, folder);
+          },
+          py::arg("folder"),
+          "Writes posed_G.nii.gz, posed_S.nii.gz, posed_image.nii.gz, transform.nrrd and "
+          "report.json into the folder, as `repose pose` does.");
+
+  py::class_<Rig>(m, "Rig", R"doc(
+A body rigged for a pose: the cage and transfer mesh (built from the body-part map S, with the
+separations the pose asks for, bones and one-part organs as whole pieces), embedded, the pose's
+groups resolved. Each frame of the pose is then a few solves: `deform` gives the posed cage and
+mesh, `pose_frame` the full-resolution volumes and report.)doc")
+      .def(py::init([](const Volume& organs, const Volume& parts, const Pose& pose,
+                       int cageVertices, double dilateMm, double meshMm,
+                       const std::string& tissuesPath, bool tissuesIfCovering, bool wholeOrgans,
+                       int jointRings, int threads, const py::object& progress) {
+             if (parts.dims() != organs.dims() ||
+                 !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
+               throw Error("the body-part map is not on the organ map's grid");
+             if (!isIntegerType(organs.scalarType()))
+               throw Error("the organ map holds float voxels, not labels");
+             auto r = std::make_unique<Rig>();
+             r->settings.cageVertices = cageVertices;
+             r->settings.dilateMm = dilateMm;
+             r->settings.meshMm = meshMm;
+             r->settings.threads = threads;
+             r->settings.wholeOrgans = wholeOrgans;
+             r->jointRings = jointRings;
+             applyTissues(*r, organs, tissuesPath, tissuesIfCovering);
+             withProgress(progress, [&](const ProgressFn& fn) {
+               const auto separations = resolveSeparations(pose, parts.labels());
+               RigGeometry g = buildRigGeometry(parts, separations, r->settings, fn, &organs);
+               r->rig = std::make_unique<PoseRig>(std::move(g), pose, parts.labels(), threads,
+                                                  jointRings);
+               return 0;
+             });
+             return r;
+           }),
+           py::arg("organs"), py::arg("parts"), py::arg("pose"), py::kw_only(),
+           py::arg("cage_vertices") = 300, py::arg("dilate_mm") = 10.0, py::arg("mesh_mm") = 0.0,
+           py::arg("_tissues_path") = "", py::arg("_tissues_if_covering") = false,
+           py::arg("whole_organs") = true, py::arg("joint_rings") = -1, py::arg("threads") = 0,
+           py::arg("progress") = py::none())
+      .def_property_readonly("frame_count", [](const Rig& r) { return r.rig->frameCount(); })
+      .def_property_readonly("frame_names",
+                             [](const Rig& r) {
+                               std::vector<std::string> names;
+                               for (std::size_t i = 0; i < r.rig->frameCount(); ++i)
+                                 names.push_back(r.rig->frameName(i));
+                               return names;
+                             })
+      .def_property_readonly("pose", [](const Rig& r) { return r.rig->pose(); })
+      .def_property_readonly(
+          "cage_vertices", [](const Rig& r) { return verticesOf(r.rig->cage().vertices); },
+          "Rest cage vertices (n x 3, RAS mm).")
+      .def_property_readonly("cage_faces", [](const Rig& r) { return r.rig->cage().faces; })
+      .def_property_readonly(
+          "mesh_vertices", [](const Rig& r) { return verticesOf(r.rig->mesh().vertices); },
+          "Rest transfer-mesh vertices (n x 3, RAS mm).")
+      .def_property_readonly("mesh_tets", [](const Rig& r) { return r.rig->mesh().tets; })
+      .def_property_readonly(
+          "tissue_table", [](const Rig& r) { return r.tissueTableName; },
+          "Which tissue table gives densities and bones ('phantom default', a path, or 'none').")
+      .def(
+          "deform",
+          [](const Rig& r, std::size_t index) {
+            PoseRig::Frame f;
+            {
+              py::gil_scoped_release release;
+              f = r.rig->frame(index);
+            }
+            return py::make_tuple(f.cage, f.deformed);
+          },
+          py::arg("index") = 0,
+          "The frame's posed cage and posed transfer-mesh vertices (RAS mm): the interactive "
+          "solve (ARAP + Green coordinates + rigidity), no voxels.")
+      .def(
+          "pose_frame",
+          [](const Rig& r, const Volume& organs, const Volume& parts, std::size_t index,
+             const py::object& image, double background, double spacingMm, bool fillPockets,
+             const py::object& progress) {
+            PoseFrameOptions o;
+            const Volume* img = image.is_none() ? nullptr : &image.cast<const Volume&>();
+            o.image = img;
+            o.background = background;
+            o.tissues = r.tissues ? &*r.tissues : nullptr;
+            o.tissueTableName = r.tissueTableName;
+            o.fillPockets = fillPockets;
+            o.spacingMm = spacingMm;
+            o.threads = r.settings.threads;
+            PosedFrame f = withProgress(progress, [&](const ProgressFn& fn) {
+              o.progress = fn;
+              return poseFrame(*r.rig, index, organs, parts, o);
+            });
+            return f;
+          },
+          py::arg("organs"), py::arg("parts"), py::arg("index") = 0, py::kw_only(),
+          py::arg("image") = py::none(), py::arg("background") = 0.0, py::arg("spacing_mm") = 0.0,
+          py::arg("fill_pockets") = true, py::arg("progress") = py::none(),
+          R"doc(Poses frame `index` at full resolution in core: the posed organ and part maps (and
+image), the displacement field and the report. spacing_mm: the output voxel size (0: the
+input's), e.g. 2 mm for an FDTD grid.)doc")
+      .def(
+          "pose_labels_to_file",
+          [](const Rig& r, const std::string& organsPath, const std::string& outPath,
+             std::size_t index, double memoryBytes, double spacingMm, const py::object& progress) {
+            if (!(memoryBytes >= 16.0 * 1048576))
+              throw Error("pose_labels_to_file: the memory budget must be at least 16 MiB");
+            withProgress(progress, [&](const ProgressFn& fn) {
+              const PoseRig::Frame f = r.rig->frame(index);
+              SliceCache cache(organsPath, std::size_t(memoryBytes / 2));
+              const VolumeGeometry grid =
+                  deformedGrid(cache.layout().geometry, f.deformed, spacingMm);
+              const std::vector<std::uint8_t> outer = outerFaces(r.rig->mesh());
+              RasterOptions ro;
+              ro.progress = fn;
+              ro.outerFaces = &outer;
+              rasterizeLabelsToFile(cache, r.rig->mesh(), f.deformed, grid, outPath,
+                                    std::size_t(memoryBytes / 4), ro);
+              return 0;
+            });
+          },
+          py::arg("organs_path"), py::arg("out_path"), py::arg("index") = 0, py::kw_only(),
+          py::arg("memory_bytes") = 1024.0 * 1048576, py::arg("spacing_mm") = 0.0,
+          py::arg("progress") = py::none(),
+          R"doc(Out of core: frame `index` of the NIfTI label map at organs_path posed straight
+into the NIfTI out_path, slab by slab, holding about memory_bytes (input slices and output
+slabs), so label maps larger than memory can be posed.)doc")
+      .def(
+          "save_scene",
+          [](const Rig& r, const std::string& folder, const std::string& organsPath,
+             const std::string& partsPath, const std::string& imagePath) {
+            const std::string key = sceneRigKey(partsPath, r.rig->pose(), r.settings);
+            writeSceneFolder(folder, *r.rig, key, {organsPath, partsPath, imagePath}, r.settings);
+          },
+          py::arg("folder"), py::arg("organs_path"), py::arg("parts_path"),
+          py::arg("image_path") = "",
+          "Writes a scene folder (scene.json, cage.vtk, tm.vtu, the pose) that the workbench "
+          "opens and `repose pose --scene` reuses; the inputs are named by path.");
+
+  m.def(
+      "_rig_from_scene",
+      [](const std::string& folder, const Volume& organs, const Volume& parts,
+         const py::object& pose, int jointRings, int threads, const std::string& tissuesPath,
+         bool tissuesIfCovering) {
+        SceneContents scene = readSceneFolder(folder);
+        auto r = std::make_unique<Rig>();
+        r->jointRings = jointRings;
+        r->settings.threads = threads;
+        applyTissues(*r, organs, tissuesPath, tissuesIfCovering);
+        const Pose p = pose.is_none() ? scene.pose : pose.cast<Pose>();
+        {
+          py::gil_scoped_release release;
+          r->rig = std::make_unique<PoseRig>(std::move(scene.geometry), p, parts.labels(), threads,
+                                             jointRings);
+        }
+        py::dict inputs;
+        inputs["organs"] = scene.inputs.organs;
+        inputs["parts"] = scene.inputs.parts;
+        inputs["image"] = scene.inputs.image;
+        return py::make_tuple(std::move(r), inputs);
+      },
+      py::arg("folder"), py::arg("organs"), py::arg("parts"), py::arg("pose") = py::none(),
+      py::arg("joint_rings") = -1, py::arg("threads") = 0, py::arg("_tissues_path") = "",
+      py::arg("_tissues_if_covering") = false);
+  m.def(
+      "_scene_inputs",
+      [](const std::string& folder) {
+        const SceneContents scene = readSceneFolder(folder);
+        py::dict inputs;
+        inputs["organs"] = scene.inputs.organs;
+        inputs["parts"] = scene.inputs.parts;
+        inputs["image"] = scene.inputs.image;
+        return inputs;
+      },
+      py::arg("folder"));
+}
+
+}  // namespace repose::python

@@ -1,0 +1,214 @@
+"""`import repose`: the bindings against nibabel (a reader we did not write), against the command
+line (same files, same messages), and as a script uses them: arrays in and out without copies,
+a rig posed in and out of core, scenes, progress and cancellation, and the two examples."""
+import os
+import pathlib
+import subprocess
+import sys
+import threading
+
+import nibabel as nib
+import numpy as np
+import pytest
+
+rp = pytest.importorskip("repose", reason="the bindings are built into build/python")
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+POSES = REPO / "bench" / "poses"
+
+
+@pytest.fixture(scope="module")
+def phantom():
+    return rp.make_phantom(8.0, image=True)
+
+
+@pytest.fixture(scope="module")
+def elbow_rig(phantom):
+    return rp.build_rig(phantom["organs"], phantom["parts"], rp.Pose.read(str(POSES / "elbow90.pose.json")))
+
+
+def test_version_is_the_projects():
+    cmake = (REPO / "CMakeLists.txt").read_text()
+    assert f"VERSION {rp.__version__}" in cmake
+
+
+def test_array_is_a_view_in_nibabel_order(phantom):
+    g = phantom["organs"]
+    a = g.array
+    assert a.shape == g.shape and a.flags["F_CONTIGUOUS"] and a.dtype == np.uint8
+    assert np.shares_memory(a, g.array)  # no copy on each access
+    copy = g.copy()
+    copy.array[0, 0, 0] = 77  # writes go into the volume
+    assert copy.array[0, 0, 0] == 77 and g.array[0, 0, 0] != 77
+
+
+def test_round_trip_with_nibabel_both_ways(tmp_path, phantom):
+    g = phantom["organs"]
+    # Repose -> file -> nibabel: same voxels and affine.
+    rp.write_volume(g, str(tmp_path / "g.nii.gz"))
+    img = nib.load(tmp_path / "g.nii.gz")
+    np.testing.assert_array_equal(np.asanyarray(img.dataobj), g.array)
+    np.testing.assert_allclose(img.affine, g.affine, atol=1e-5)
+    # nibabel array (another dtype, C order, an oblique affine) -> Repose -> nibabel: the same.
+    rng = np.random.default_rng(3)
+    data = np.ascontiguousarray(rng.integers(0, 300, size=(11, 7, 5)).astype(np.int64))
+    affine = np.array([[0, -1.3, 0, 20.0], [1.3, 0, 0, -4.5], [0, 0, 7.2, -804.5], [0, 0, 0, 1]])
+    v = rp.volume_from_array(data, affine, labels={1: "liver", 299: "spleen"})
+    assert v.dtype == np.uint16 and v.is_label_map
+    assert {l["name"] for l in v.labels} == {"liver", "spleen"}
+    np.testing.assert_array_equal(v.array, data)
+    np.testing.assert_allclose(v.spacing, [1.3, 1.3, 7.2])
+    out = rp.to_nibabel(v)
+    nib.save(out, tmp_path / "v.nii.gz")
+    back = nib.load(tmp_path / "v.nii.gz")
+    np.testing.assert_array_equal(np.asanyarray(back.dataobj), data)
+    np.testing.assert_allclose(back.affine, affine)
+    assert rp.read_volume(str(tmp_path / "v.nii.gz")).axis_codes == "".join(nib.aff2axcodes(affine))
+
+
+def test_bad_input_raises_the_command_lines_message(tmp_path, repose):
+    bad = tmp_path / "bad.nii.gz"
+    bad.write_bytes(b"not a nifti file at all")
+    with pytest.raises(rp.Error) as python_error:
+        rp.read_volume(str(bad))
+    cli = repose("info", bad, check=False)
+    assert cli.returncode != 0
+    assert str(python_error.value) in cli.stderr
+    assert "\n" not in str(python_error.value)
+    with pytest.raises(rp.Error, match="no such|cannot|not found|does not exist"):
+        rp.read_volume(str(tmp_path / "missing.nii.gz"))
+    with pytest.raises(rp.Error, match="angle_deg"):
+        rp.Pose.from_json('{"format": "repose-pose", "version": 1, "name": "x", "groups":'
+                          ' [{"name": "a", "select": {"rest": true}, "rotation": {"axis":'
+                          ' [1,0,0], "angle_deg": "ninety", "pivot": [0,0,0]}}]}', "x.pose.json")
+    with pytest.raises(rp.Error, match="expected 3 dimensions"):
+        rp.volume_from_array(np.zeros((4, 4)), np.eye(4))
+
+
+def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose, phantom):
+    g, s = phantom["organs"], phantom["parts"]
+    rp.write_volume(g, str(tmp_path / "G.nii.gz"))
+    rp.write_volume(s, str(tmp_path / "S.nii.gz"))
+    pose_file = POSES / "elbow90.pose.json"
+    repose("pose", "--input", tmp_path / "G.nii.gz", "--parts", tmp_path / "S.nii.gz",
+           "--pose", pose_file, "--scene", tmp_path / "scene", "--out", tmp_path / "cli")
+    # The same rig from the scene the command line saved, posed here.
+    scene = rp.load_scene(tmp_path / "scene")
+    frame = scene.rig.pose_frame(scene.organs, scene.parts)
+    frame.write(str(tmp_path / "py"))
+    for name in ("posed_G.nii.gz", "posed_S.nii.gz"):
+        a = nib.load(tmp_path / "cli" / name)
+        b = nib.load(tmp_path / "py" / name)
+        np.testing.assert_array_equal(np.asanyarray(a.dataobj), np.asanyarray(b.dataobj))
+        np.testing.assert_allclose(a.affine, b.affine)
+    report = frame.report
+    assert report["quality"]["all_met"] and report["tissue_table"] == "phantom default"
+    assert report["body"]["mass_before_kg"] > 20
+    field = frame.field
+    assert field.shape == frame.organs.shape + (3,) and np.isfinite(field).all()
+
+
+def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
+    g, s = phantom["organs"], phantom["parts"]
+    frame = elbow_rig.pose_frame(g, s, spacing_mm=4.0, image=phantom["image"], background=-1000)
+    np.testing.assert_allclose(frame.organs.spacing, [4, 4, 4])
+    assert frame.image is not None and frame.image.array.min() == -1000
+    # Body volume kept at 4 mm within a percent of the 8 mm input's.
+    before = sum(g.label_volumes_ml().values())
+    after = sum(frame.organs.label_volumes_ml().values())
+    assert abs(after / before - 1) < 0.01
+    # Out of core: the same labels as in core, under a small budget.
+    rp.write_volume(g, str(tmp_path / "G.nii"))
+    elbow_rig.pose_labels_to_file(str(tmp_path / "G.nii"), str(tmp_path / "posed.nii.gz"),
+                                  memory_bytes=32 * 2**20)
+    in_core = elbow_rig.pose_frame(g, s, fill_pockets=False)
+    streamed = nib.load(tmp_path / "posed.nii.gz")
+    np.testing.assert_array_equal(np.asanyarray(streamed.dataobj), in_core.organs.array)
+
+
+def test_progress_cancellation_and_the_gil(phantom, elbow_rig):
+    g, s = phantom["organs"], phantom["parts"]
+    seen = []
+    elbow_rig.pose_frame(g, s, progress=lambda f, stage: seen.append((f, stage)))
+    assert seen and seen[-1][0] == pytest.approx(1.0)
+    # Returning False cancels: repose.Cancelled, a repose.Error.
+    with pytest.raises(rp.Cancelled):
+        elbow_rig.pose_frame(g, s, progress=lambda f, stage: f < 0.3)
+    # An exception in the callback stops the work and comes back as itself.
+    class Stop(Exception):
+        pass
+
+    def stop(f, stage):
+        raise Stop(stage)
+
+    with pytest.raises(Stop):
+        rp.build_rig(g, s, rp.Pose.read(str(POSES / "elbow90.pose.json")), progress=stop)
+    # The GIL is released during the work: another Python thread runs meanwhile.
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(1)
+            done.wait(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    for _ in range(3):
+        elbow_rig.pose_frame(g, s)
+    done.set()
+    t.join()
+    assert len(ticks) > 5
+
+
+def test_pose_edits_move_the_frame(phantom):
+    pose = rp.Pose.read(str(POSES / "elbow90.pose.json"))
+    assert pose.transform("left forearm and hand")["angle_deg"] == 90
+    pose.set_transform("left forearm and hand", angle_deg=0)
+    assert rp.Pose.from_json(pose.to_json()).transform("left forearm and hand")["angle_deg"] == 0
+    with pytest.raises(rp.Error, match="fixed"):
+        pose.set_transform("body", angle_deg=5)
+    rig = rp.build_rig(phantom["organs"], phantom["parts"], pose)
+    cage, deformed = rig.deform(0)
+    # At 0 degrees the mesh stays where it was (the solve is the identity up to round-off).
+    np.testing.assert_allclose(deformed, rig.mesh_vertices, atol=1e-6)
+    np.testing.assert_allclose(cage, rig.cage_vertices, atol=1e-6)
+
+
+def run_example(name, *args):
+    env = dict(os.environ, PYTHONPATH=os.environ.get("PYTHONPATH", str(REPO / "build" / "python")))
+    return subprocess.run([sys.executable, str(REPO / "Python" / "examples" / name), *map(str, args)],
+                          capture_output=True, text=True, env=env, timeout=600)
+
+
+def test_posture_sweep_example(tmp_path):
+    r = run_example("posture_sweep.py", "--phantom-mm", 8, "--spacing-mm", 6, "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    rows = (tmp_path / "mass_summary.csv").read_text().splitlines()
+    assert rows[0].startswith("posture,") and len(rows) == 8  # the walk's 7 keyframes
+    for step in range(7):
+        assert (tmp_path / f"step{step}" / "posed_G.nii.gz").exists()
+        img = nib.load(tmp_path / f"step{step}" / "posed_G.nii.gz")
+        np.testing.assert_allclose(img.header.get_zooms(), [6, 6, 6])
+    assert "mass change %" in r.stdout and "step6" in r.stdout
+
+
+def test_nibabel_roundtrip_example(tmp_path):
+    r = run_example("nibabel_roundtrip.py", "--phantom-mm", 8, "--angle", 45,
+                    "--out", tmp_path / "posed.nii.gz")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "27 of 27 labels kept" in r.stdout
+
+
+def test_cmake_install_gives_an_importable_package(tmp_path, bin_dir):
+    build = pathlib.Path(bin_dir).parent
+    r = subprocess.run(["cmake", "--install", str(build), "--prefix", str(tmp_path)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    package = tmp_path / "lib" / "python3" / "dist-packages"
+    assert (package / "repose" / "__init__.pyi").exists()
+    code = "import repose; print(repose.__version__, repose.make_phantom(8)['organs'].shape)"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,
+                       env=dict(os.environ, PYTHONPATH=str(package)))
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith(rp.__version__)
