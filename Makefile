@@ -30,11 +30,21 @@ demo: build
 clean:
 	rm -rf $(BUILD_DIR)
 
-.PHONY: bench
+.PHONY: bench bench-large bench-micro
 # Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).
+# `make bench`: every figure against its baseline at three sizes (< 15 min); results and plot in
+# $(BUILD_DIR)/bench. `make bench-large` adds the seed's scales (~120M, ~260M, ~860M out of core).
 bench: build
+	/usr/bin/python3 bench/run_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench
+
+bench-large: build
+	/usr/bin/python3 bench/run_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench --large
+
+# The component benchmarks one by one (Google Benchmark tables).
+bench-micro: build
 	$(BUILD_DIR)/bin/ReposeIOBench --benchmark_min_time=0.2
 	$(BUILD_DIR)/bin/ReposeCageBench --benchmark_min_time=0.2
+	$(BUILD_DIR)/bin/ReposeTransferMeshBench
 	$(BUILD_DIR)/bin/ReposeFrameBench --benchmark_min_time=0.5
 	$(BUILD_DIR)/bin/ReposeRasterBench
 	$(BUILD_DIR)/bin/ReposeRefinementBench

@@ -7,6 +7,8 @@
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
 #include "repose/phantom/Phantom.h"
+#include "repose/io/NrrdIO.h"
+#include "repose/io/VolumeIO.h"
 #include "repose/raster/Rasterizer.h"
 
 #include <benchmark/benchmark.h>
@@ -58,6 +60,19 @@ const Scene& scene() {
     s.deformed = deformation.deform(bench::raiseRightArm60(s.cage));
     s.output = deformedGrid(s.organs.geometry(), s.deformed);
     s.outer = outerFaces(s.mesh);
+    // For the baselines that run outside this process (bench/run_bench.py: plastimatch warp):
+    // the input G, the displacement field of this very deformation on the output grid, and our
+    // posed labels to compare theirs with.
+    if (const char* dir = std::getenv("REPOSE_RASTER_EXPORT_DIR")) {
+      const std::string d = dir;
+      writeVolume(s.organs, d + "/G.nii");
+      writeDisplacementFieldNrrd(
+          rasterizeDisplacement(s.mesh, s.deformed, s.organs.geometry(), s.output), s.output,
+          d + "/transform.nrrd");
+      RasterOptions o;
+      o.outerFaces = &s.outer;
+      writeVolume(rasterizeLabels(s.organs, s.mesh, s.deformed, s.output, o), d + "/posed_G.nii");
+    }
     std::cout << "raster scene: " << voxelMm() << " mm phantom, input " << s.organs.numVoxels()
               << " voxels, output " << s.output.dims[0] << "x" << s.output.dims[1] << "x"
               << s.output.dims[2] << " = " << s.output.numVoxels() << " voxels, TM "
@@ -80,10 +95,28 @@ void BM_RasterizeLabels(benchmark::State& state) {
   state.counters["shell"] = double(r.shellVoxels);
 }
 
-// The VTK baseline: probe the deformed TM (point data = rest positions) at every output voxel
-// centre, then look up the nearest input label at the interpolated rest position.
-void BM_VtkProbeFilterBaseline(benchmark::State& state) {
+// The same with the files a file-to-file tool reads and writes (plastimatch's baseline):
+// read G (.nii), rasterize, write the posed labels (.nii), uncompressed.
+void BM_RasterizeLabelsFileToFile(benchmark::State& state) {
   const Scene& s = scene();
+  const char* dir = std::getenv("REPOSE_RASTER_EXPORT_DIR");
+  if (!dir) {
+    state.SkipWithError("REPOSE_RASTER_EXPORT_DIR is not set");
+    return;
+  }
+  const std::string d = dir;
+  RasterOptions o;
+  o.outerFaces = &s.outer;
+  for (auto _ : state) {
+    const Volume G = readVolume(d + "/G.nii");
+    writeVolume(rasterizeLabels(G, s.mesh, s.deformed, s.output, o), d + "/ours_file.nii");
+  }
+  state.counters["output_voxels_per_s"] = benchmark::Counter(
+      double(s.output.numVoxels()) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+// The deformed TM as VTK sees it: tets at the deformed positions, the rest positions as point data.
+vtkSmartPointer<vtkUnstructuredGrid> vtkDeformedMesh(const Scene& s) {
   auto grid = vtkSmartPointer<vtkUnstructuredGrid>::New();
   auto points = vtkSmartPointer<vtkPoints>::New();
   auto rest = vtkSmartPointer<vtkDoubleArray>::New();
@@ -101,51 +134,86 @@ void BM_VtkProbeFilterBaseline(benchmark::State& state) {
                               s.mesh.tets(t, 3)};
     grid->InsertNextCell(VTK_TETRA, 4, ids);
   }
-  // The phantom's grid is RAS-aligned, so vtkImageData (axis-aligned) holds the output grid.
+  return grid;
+}
+
+// vtkImageData holding an axis-aligned grid (the phantom's grids are RAS-aligned).
+vtkSmartPointer<vtkImageData> vtkGrid(const VolumeGeometry& g) {
   auto image = vtkSmartPointer<vtkImageData>::New();
-  image->SetDimensions(int(s.output.dims[0]), int(s.output.dims[1]), int(s.output.dims[2]));
-  const Eigen::Vector3d o = s.output.origin(), sp = s.output.spacing();
+  image->SetDimensions(int(g.dims[0]), int(g.dims[1]), int(g.dims[2]));
+  const Eigen::Vector3d o = g.origin(), sp = g.spacing();
   image->SetOrigin(o.x(), o.y(), o.z());
   image->SetSpacing(sp.x(), sp.y(), sp.z());
+  return image;
+}
+
+// vtkProbeFilter of the deformed TM at every point of `image`, then the nearest input label at
+// the interpolated rest position: what one would write with VTK alone.
+std::vector<std::uint8_t> vtkProbeLabels(const Scene& s, vtkUnstructuredGrid* mesh,
+                                         vtkImageData* image) {
+  auto probe = vtkSmartPointer<vtkProbeFilter>::New();
+  probe->SetInputData(image);
+  probe->SetSourceData(mesh);
+  probe->Update();
+  auto* out = probe->GetOutput();
+  auto* valid = out->GetPointData()->GetArray(probe->GetValidPointMaskArrayName());
+  auto* r = out->GetPointData()->GetArray("rest");
   const auto d = s.organs.dims();
   const std::uint8_t* G = s.organs.data<std::uint8_t>();
-  for (auto _ : state) {
-    auto probe = vtkSmartPointer<vtkProbeFilter>::New();
-    probe->SetInputData(image);
-    probe->SetSourceData(grid);
-    probe->Update();
-    auto* out = probe->GetOutput();
-    auto* valid = out->GetPointData()->GetArray(probe->GetValidPointMaskArrayName());
-    auto* r = out->GetPointData()->GetArray("rest");
-    std::vector<std::uint8_t> labels(static_cast<std::size_t>(out->GetNumberOfPoints()), 0);
-    for (vtkIdType p = 0; p < out->GetNumberOfPoints(); ++p) {
-      if (valid->GetComponent(p, 0) == 0) continue;
-      double q[3];
-      r->GetTuple(p, q);
-      const Eigen::Vector3d ijk = s.organs.geometry().rasToVoxel(Eigen::Vector3d(q[0], q[1], q[2]));
-      const std::int64_t x = std::llround(ijk.x()), y = std::llround(ijk.y()),
-                         z = std::llround(ijk.z());
-      if (x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2])
-        labels[p] = G[x + d[0] * (y + d[1] * z)];
-    }
-    benchmark::DoNotOptimize(labels.data());
+  std::vector<std::uint8_t> labels(static_cast<std::size_t>(out->GetNumberOfPoints()), 0);
+  for (vtkIdType p = 0; p < out->GetNumberOfPoints(); ++p) {
+    if (valid->GetComponent(p, 0) == 0) continue;
+    double q[3];
+    r->GetTuple(p, q);
+    const Eigen::Vector3d ijk = s.organs.geometry().rasToVoxel(Eigen::Vector3d(q[0], q[1], q[2]));
+    const std::int64_t x = std::llround(ijk.x()), y = std::llround(ijk.y()),
+                       z = std::llround(ijk.z());
+    if (x >= 0 && y >= 0 && z >= 0 && x < d[0] && y < d[1] && z < d[2])
+      labels[p] = G[x + d[0] * (y + d[1] * z)];
   }
+  return labels;
+}
+
+// The VTK baseline of the full label map, on the same deformed TM and output grid.
+void BM_VtkProbeFilterBaseline(benchmark::State& state) {
+  const Scene& s = scene();
+  const auto mesh = vtkDeformedMesh(s);
+  const auto image = vtkGrid(s.output);
+  for (auto _ : state) benchmark::DoNotOptimize(vtkProbeLabels(s, mesh, image).data());
   state.counters["output_voxels_per_s"] = benchmark::Counter(
       double(s.output.numVoxels()) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
-// One live slice: 512x512 axial, coronal or sagittal through the middle of the deformed body.
-void BM_LiveSlice(benchmark::State& state) {
-  const Scene& s = scene();
-  const auto orientation = static_cast<SliceOrientation>(state.range(0));
+// The plane of a live slice: size x size pixels through the middle of the deformed body.
+VolumeGeometry livePlane(const Scene& s, SliceOrientation orientation, int size) {
   const Eigen::Vector3d lo = s.deformed.colwise().minCoeff(), hi = s.deformed.colwise().maxCoeff();
   const int axis = orientation == SliceOrientation::Axial     ? 2
                    : orientation == SliceOrientation::Coronal ? 1
                                                               : 0;
+  return slicePlaneGrid(orientation, 0.5 * (lo[axis] + hi[axis]), lo, hi, size);
+}
+
+// The VTK baseline of a live slice: during a drag every frame moves the mesh, so each iteration
+// hands the probe new points (its cell locator is rebuilt, as it would be in an application).
+void BM_VtkProbeSliceBaseline(benchmark::State& state) {
+  const Scene& s = scene();
+  const auto orientation = static_cast<SliceOrientation>(state.range(0));
+  const auto mesh = vtkDeformedMesh(s);
+  const auto image = vtkGrid(livePlane(s, orientation, int(state.range(1))));
+  for (auto _ : state) {
+    mesh->GetPoints()->Modified();
+    benchmark::DoNotOptimize(vtkProbeLabels(s, mesh, image).data());
+  }
+}
+
+// One live slice: size x size, axial, coronal or sagittal through the middle of the deformed body.
+void BM_LiveSlice(benchmark::State& state) {
+  const Scene& s = scene();
   const VolumeGeometry plane =
-      slicePlaneGrid(orientation, 0.5 * (lo[axis] + hi[axis]), lo, hi, 512);
+      livePlane(s, static_cast<SliceOrientation>(state.range(0)), int(state.range(2)));
   RasterOptions o;
   o.outerFaces = &s.outer;
+  o.threads = int(state.range(1));
   for (auto _ : state)
     benchmark::DoNotOptimize(rasterizeLabels(s.organs, s.mesh, s.deformed, plane, o));
 }
@@ -153,10 +221,18 @@ void BM_LiveSlice(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_RasterizeLabels)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RasterizeLabelsFileToFile)->UseRealTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_VtkProbeFilterBaseline)->UseRealTime()->Unit(benchmark::kMillisecond)->Iterations(1);
-// Arguments: orientation (0 axial, 1 coronal, 2 sagittal), threads (0: all cores).
+// Arguments: orientation (0 axial, 1 coronal, 2 sagittal), threads (0: all cores), pixels a side.
 BENCHMARK(BM_LiveSlice)
-    ->ArgsProduct({{0, 1, 2}, {1, 0}})
+    ->ArgsProduct({{0, 1, 2}, {1, 0}, {512}})
+    ->ArgsProduct({{0}, {0}, {256, 1024}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+// Arguments: orientation, pixels a side.
+BENCHMARK(BM_VtkProbeSliceBaseline)
+    ->ArgsProduct({{0, 1, 2}, {512}})
+    ->ArgsProduct({{0}, {256, 1024}})
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -12,6 +12,7 @@ PACKAGES=(
   python3-dev pybind11-dev
   python3-numpy python3-nibabel python3-pytest python3-matplotlib python3-jsonschema
   xvfb xauth
+  plastimatch time
 )
 
 missing=()
