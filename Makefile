@@ -8,7 +8,7 @@ CMAKE_FLAGS := -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) \
   $(if $(CCACHE),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache,)
 DEMO_DIR ?= $(BUILD_DIR)/demo
 
-.PHONY: deps configure build test demo clean
+.PHONY: deps configure build test test-asan fuzz-build fuzz-smoke demo clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -21,14 +21,42 @@ configure: deps $(BUILD_DIR)/build.ninja
 build: configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
-test: build
+test: build fuzz-build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	cd $(FUZZ_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The readers' libFuzzer targets (clang, ASan + UBSan) in their own build folder; `make test` runs
+# each a few seconds (fuzz-smoke); scripts/fuzz.sh runs long campaigns (docs/RELIABILITY.md).
+FUZZ_DIR ?= build-fuzz
+$(FUZZ_DIR)/build.ninja: | deps
+	cmake -S . -B $(FUZZ_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release \
+	  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+	  $(if $(CCACHE),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache,) \
+	  -DREPOSE_FUZZ=ON -DREPOSE_BUILD_GUI=OFF -DREPOSE_BUILD_PYTHON=OFF \
+	  -DREPOSE_BUILD_BENCH=OFF -DREPOSE_BUILD_TESTING=OFF
+
+fuzz-build: $(FUZZ_DIR)/build.ninja
+	cmake --build $(FUZZ_DIR) -j $(JOBS)
+
+fuzz-smoke: fuzz-build
+	cd $(FUZZ_DIR) && ctest --output-on-failure -j $(JOBS)
 
 demo: build
 	bash scripts/demo.sh $(BUILD_DIR) $(DEMO_DIR)
 
+# The whole suite under AddressSanitizer + UndefinedBehaviorSanitizer, in its own build folder
+# (Release with line tables only: full -g on the CGAL and VTK templates multiplies build time).
+ASAN_DIR ?= build-asan
+test-asan: deps
+	cmake -S . -B $(ASAN_DIR) $(CMAKE_FLAGS) -DREPOSE_SANITIZE=ON -DREPOSE_BUILD_BENCH=OFF
+	cmake --build $(ASAN_DIR) -j $(JOBS)
+	cd $(ASAN_DIR) && ASAN_OPTIONS=$(ASAN_OPTIONS_TEST) UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+	  LSAN_OPTIONS=suppressions=$(CURDIR)/Testing/Sanitizers/lsan.supp \
+	  ctest --output-on-failure -j $(JOBS) -LE no-asan
+ASAN_OPTIONS_TEST := detect_leaks=1:abort_on_error=1:strict_string_checks=1:check_initialization_order=1
+
 clean:
-	rm -rf $(BUILD_DIR)
+	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(FUZZ_DIR)
 
 .PHONY: bench bench-large bench-micro
 # Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).

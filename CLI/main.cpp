@@ -4,6 +4,9 @@
 #include "Commands.h"
 
 #include "repose/util/Error.h"
+#include "repose/util/Interrupt.h"
+
+#include <csignal>
 
 #include <cstring>
 #include <iostream>
@@ -18,6 +21,22 @@ void printUsage() {
     std::cout << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
 }
 
+// SIGINT / SIGTERM: ask Core to stop at its next progress point; the command then unwinds like a
+// cancellation (temporary outputs removed) and exits 128 + the signal. The handler is one-shot:
+// a second signal kills at once (the default action), for a user who cannot wait.
+void onSignal(int signal) {
+  repose::requestInterrupt(signal);
+}
+
+void installSignalHandlers() {
+  struct sigaction action {};
+  action.sa_handler = onSignal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -29,6 +48,7 @@ int main(int argc, char** argv) {
     std::cout << "repose " << REPOSE_VERSION << "\n";
     return 0;
   }
+  installSignalHandlers();
   const std::string name = argv[1];
   const repose::cli::Args args(argv + 2, argv + argc);
   for (const auto& command : repose::cli::kCommands) {
@@ -40,8 +60,10 @@ int main(int argc, char** argv) {
                 << " --help)\n";
       return 2;
     } catch (const repose::Cancelled&) {
-      std::cerr << "repose " << name << ": cancelled\n";
-      return 130;
+      const int signal = repose::interruptSignal();
+      std::cerr << "repose " << name << ": " << (signal == SIGTERM ? "terminated" : "interrupted")
+                << "; no partial file was left\n";
+      return 128 + (signal > 0 ? signal : SIGINT);
     } catch (const std::bad_alloc&) {
       std::cerr << "repose " << name << ": error: out of memory\n";
       return 1;

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "repose/util/Error.h"
+#include "repose/util/Interrupt.h"
 
 #include <unistd.h>
 
@@ -42,6 +43,8 @@ AtomicOutput::~AtomicOutput() {
 
 void AtomicOutput::commit() {
   if (committed_) return;
+  // An interrupted run never publishes: the destructor removes what was written.
+  throwIfInterrupted();
   const fs::path folder = fs::path(finalPath_).parent_path().empty()
                               ? fs::path(".")
                               : fs::path(finalPath_).parent_path();

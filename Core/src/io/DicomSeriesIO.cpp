@@ -4,6 +4,9 @@
 
 #include "repose/util/Error.h"
 
+#include "DicomSandbox.h"
+#include "DicomScreen.h"
+
 #include <gdcmDirectory.h>
 #include <gdcmImageReader.h>
 #include <gdcmScanner.h>
@@ -112,13 +115,18 @@ Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
   const auto& files = directory.GetFilenames();
   if (files.empty()) throwFileError(folder, "folder holds no files");
 
+  std::vector<std::string> dicomFiles;
+  for (const std::string& f : files)
+    if (io::screenDicomFile(f)) dicomFiles.push_back(f);
+  if (dicomFiles.empty()) throwFileError(folder, "no DICOM image slices found");
+  io::probeDicomFilesInChild(dicomFiles);
   gdcm::Scanner scanner;
   for (const gdcm::Tag& t : {kSeriesUid, kPosition, kOrientation, kPixelSpacing, kFrames})
     scanner.AddTag(t);
-  if (!scanner.Scan(files)) throwFileError(folder, "cannot scan the DICOM files");
+  if (!scanner.Scan(dicomFiles)) throwFileError(folder, "cannot scan the DICOM files");
 
   std::map<std::string, std::vector<std::string>> series;
-  for (const std::string& f : files) {
+  for (const std::string& f : dicomFiles) {
     if (!scanner.IsKey(f.c_str())) continue;  // not DICOM (e.g. a DICOMDIR-less README)
     const char* uid = scanner.GetValue(f.c_str(), kSeriesUid);
     const char* ipp = scanner.GetValue(f.c_str(), kPosition);

@@ -6,6 +6,7 @@
 #include "repose/io/AtomicOutput.h"
 #include "repose/util/Error.h"
 
+#include <algorithm>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -79,18 +80,27 @@ TriangleMesh readVtk(const std::string& path, std::istream& in) {
       std::size_t n;
       std::string type;
       if (!(in >> n >> type)) throwFileError(path, "bad POINTS header");
-      v.resize(n);
-      for (auto& p : v)
+      // Counts come from the file: grow with what is actually read, never allocate by them
+      // (a corrupt count of 1e9 asked for 24 GB: found by Testing/Fuzz/FuzzMesh).
+      v.clear();
+      v.reserve(std::min<std::size_t>(n, 1 << 16));
+      for (std::size_t i = 0; i < n; ++i) {
+        Eigen::Vector3d p;
         if (!(in >> p.x() >> p.y() >> p.z())) throwFileError(path, "truncated POINTS");
+        v.push_back(p);
+      }
     } else if (word == "POLYGONS") {
       std::size_t n, total;
       if (!(in >> n >> total)) throwFileError(path, "bad POLYGONS header");
       for (std::size_t c = 0; c < n; ++c) {
         int k;
         if (!(in >> k) || k < 3) throwFileError(path, "bad polygon " + std::to_string(c));
-        std::vector<int> idx(k);
-        for (int& i : idx)
+        std::vector<int> idx;
+        for (int j = 0; j < k; ++j) {
+          int i;
           if (!(in >> i)) throwFileError(path, "truncated POLYGONS");
+          idx.push_back(i);
+        }
         for (int t = 1; t + 1 < k; ++t) f.emplace_back(idx[0], idx[t], idx[t + 1]);
       }
     }

@@ -197,7 +197,7 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
   const bool direct = !scaled && scalarSize(memType) == io::diskTypeSize(diskType) &&
                       io::memoryTypeFor(diskType) == memType && diskType != io::DiskType::UInt32 &&
                       diskType != io::DiskType::Int8;
-  // niftilib loads into nim->data when it is already allocated: read straight into our buffer.
+  // Straight into the volume when no conversion is needed, else into a staging buffer.
   std::vector<std::uint8_t> staging;
   if (direct) {
     nim->data = volume.layerData(0);
@@ -205,9 +205,18 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
     staging.resize(static_cast<std::size_t>(dataBytes));
     nim->data = staging.data();
   }
-  const int rc = nifti_image_load(nim.get());
-  nim->data = nullptr;  // never let niftilib free our buffers
-  if (rc != 0) throwFileError(path, "cannot read the voxel data (truncated or corrupt file)");
+  // Read with niftilib's buffer reader, not nifti_image_load: on a short read that one calls
+  // free() on nim->data, which is our (operator new) buffer (found by Testing/Fuzz/FuzzNifti).
+  void* const target = nim->data;
+  nim->data = nullptr;  // niftilib never owns our buffers
+  znzFile fp = znzopen(nim->iname, "rb", nifti_is_gzfile(nim->iname));
+  if (znz_isnull(fp)) throwFileError(path, "cannot open the voxel data");
+  // fseek returns 0, gzseek the new offset; both -1 on failure.
+  const bool positioned = znzseek(fp, static_cast<znz_off_t>(nim->iname_offset), SEEK_SET) >= 0;
+  const int64_t got = positioned ? nifti_read_buffer(fp, target, dataBytes, nim.get()) : -1;
+  znzclose(fp);
+  if (got != static_cast<int64_t>(dataBytes))
+    throwFileError(path, "cannot read the voxel data (truncated or corrupt file)");
   if (!direct) {
     if (scaled) {
       std::vector<float> tmp(static_cast<std::size_t>(nim->nvox));

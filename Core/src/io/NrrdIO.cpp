@@ -8,9 +8,11 @@
 
 #include <teem/nrrd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <memory>
 
@@ -150,11 +152,34 @@ std::map<std::string, std::string> keyValues(const Nrrd& nrrd) {
   return kv;
 }
 
+// teem (Debian 12's libteem) formats a field's text into a fixed-size stack buffer when it cannot
+// parse it: a field value of ~1,000-1,900 characters smashes its stack (found by
+// Testing/Fuzz/FuzzSegNrrd). Real field lines are a few hundred characters at most (sizes, space
+// directions of a 3D volume); key:=value pairs and comments are stored, not parsed, and may be
+// long (Slicer's segment tags). So field lines are checked before teem reads the header.
+constexpr std::size_t kMaxFieldLine = 800;
+
+void checkNrrdFieldLines(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (std::size_t n = 1; std::getline(in, line); ++n) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) return;  // end of an attached header
+    if (n == 1 || line[0] == '#' || line.find(":=") != std::string::npos) continue;
+    if (line.size() > kMaxFieldLine)
+      throwFileError(path, "header line " + std::to_string(n) + " (" +
+                               line.substr(0, std::min<std::size_t>(line.find(':'), 40)) + ") is " +
+                               std::to_string(line.size()) +
+                               " characters long: not a NRRD field (corrupt header)");
+  }
+}
+
 }  // namespace
 
 Volume readNrrd(const std::string& path, const ReadOptions& options) {
   io::requireReadableFile(path);
   reportProgress(options.progress, 0.0, "reading");
+  checkNrrdFieldLines(path);
   NrrdPtr nrrd(nrrdNew());
   if (nrrdLoad(nrrd.get(), path.c_str(), nullptr) != 0) {
     std::string message = takeBiffMessage();

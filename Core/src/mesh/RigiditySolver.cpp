@@ -7,6 +7,7 @@
 #include "TetAdjacency.h"
 #include "numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
+#include "repose/util/Interrupt.h"
 #include "repose/util/Parallel.h"
 
 #include <Eigen/LU>
@@ -325,6 +326,7 @@ CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& c
         std::make_unique<CompactGreenMatrix>(n, cage_.vertices.rows(), cage_.faces.rows());
     std::vector<int> missed;
     for (Eigen::Index first = 0; first < n; first += kBlock) {
+      throwIfInterrupted();  // the embedding is the longest step without a progress callback
       const Eigen::Index rows = std::min(kBlock, n - first);
       Eigen::MatrixX3d points(rows, 3);
       for (Eigen::Index r = 0; r < rows; ++r)

@@ -264,7 +264,10 @@ Pose parsePose(const std::string& text, const std::string& source) {
           k[i].contains("name") ? r.string(k[i]["name"], f + ".name") : "frame" + std::to_string(i);
       if (!k[i].contains("groups")) r.fail(f + ".groups", "required");
       const json& gs = r.object(k[i]["groups"], f + ".groups");
-      for (const auto& [name, t] : gs.items()) {
+      for (const auto& item : gs.items()) {
+        // Named copies, not structured bindings: C++17 lambdas cannot capture those (clang).
+        const std::string name = item.key();
+        const json& t = item.value();
         const std::string gf = f + ".groups." + name;
         const auto it = std::find_if(pose.groups.begin(), pose.groups.end(),
                                      [&](const PoseGroup& g) { return g.name == name; });

@@ -9,10 +9,12 @@
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
+#include "repose/util/Interrupt.h"
 
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <stdlib.h>
 #include <set>
 
 namespace repose {
@@ -92,16 +94,43 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
 }
 
 void writePosedFrame(const PosedFrame& frame, const std::string& folder) {
-  const std::filesystem::path dir(folder);
-  if (!std::filesystem::exists(std::filesystem::absolute(dir).parent_path()))
-    throw Error(folder + ": its parent folder does not exist");
-  std::filesystem::create_directories(dir);
-  writeVolume(frame.organs, (dir / "posed_G.nii.gz").string());
-  writeVolume(frame.parts, (dir / "posed_S.nii.gz").string());
-  if (frame.image) writeVolume(*frame.image, (dir / "posed_image.nii.gz").string());
-  writeDisplacementFieldNrrd(frame.field, frame.grid, (dir / "transform.nrrd").string());
-  writeTextFileAtomically((dir / "report.json").string(),
+  namespace fs = std::filesystem;
+  fs::path dir = fs::absolute(fs::path(folder)).lexically_normal();
+  if (!dir.has_filename()) dir = dir.parent_path();  // "OUT/frame/"
+  if (!fs::exists(dir.parent_path())) throw Error(folder + ": its parent folder does not exist");
+  // The frame's files are one result: written into a hidden folder beside `folder` and moved in
+  // together at the end, so an error, a Cancel or an interrupt never leaves half a frame.
+  std::string pattern = (dir.parent_path() / ".repose-tmp-XXXXXX").string();
+  if (!::mkdtemp(pattern.data()))
+    throwFileError(folder, "cannot write in the output folder's parent");
+  const fs::path temp(pattern);
+  struct RemoveOnExit {
+    fs::path path;
+    ~RemoveOnExit() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  } cleanup{temp};
+  writeVolume(frame.organs, (temp / "posed_G.nii.gz").string());
+  writeVolume(frame.parts, (temp / "posed_S.nii.gz").string());
+  if (frame.image) writeVolume(*frame.image, (temp / "posed_image.nii.gz").string());
+  writeDisplacementFieldNrrd(frame.field, frame.grid, (temp / "transform.nrrd").string());
+  writeTextFileAtomically((temp / "report.json").string(),
                           nlohmann::json::parse(frame.reportJson).dump(2) + "\n");
+  throwIfInterrupted();
+  std::error_code ec;
+  if (!fs::exists(dir)) {
+    fs::rename(temp, dir, ec);
+    if (ec) throwFileError(folder, "cannot move the frame into place: " + ec.message());
+    return;
+  }
+  // An existing folder (a re-run): its files are replaced one by one, the report last.
+  for (const char* name :
+       {"posed_G.nii.gz", "posed_S.nii.gz", "posed_image.nii.gz", "transform.nrrd", "report.json"})
+    if (fs::exists(temp / name)) {
+      fs::rename(temp / name, dir / name, ec);
+      if (ec) throwFileError((dir / name).string(), "cannot move into place: " + ec.message());
+    }
 }
 
 }  // namespace repose

@@ -85,20 +85,33 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
 
 namespace {
 
+// A string member, or "" when the node is not an object or the member is absent or not a string
+// (json::value would throw its own exception type on those: found by Testing/Fuzz/FuzzScene).
+std::string stringOf(const json& node, const char* key) {
+  if (!node.is_object()) return "";
+  const auto it = node.find(key);
+  return it != node.end() && it->is_string() ? it->get<std::string>() : "";
+}
+
+json nodesOf(const json& doc) {
+  const auto it = doc.find("nodes");
+  return it != doc.end() && it->is_array() ? *it : json::array();
+}
+
 json readSceneJson(const fs::path& scene) {
   const fs::path file = scene / "scene.json";
   std::ifstream in(file);
   if (!in) throw Error(scene.string() + ": not a scene folder (no scene.json)");
   const json doc = json::parse(in, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) throw Error(file.string() + ": not valid JSON");
-  if (doc.value("format", "") != "repose-scene")
+  if (stringOf(doc, "format") != "repose-scene")
     throw Error(file.string() + ": not a Repose scene (format is not \"repose-scene\")");
   return doc;
 }
 
 // A node's file, relative to the scene folder unless absolute.
 std::string fileOf(const fs::path& scene, const json& node, const char* key) {
-  const std::string name = node.value(key, "");
+  const std::string name = stringOf(node, key);
   if (name.empty()) return name;
   return fs::path(name).is_absolute() ? name : (scene / name).string();
 }
@@ -110,8 +123,8 @@ SceneContents readSceneFolder(const std::string& folder) {
   const json doc = readSceneJson(scene);
   SceneContents out;
   std::string cageFile, meshFile, poseFile;
-  for (const json& node : doc.value("nodes", json::array())) {
-    const std::string cls = node.value("class", "");
+  for (const json& node : nodesOf(doc)) {
+    const std::string cls = stringOf(node, "class");
     if (cls == "vtkMRMLReposeSegmentationNode" && out.inputs.organs.empty()) {
       out.inputs.organs = fileOf(scene, node, "LabelMapFileName");
       out.inputs.parts = fileOf(scene, node, "BodyPartMapFileName");
@@ -132,7 +145,8 @@ SceneContents readSceneFolder(const std::string& folder) {
   out.geometry.cage = readTriangleMesh(cageFile);
   out.geometry.mesh = readTransferMesh(meshFile);
   out.pose = readPoseFile(poseFile);
-  if (doc.contains("built_for") && !doc["built_for"].is_null()) out.key = doc["built_for"].dump();
+  if (doc.contains("built_for") && !doc["built_for"].is_null())
+    out.key = doc["built_for"].dump(-1, ' ', false, json::error_handler_t::replace);
   return out;
 }
 
@@ -145,12 +159,13 @@ std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::st
   } catch (const Error&) {
     return std::nullopt;  // not ours: built again (and written over)
   }
-  if (doc.value("built_for", json()) != json::parse(key)) return std::nullopt;
+  const auto builtFor = doc.find("built_for");
+  if (builtFor == doc.end() || *builtFor != json::parse(key, nullptr, false)) return std::nullopt;
   std::string cageFile, meshFile;
-  for (const json& node : doc.value("nodes", json::array())) {
-    if (node.value("class", "") == "vtkMRMLReposeCageNode")
+  for (const json& node : nodesOf(doc)) {
+    if (stringOf(node, "class") == "vtkMRMLReposeCageNode")
       cageFile = fileOf(scene, node, "FileName");
-    if (node.value("class", "") == "vtkMRMLReposeTransferMeshNode")
+    if (stringOf(node, "class") == "vtkMRMLReposeTransferMeshNode")
       meshFile = fileOf(scene, node, "FileName");
   }
   if (cageFile.empty() || meshFile.empty()) return std::nullopt;

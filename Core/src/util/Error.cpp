@@ -1,5 +1,6 @@
 // One-line file errors: "path: problem".
 #include "repose/util/Error.h"
+#include "repose/util/Interrupt.h"
 #include "repose/util/Progress.h"
 
 namespace repose {
@@ -12,6 +13,7 @@ void throwFileError(const std::string& path, const std::string& problem) {
 }
 
 void reportProgress(const ProgressFn& fn, double fraction, const std::string& stage) {
+  throwIfInterrupted();
   if (fn && !fn(fraction, stage)) throw Cancelled();
 }
 

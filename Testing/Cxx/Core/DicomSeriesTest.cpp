@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -109,5 +110,62 @@ TEST(DicomSeries, BadFoldersGiveOneLineErrors) {
     FAIL();
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("evenly spaced"), std::string::npos) << e.what();
+  }
+}
+
+// Regression (Testing/Fuzz/FuzzDicom): GDCM allocates and zero-fills each element at the length
+// the file claims, so one corrupt length made a 0.5 MB file take 4 GB. Such a file is refused
+// before GDCM sees it, with the element named; the untouched series still reads.
+TEST(DicomSeries, ElementLongerThanTheFileIsRefusedBeforeGdcmAllocatesIt) {
+  ScratchDir dir;
+  const std::string src = dataPath("dcmqi_ct3slice/ct-3slice");
+  for (const auto& e : std::filesystem::directory_iterator(src))
+    std::filesystem::copy_file(e.path(), dir.path() / e.path().filename());
+  EXPECT_EQ(readVolume(dir.path().string()).dims()[2], 3);
+  // The middle slice's (7FE0,0010) Pixel Data made to claim 0xFF000000 bytes (its 32-bit length
+  // follows the tag in implicit VR, as here, or "OW" and two reserved bytes in explicit VR).
+  const std::string slice = (dir.path() / "02.dcm").string();
+  std::fstream f(slice, std::ios::in | std::ios::out | std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(f)), {});
+  const char pixelData[4] = {'\xE0', '\x7F', '\x10', '\x00'};
+  const auto at = std::search(bytes.begin(), bytes.end(), pixelData, pixelData + 4);
+  ASSERT_NE(at, bytes.end());
+  const bool explicitVr = at[4] == 'O' && (at[5] == 'W' || at[5] == 'B');
+  const std::size_t lengthAt = std::size_t(at - bytes.begin()) + (explicitVr ? 8 : 4);
+  const unsigned char huge[4] = {0x00, 0x00, 0x00, 0xFF};
+  f.clear();
+  f.seekp(std::streamoff(lengthAt));
+  f.write(reinterpret_cast<const char*>(huge), 4);
+  f.close();
+  try {
+    readVolume(dir.path().string());
+    FAIL() << "a file claiming 4 GB of pixel data was read";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("02.dcm"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("(7FE0,0010) claims 4278190080 bytes"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+// Regression (Testing/Fuzz/FuzzDicom): a file meta header followed by zeros makes Debian's GDCM
+// fail an assert() and abort the process. GDCM now reads each file first in a child process, so
+// this process lives and the file is refused by name.
+TEST(DicomSeries, AFileThatAbortsGdcmIsRefusedAndTheProcessLives) {
+  ScratchDir dir;
+  std::ifstream in(dataPath("dcmqi_ct3slice/liver.dcm"), std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_GT(bytes.size(), 402u);
+  bytes.resize(402);
+  bytes.insert(bytes.end(), 11, '\0');
+  std::ofstream(dir.file("broken.dcm"), std::ios::binary)
+      .write(bytes.data(), std::streamsize(bytes.size()));
+  try {
+    readVolume(dir.path().string());
+    FAIL() << "the broken file was read";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("broken.dcm: corrupt DICOM"), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
   }
 }

@@ -34,6 +34,15 @@ TEST(MeshIO, QuadsAreTriangulatedAndBadFilesRefused) {
   std::ofstream(dir.file("trunc.vtk"))
       << "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1";
   EXPECT_THROW(readTriangleMesh(dir.file("trunc.vtk")), Error);
+  // Regression (Testing/Fuzz/FuzzMesh): counts are not allocations. These asked for 24 GB and
+  // 8 GB before the first value was read; now they fail at the end of the file.
+  std::ofstream(dir.file("hugecount.vtk"))
+      << "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\nPOINTS 999999995 float\n0 0 0\n";
+  EXPECT_THROW(readTriangleMesh(dir.file("hugecount.vtk")), Error);
+  std::ofstream(dir.file("hugepolygon.vtk")) << "# vtk DataFile Version 3.0\nx\nASCII\nDATASET "
+                                                "POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                                             << "POLYGONS 1 4\n2000000000 0 1 2\n";
+  EXPECT_THROW(readTriangleMesh(dir.file("hugepolygon.vtk")), Error);
   EXPECT_THROW(readTriangleMesh(dir.file("missing.obj")), Error);
   EXPECT_THROW(writeTriangleMesh(sphereMesh({0, 0, 0}, 1, 0), dir.file("x.stl")), Error);
 }

@@ -186,6 +186,20 @@ TEST(NiftiIO, BadInputGivesOneLineErrors) {
   expectOneLineError(dir.file("empty.nii"), "empty");
 }
 
+// Regression (Testing/Fuzz/FuzzNifti): a .nii.gz whose compressed voxel data ends early made
+// niftilib free() the volume's own buffer (allocated with new) and the volume free it again.
+TEST(NiftiIO, TruncatedGzipVoxelDataIsAnErrorNotACrash) {
+  ScratchDir dir;
+  std::ifstream in(dataPath("totalsegmentator/example_seg.nii.gz"), std::ios::binary);
+  const std::vector<char> gz((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_GT(gz.size(), 20000u);
+  for (const std::size_t keep : {gz.size() / 2, gz.size() - 100}) {
+    const std::string path = dir.file("cut" + std::to_string(keep) + ".nii.gz");
+    writeAll(path, std::vector<char>(gz.begin(), gz.begin() + std::ptrdiff_t(keep)));
+    expectOneLineError(path, "voxel data");
+  }
+}
+
 TEST(NiftiIO, FailedWriteLeavesNoFile) {
   ScratchDir dir;
   Volume v = randomVolume(ScalarType::UInt8, obliqueGeometry(), 5, 1);

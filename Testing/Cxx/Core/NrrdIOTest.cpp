@@ -179,4 +179,16 @@ TEST(NrrdIO, BadInputGivesOneLineErrors) {
               "2D");
   expectError("missingdata.nhdr", head + "encoding: raw\ndata file: nowhere.raw\n", "");
   expectError("badgz.nrrd", head + "encoding: gzip\n\nnot gzip at all", "truncated or corrupt");
+  // Regression (Testing/Fuzz/FuzzSegNrrd): a field of ~1,000-1,900 characters that teem cannot
+  // parse overflowed teem's error buffer on the stack; it is refused before teem reads it.
+  for (const std::size_t n : {1000u, 1500u})
+    expectError("longfield" + std::to_string(n) + ".nrrd",
+                head + "space origin: (" + std::string(n, '9') + ")\nencoding: raw\n\n" +
+                    std::string(128, 'x'),
+                "(space origin) is " + std::to_string(n + 16) + " characters long");
+  // Long key:=value pairs are data, not fields: Slicer's segment tags are read as before.
+  const std::string tags = head + "encoding: raw\nSegment0_Tags:=" + std::string(3000, 't') +
+                           "\n\n" + std::string(128, 'x');
+  std::ofstream(dir.file("longtags.nrrd"), std::ios::binary) << tags;
+  EXPECT_NO_THROW(readVolume(dir.file("longtags.nrrd")));
 }

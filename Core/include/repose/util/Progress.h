@@ -9,7 +9,8 @@ namespace repose {
 
 using ProgressFn = std::function<bool(double fraction, const std::string& stage)>;
 
-// Calls fn if set; throws repose::Cancelled when it returns false.
+// Calls fn if set; throws repose::Cancelled when it returns false or an interrupt was requested
+// (util/Interrupt.h), so every progress point is also a stop point.
 void reportProgress(const ProgressFn& fn, double fraction, const std::string& stage);
 
 }  // namespace repose
