@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -47,6 +49,11 @@ struct Reader {
   }
   int integer(const json& j, const std::string& field) const {
     if (!j.is_number_integer()) fail(field, "expected an integer");
+    // get<int> would wrap 4294967297 to 1 silently; refuse what an int cannot hold.
+    const auto wide = j.is_number_unsigned() ? static_cast<long double>(j.get<std::uint64_t>())
+                                             : static_cast<long double>(j.get<std::int64_t>());
+    if (wide < std::numeric_limits<int>::min() || wide > std::numeric_limits<int>::max())
+      fail(field, "integer out of range");
     return j.get<int>();
   }
 
@@ -182,7 +189,9 @@ Pose parsePose(const std::string& text, const std::string& source) {
   json j;
   try {
     j = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {
+    // parse_error for broken syntax, out_of_range for a number beyond double (1e99999): both are
+    // a bad file, never a crash (found by the PoseJson fuzzer, docs/RELIABILITY.md).
     throw Error(source + ": not valid JSON (" + std::string(e.what()) + ")");
   }
   r.object(j, "(top level)");

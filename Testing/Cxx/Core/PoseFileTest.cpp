@@ -104,6 +104,15 @@ TEST(PoseFile, BadFieldsAreRefusedByName) {
       {with("\"translation\":[10,0,0]", "\"translaton\":[10,0,0]"),
        "p.json: groups[0].translaton: unknown field"},
       {with("\"rest\":true", "\"rest\":true,\"parts\":[3]"), "p.json: groups[1].select: rest"},
+      // Found by the PoseJson fuzzer: a number beyond double threw json::out_of_range past the
+      // parse_error handler and terminated the process.
+      {with("\"angle_deg\":90", "\"angle_deg\":2222222222222222e22222"), "p.json: not valid JSON"},
+      {with("\"angle_deg\":90", "\"angle_deg\":-1e99999"), "p.json: not valid JSON"},
+      // An index an int cannot hold is refused, not wrapped (4294967297 would become 1).
+      {with("\"parts\":[4]", "\"cage_vertices\":[4294967297]"),
+       "p.json: groups[0].select.cage_vertices[0]: integer out of range"},
+      {with("\"version\":1", "\"version\":18446744073709551615"),
+       "p.json: version: integer out of range"},
   };
   for (const auto& [text, message] : cases) {
     const std::string e = errorOf(text);
