@@ -3,6 +3,7 @@
 #include "ArgParser.h"
 #include "SeparationOptions.h"
 #include "Commands.h"
+#include "InputChecks.h"
 #include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
@@ -52,6 +53,8 @@ int runCage(const Args& args) {
   int proxy = 1;
   const Volume parts =
       readLabelsWithinBudget(p.get("parts"), parseMemoryBudget(p.get("memory")), 3, proxy);
+  requirePoseableLabels(parts, p.get("parts"));
+  warnUnnamedLabels(parts, p.get("parts"), "cage");
   const Cage cage = buildCage(parts, o);
   writeTriangleMesh(cage.mesh, out);
   const double seconds =

@@ -2,6 +2,7 @@
 // geometry in RAS and the label names; the output appears only when complete.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "MemoryBudget.h"
 #include "TerminalProgress.h"
 #include "VolumeReport.h"
 
@@ -21,6 +22,7 @@ int runConvert(const Args& args) {
       .option("nifti-version", "1|2", "NIfTI header version for .nii/.nii.gz outputs", "1")
       .flag("no-compress", "write .nrrd/.nhdr data uncompressed (raw)")
       .flag("json", "print a JSON description of the written volume");
+  declareMemoryOption(p, "a volume that would not fit is refused with the numbers");
   if (!p.parse(args)) return 0;
   const std::string in = p.get("IN"), out = p.get("OUT");
   WriteOptions w;
@@ -29,8 +31,7 @@ int runConvert(const Args& args) {
   w.compress = !p.has("no-compress");
   formatForPath(out);  // an unknown output type fails before the input is read
   refuseOverwritingInput(in, out);
-  ReadOptions r;
-  r.progress = terminalProgress();
+  const ReadOptions r = readOptionsWithin(parseMemoryBudget(p.get("memory")));
   w.progress = terminalProgress();
   const Volume volume = readVolume(in, r);
   writeVolume(volume, out, w);

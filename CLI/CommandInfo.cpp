@@ -1,6 +1,7 @@
 // `repose info FILE [--json]`: geometry, orientation, type and labels of a volume.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "MemoryBudget.h"
 #include "TerminalProgress.h"
 #include "VolumeReport.h"
 
@@ -15,11 +16,10 @@ int runInfo(const Args& args) {
               "label with its name, voxel count and volume. FILE is .nii, .nii.gz, .nrrd,\n"
               ".nhdr, .seg.nrrd or a DICOM series folder.");
   p.positional("FILE", "the volume to describe").flag("json", "print JSON instead of text");
+  declareMemoryOption(p, "a volume that would not fit is refused with the numbers");
   if (!p.parse(args)) return 0;
-  ReadOptions options;
-  options.progress = terminalProgress();
   const std::string path = p.get("FILE");
-  const Volume volume = readVolume(path, options);
+  const Volume volume = readVolume(path, readOptionsWithin(parseMemoryBudget(p.get("memory"))));
   const nlohmann::json description = describeVolume(volume, path);
   if (p.has("json"))
     std::cout << description.dump(2) << "\n";

@@ -3,6 +3,7 @@
 #include "ArgParser.h"
 #include "SeparationOptions.h"
 #include "Commands.h"
+#include "InputChecks.h"
 #include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
@@ -48,6 +49,8 @@ int runMesh(const Args& args) {
   int proxy = 1;
   const Volume parts =
       readLabelsWithinBudget(p.get("parts"), parseMemoryBudget(p.get("memory")), 8, proxy);
+  requirePoseableLabels(parts, p.get("parts"));
+  warnUnnamedLabels(parts, p.get("parts"), "mesh");
   const TriangleMesh cage = readTriangleMesh(p.get("cage"));
   TransferMeshOptions o;
   o.sizeMm = p.getDouble("size-mm");

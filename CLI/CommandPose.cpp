@@ -6,6 +6,7 @@
 // displacement field and writes report.json with the quality checks of docs/QUALITY.md.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "InputChecks.h"
 #include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
@@ -116,16 +117,20 @@ int runPose(const Args& args) {
   if (p.getInt("joint-rings") < -1 || p.getInt("joint-rings") > 8)
     throw UsageError{"--joint-rings must be -1..8"};
 
-  const Volume organs = readVolume(p.get("input"));
-  const Volume parts = readVolume(p.get("parts"));
-  if (!isIntegerType(organs.scalarType()))
-    throw Error(p.get("input") + ": not a label map (float voxels); pose images with --image");
+  // The inputs are held in core for the whole job: each read refuses, with the numbers, what the
+  // budget cannot hold; the frames are checked against what is left (checkGrid below).
+  const Volume organs = readVolume(p.get("input"), readOptionsWithin(budget, !quiet));
+  const Volume parts = readVolume(p.get("parts"), readOptionsWithin(budget, !quiet));
+  requirePoseableLabels(organs, p.get("input"));
+  requirePoseableLabels(parts, p.get("parts"));
+  warnUnnamedLabels(organs, p.get("input"), "pose");
+  warnUnnamedLabels(parts, p.get("parts"), "pose");
   if (parts.dims() != organs.dims() ||
       !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
     throw Error(p.get("parts") + ": not on the grid of " + p.get("input"));
   std::optional<Volume> image;
   if (p.has("image")) {
-    image = readVolume(p.get("image"));
+    image = readVolume(p.get("image"), readOptionsWithin(budget, !quiet));
     if (image->dims() != organs.dims())
       throw Error(p.get("image") + ": not on the grid of " + p.get("input"));
   }
@@ -201,6 +206,19 @@ int runPose(const Args& args) {
              : std::string()) +
         "; quality targets " + (q["all_met"].get<bool>() ? "met" : "NOT all met") + " -> " +
         (dir / "report.json").string());
+    // What a drag or a pose can do wrong, said on stderr (stdout may be JSON): folds, body parts
+    // the cage cannot reach, labels gone (docs/RELIABILITY.md, degenerate geometry).
+    const auto warn = [&](std::int64_t n, const std::string& what) {
+      if (n > 0)
+        std::cerr << "repose pose: warning: frame " << frameName << ": " << n << " " << what
+                  << "\n";
+    };
+    warn(report["mesh"]["inverted_tets"].get<std::int64_t>(),
+         "tets turned inside out (the pose folds the body there; overlapping tissue is resolved "
+         "bone first)");
+    warn(report["mesh"]["unreachable_vertices_left_at_rest"].get<std::int64_t>(),
+         "mesh vertices in parts with no vertex inside the cage, left at rest");
+    warn(report["labels_lost"].get<std::int64_t>(), "labels vanished from the output");
     summary.push_back(report);
   }
   const double seconds =

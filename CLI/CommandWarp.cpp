@@ -38,7 +38,7 @@ namespace {
 std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
   const NiftiLayout& l = cache.layout();
   const std::int64_t n = l.geometry.dims[0] * l.geometry.dims[1];
-  const Eigen::Vector3d s = l.geometry.spacing();
+  const double voxelMm3 = l.geometry.voxelVolumeMm3();
   std::map<int, std::int64_t> counts;
   dispatchScalar(l.type, [&](auto* tag) {
     using T = std::remove_pointer_t<decltype(tag)>;
@@ -49,7 +49,7 @@ std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
     }
   });
   std::map<int, double> mm3;
-  for (const auto& [value, count] : counts) mm3[value] = double(count) * s.prod();
+  for (const auto& [value, count] : counts) mm3[value] = double(count) * voxelMm3;
   return mm3;
 }
 
@@ -107,7 +107,7 @@ int runWarp(const Args& args) {
   if (niftiInput) {
     layout = readNiftiLayout(input);
   } else {
-    labels = readVolume(input);
+    labels = readVolume(input, readOptionsWithin(budget, false));
     layout.geometry = labels->geometry(), layout.type = labels->scalarType();
     layout.labels = labels->labels();
   }
@@ -129,16 +129,22 @@ int runWarp(const Args& args) {
   // peak so far): in core if both fit, else out of core, else refuse before the work.
   const double voxelBytes = double(scalarSize(layout.type)) * layers;
   const double outBytes = double(grid.numVoxels()) * voxelBytes;
-  const double inBytes = double(layout.geometry.numVoxels()) * voxelBytes;
+  // (A non-NIfTI input is already read: its bytes are in the peak below.)
+  const double inBytes = labels ? 0.0 : double(layout.geometry.numVoxels()) * voxelBytes;
+  // In core, --image holds the image and its posed copy (up to 4 bytes a voxel each) and
+  // --transform-out the field (3 floats an output voxel) beside the label maps.
+  const double imageBytes =
+      p.has("image") ? 4.0 * double(layout.geometry.numVoxels() + grid.numVoxels()) : 0.0;
+  const double fieldBytes = p.has("transform-out") ? 12.0 * double(grid.numVoxels()) : 0.0;
   const double used = peakResidentBytes();
   const double available = budget - used;
-  const bool inCore = inBytes + outBytes <= available;
+  const bool inCore = inBytes + outBytes + imageBytes + fieldBytes <= available;
   const bool niftiOutput = formatForPath(out) == FileFormat::Nifti;
   if (!inCore) {
-    const std::string why = out + ": posing in memory needs " + gib(inBytes + outBytes) + " (" +
-                            std::to_string(grid.numVoxels()) + " output voxels) beyond the " +
-                            gib(used) + " the mesh and cage use, more than the budget of " +
-                            gib(budget);
+    const std::string why =
+        out + ": posing in memory needs " + gib(inBytes + outBytes + imageBytes + fieldBytes) +
+        " (" + std::to_string(grid.numVoxels()) + " output voxels) beyond the " + gib(used) +
+        " the mesh and cage use, more than the budget of " + gib(budget);
     if (!niftiInput || !niftiOutput || layers > 1)
       throw Error(why + "; out of core needs NIfTI in and out");
     if (p.has("image") || p.has("transform-out"))
@@ -160,10 +166,10 @@ int runWarp(const Args& args) {
   RasterReport report;
   std::map<std::pair<int, int>, std::pair<double, double>> volumes;  // (layer, value) -> mm3
   if (inCore) {
-    if (!labels) labels = readVolume(input);
+    if (!labels) labels = readVolume(input, readOptionsWithin(budget, false));
     const Volume posedLabels = rasterizeLabels(*labels, mesh, deformed, grid, ro, &report);
     if (p.has("image")) {
-      const Volume image = readVolume(p.get("image"));
+      const Volume image = readVolume(p.get("image"), readOptionsWithin(budget, false));
       const Volume posedImage =
           rasterizeImage(image, mesh, deformed, grid, p.getDouble("background"), ro);
       writeVolume(posedImage, p.get("image-out"));
@@ -182,7 +188,7 @@ int runWarp(const Args& args) {
     rasterizeLabelsToFile(cache, mesh, deformed, grid, out, static_cast<std::size_t>(available / 4),
                           ro, &report);
     for (const auto& [value, mm3] : streamedLabelVolumes(cache)) volumes[{0, value}].first = mm3;
-    const double voxelMm3 = grid.spacing().prod();
+    const double voxelMm3 = grid.voxelVolumeMm3();
     for (const auto& [value, count] : report.labelVoxels)
       volumes[{0, value}].second = double(count) * voxelMm3;
   }
@@ -214,6 +220,7 @@ int runWarp(const Args& args) {
       {"voxels_in_shell", report.shellVoxels},
       {"inverted_tets", report.invertedTets},
       {"flat_tets", report.flatTets},
+      {"unreachable_vertices_left_at_rest", deformation.solver().unconstrainedVertices()},
       {"labels_lost", lost},
       {"labels", perLabel},
       {"seconds", seconds}};
@@ -230,6 +237,9 @@ int runWarp(const Args& args) {
       std::cout << "warning: " << report.invertedTets
                 << " tets turned inside out (the pose folds the body there)\n";
     if (lost > 0) std::cout << "warning: " << lost << " labels vanished from the output\n";
+    if (deformation.solver().unconstrainedVertices() > 0)
+      std::cout << "warning: " << deformation.solver().unconstrainedVertices()
+                << " mesh vertices in parts with no vertex inside the cage were left at rest\n";
   }
   return 0;
 }

@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -60,14 +61,35 @@ std::string gib(double bytes) {
   return s.str();
 }
 
+ReadOptions readOptionsWithin(double budget, bool progress) {
+  ReadOptions r;
+  if (progress) r.progress = terminalProgress();
+  // Never 0 (no limit): a budget already used up refuses every read.
+  r.memoryLimitBytes = std::max(1.0, budget - peakResidentBytes());
+  return r;
+}
+
 Volume readLabelsWithinBudget(const std::string& path, double budget, double bytesPerVoxelNeeded,
                               int& factor) {
   factor = 1;
-  if (formatForPath(path) != FileFormat::Nifti) return readVolume(path);
+  if (formatForPath(path) != FileFormat::Nifti) {
+    // No proxy without reading slices in place (NIfTI only): in core, or refused with the numbers.
+    Volume v = readVolume(path, readOptionsWithin(budget, false));
+    const double need = double(v.numVoxels()) * bytesPerVoxelNeeded;
+    const double held = double(v.numVoxels()) * double(scalarSize(v.scalarType())) * v.layers();
+    if (need - held > budget - peakResidentBytes())
+      throw Error(path + ": working on it needs " + gib(need) + " (" +
+                  std::to_string(v.numVoxels()) + " voxels), more than the memory budget of " +
+                  gib(budget) +
+                  " leaves; raise --memory, or convert it to NIfTI for the "
+                  "downsampled proxy");
+    return v;
+  }
   const NiftiLayout layout = readNiftiLayout(path);
   const double available = budget - peakResidentBytes();
   const std::int64_t voxels = layout.geometry.numVoxels();
-  if (double(voxels) * bytesPerVoxelNeeded <= available) return readVolume(path);
+  if (double(voxels) * bytesPerVoxelNeeded <= available)
+    return readVolume(path, readOptionsWithin(budget, false));
   // The proxy must fit with the same overhead; the cache gets a quarter of what is left.
   factor = proxyFactor(voxels, static_cast<std::size_t>(std::ceil(bytesPerVoxelNeeded)),
                        0.5 * available);

@@ -2,6 +2,7 @@
 // switches to a downsampled proxy (io/LabelProxy.h) when a label map would not fit.
 #pragma once
 
+#include "repose/io/VolumeIO.h"
 #include "repose/volume/Volume.h"
 
 #include <string>
@@ -18,6 +19,10 @@ double parseMemoryBudget(const std::string& text);
 // The process's peak resident set so far (VmHWM), in bytes; 0 if unknown.
 double peakResidentBytes();
 std::string gib(double bytes);
+
+// Read options for a volume read in core under `budget`: the reader refuses, naming the file and
+// the numbers, when its estimate exceeds what the budget leaves beyond the process's peak so far.
+ReadOptions readOptionsWithin(double budget, bool progress = true);
 
 // Reads the label map at `path` in core when voxels * bytesPerVoxelNeeded fit in `budget`;
 // otherwise (NIfTI only) builds its mode proxy through a slice cache, coarse enough to fit.

@@ -20,6 +20,9 @@ nlohmann::json describeVolume(const Volume& volume, const std::string& path) {
   const Eigen::Vector3d s = g.spacing();
   j["spacing_mm"] = {s.x(), s.y(), s.z()};
   j["orientation"] = g.axisCodes();
+  // Sheared grids are read and described, but a rig cannot be built from one (VolumeGeometry.h).
+  j["axis_skew_deg"] = g.axisSkewDegrees();
+  j["voxel_volume_mm3"] = g.voxelVolumeMm3();
   nlohmann::json m = nlohmann::json::array();
   for (int r = 0; r < 4; ++r)
     m.push_back({g.ijkToRas(r, 0), g.ijkToRas(r, 1), g.ijkToRas(r, 2), g.ijkToRas(r, 3)});
@@ -57,6 +60,10 @@ nlohmann::json describeVolume(const Volume& volume, const std::string& path) {
       if (!present) unused.push_back({{"value", l.value}, {"name", l.name}});
     }
     j["labels_declared_absent"] = unused;
+    // The reverse: values with voxels that a non-empty table does not name.
+    nlohmann::json unnamed = nlohmann::json::array();
+    for (const LabelCount& c : unnamedLabels(volume)) unnamed.push_back(c.value);
+    j["labels_unnamed"] = unnamed;
   } else {
     double lo = std::numeric_limits<double>::max(), hi = -lo, sum = 0;
     for (std::int64_t i = 0; i < volume.numVoxels(); ++i) {
@@ -84,6 +91,9 @@ std::string formatVolumeText(const nlohmann::json& j) {
   out << ")\n";
   out << "  spacing      " << triple(j["spacing_mm"], " x ") << " mm\n";
   out << "  orientation  " << j["orientation"].get<std::string>() << "\n";
+  if (j["axis_skew_deg"].get<double>() > kMaxAxisSkewDegrees)
+    out << "  warning      voxel axes are not orthogonal (sheared by "
+        << j["axis_skew_deg"].get<double>() << " degrees): resample before posing\n";
   out << "  origin       (" << triple(j["origin_ras_mm"], ", ") << ") mm RAS\n";
   out << "  extent       (" << triple(j["extent_ras_mm"]["min"], ", ") << ") .. ("
       << triple(j["extent_ras_mm"]["max"], ", ") << ") mm RAS, size "
@@ -101,6 +111,9 @@ std::string formatVolumeText(const nlohmann::json& j) {
           << std::fixed << std::setprecision(2) << l["volume_ml"].get<double>() << " ml\n"
           << std::defaultfloat << std::setprecision(6);
     }
+    if (!j["labels_unnamed"].empty())
+      out << "  warning      values with voxels but no name in the label table: "
+          << j["labels_unnamed"].dump() << "\n";
   } else if (j.contains("intensity")) {
     out << "  intensity    min " << j["intensity"]["min"].get<double>() << ", max "
         << j["intensity"]["max"].get<double>() << ", mean " << j["intensity"]["mean"].get<double>()

@@ -47,6 +47,9 @@ double CageField::at(const Eigen::Vector3d& gridMm) const {
 CageField makeCageField(const Volume& parts, const CageOptions& options, std::int64_t& bodyVoxels) {
   if (!isIntegerType(parts.scalarType()))
     throw Error("the cage needs a label map (integer voxels), not float32");
+  // The distance field and the surface assume orthogonal voxel axes (the workbench and the
+  // Python bindings get here without the CLI's check, which names the file).
+  parts.geometry().requireOrthogonalAxes("the body-part map");
   if (options.dilateMm < 0 || !std::isfinite(options.dilateMm))
     throw Error("dilation must be >= 0 mm");
   const VolumeGeometry& in = parts.geometry();

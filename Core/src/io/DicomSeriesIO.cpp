@@ -6,6 +6,7 @@
 
 #include "DicomSandbox.h"
 #include "DicomScreen.h"
+#include "ReaderCommon.h"
 
 #include <gdcmDirectory.h>
 #include <gdcmImageReader.h>
@@ -202,7 +203,9 @@ Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
   g.ijkToRas = flipLpsRas(lps);
   g.validate(folder);
 
-  // float32 holds every int16 exactly, so it can stage the values until the type is known.
+  // float32 holds every int16 exactly, so it can stage the values until the type is known: 4 bytes
+  // a voxel staged, then up to 4 in the volume.
+  io::checkReadMemory(folder, g.numVoxels(), 8, options);
   std::vector<float> all(static_cast<std::size_t>(g.numVoxels()));
   std::vector<double> pixels;
   bool integral = true;

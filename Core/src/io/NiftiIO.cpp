@@ -193,10 +193,12 @@ Volume readNifti(const std::string& path, const ReadOptions& options) {
   reportProgress(options.progress, 0.0, "reading");
   const bool scaled = nim->scl_slope != 0.0 && (nim->scl_slope != 1.0 || nim->scl_inter != 0.0);
   const ScalarType memType = scaled ? ScalarType::Float32 : io::memoryTypeFor(diskType);
-  Volume volume(geometry, memType);
   const bool direct = !scaled && scalarSize(memType) == io::diskTypeSize(diskType) &&
                       io::memoryTypeFor(diskType) == memType && diskType != io::DiskType::UInt32 &&
                       diskType != io::DiskType::Int8;
+  io::checkReadMemory(path, nim->nvox,
+                      double(scalarSize(memType)) + (direct ? 0.0 : double(nim->nbyper)), options);
+  Volume volume(geometry, memType);
   // Straight into the volume when no conversion is needed, else into a staging buffer.
   std::vector<std::uint8_t> staging;
   if (direct) {

@@ -181,6 +181,24 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
   reportProgress(options.progress, 0.0, "reading");
   checkNrrdFieldLines(path);
   NrrdPtr nrrd(nrrdNew());
+  if (options.memoryLimitBytes > 0) {
+    // teem allocates the voxels as it reads them: the header alone first, for the estimate
+    // (teem's copy of the voxels, then Repose's volume in its memory type).
+    std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
+                                                                     &nrrdIoStateNix);
+    nio->skipData = AIR_TRUE;
+    if (nrrdLoad(nrrd.get(), path.c_str(), nio.get()) != 0) {
+      takeBiffMessage();  // a header teem cannot read is reported by the full read below
+    } else {
+      io::DiskType t;
+      const double memBytes = diskTypeFromNrrd(nrrd->type, t)
+                                  ? double(scalarSize(io::memoryTypeFor(t)))
+                                  : double(nrrdElementSize(nrrd.get()));
+      io::checkReadMemory(path, std::int64_t(nrrdElementNumber(nrrd.get())),
+                          double(nrrdElementSize(nrrd.get())) + memBytes, options);
+    }
+    nrrd.reset(nrrdNew());
+  }
   if (nrrdLoad(nrrd.get(), path.c_str(), nullptr) != 0) {
     std::string message = takeBiffMessage();
     if (message.find("fread got only") != std::string::npos ||

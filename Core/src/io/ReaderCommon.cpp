@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <unordered_set>
 
 namespace repose::io {
@@ -96,6 +97,30 @@ void convertVoxels(DiskType from, const void* in, ScalarType to, void* out, std:
     using T = std::remove_pointer_t<decltype(tag)>;
     convertFrom(from, in, static_cast<T*>(out), n, path);
   });
+}
+
+void checkReadMemory(const std::string& path, std::int64_t voxels, double bytesPerVoxel,
+                     const ReadOptions& options) {
+  const double need = double(voxels) * bytesPerVoxel;
+  if (options.memoryLimitBytes <= 0 || need <= options.memoryLimitBytes) return;
+  const auto size = [](double bytes) {
+    std::ostringstream s;
+    s.precision(3);
+    if (bytes >= 1024.0 * 1024 * 1024)
+      s << bytes / (1024.0 * 1024 * 1024) << " GiB";
+    else
+      s << bytes / (1024.0 * 1024) << " MiB";
+    return s.str();
+  };
+  std::ostringstream m;
+  m << "reading it needs " << size(need) << " (" << voxels << " voxels x " << bytesPerVoxel
+    << " bytes), ";
+  if (options.memoryLimitBytes <= 1)
+    m << "but the memory budget is already used up (raise --memory)";
+  else
+    m << "more than the " << size(options.memoryLimitBytes)
+      << " the memory budget leaves (raise --memory)";
+  throwFileError(path, m.str());
 }
 
 void requireReadableFile(const std::string& path) {

@@ -2,6 +2,7 @@
 // ones, and the rule that decides whether an integer volume is a label map.
 #pragma once
 
+#include "repose/io/VolumeIO.h"
 #include "repose/volume/Volume.h"
 
 #include <cstdint>
@@ -19,6 +20,11 @@ ScalarType memoryTypeFor(DiskType t);
 // Converts n values; throws naming path when an integer does not fit the memory type.
 void convertVoxels(DiskType from, const void* in, ScalarType to, void* out, std::int64_t n,
                    const std::string& path);
+
+// Throws naming path, with the numbers, when a read needing voxels x bytesPerVoxel would exceed
+// options.memoryLimitBytes (when set). Called after the header, before any voxel is allocated.
+void checkReadMemory(const std::string& path, std::int64_t voxels, double bytesPerVoxel,
+                     const ReadOptions& options);
 
 // Throws "path: file not found" / "is a folder" / "cannot be read" before a library gets it.
 void requireReadableFile(const std::string& path);

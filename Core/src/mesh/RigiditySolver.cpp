@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <numeric>
+#include <sstream>
 
 namespace repose {
 namespace {
@@ -368,10 +369,33 @@ std::size_t CageDeformation::coefficientBytes() const {
   return coefficients_->bytes();
 }
 
-Eigen::MatrixX3d CageDeformation::greenPositions(const Eigen::MatrixX3d& deformedCage,
-                                                 GreenPrecision precision) const {
+void CageDeformation::checkPosedCage(const Eigen::MatrixX3d& deformedCage) const {
   if (deformedCage.rows() != cage_.vertices.rows())
     throw Error("deformed cage has the wrong number of vertices");
+  // A drag can put a handle anywhere; beyond 1000 cage sizes from rest nothing a body can do is
+  // left, and the products that follow (stretch, normals, a grid around the body) would lose
+  // their precision or overflow. Refused by vertex, with the distance (docs/RELIABILITY.md).
+  const Eigen::RowVector3d lo = cage_.vertices.colwise().minCoeff();
+  const Eigen::RowVector3d hi = cage_.vertices.colwise().maxCoeff();
+  const double size = (hi - lo).norm(), reach = 1000 * size;
+  for (Eigen::Index v = 0; v < deformedCage.rows(); ++v) {
+    const Eigen::RowVector3d p = deformedCage.row(v);
+    if (!p.allFinite())
+      throw Error("posed cage: vertex " + std::to_string(v) + " has a non-finite position");
+    const double away = (p - p.cwiseMax(lo).cwiseMin(hi)).stableNorm();  // no overflow at 1e300
+    if (away > reach) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "posed cage: vertex " << v << " is " << away << " mm from the rest cage, more than 1000 "
+        << "times the cage's size (" << size << " mm): a handle moved too far";
+      throw Error(m.str());
+    }
+  }
+}
+
+Eigen::MatrixX3d CageDeformation::greenPositions(const Eigen::MatrixX3d& deformedCage,
+                                                 GreenPrecision precision) const {
+  checkPosedCage(deformedCage);
   // Linear in the cage values: p = p_rest + C (x - x_rest). An unmoved cage gives p_rest exactly.
   const Eigen::MatrixX3d delta = greenCageValues(cage_, deformedCage) - restCageValues_;
   return restPositions_ +
@@ -393,8 +417,7 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
     throw Error("handle influence computed for another transfer mesh");
   if (influence.membership.cols() != Eigen::Index(handles.size()))
     throw Error("handle influence computed for another list of handle groups");
-  if (deformedCage.rows() != cage_.vertices.rows())
-    throw Error("deformed cage has the wrong number of vertices");
+  checkPosedCage(deformedCage);
   // Green positions only where the groups do not carry a vertex alone: in a pose of rigid
   // groups that is the joints' few rows, so the frame skips most of the dense product.
   const Eigen::Index n = Eigen::Index(embedding_.cageVertices.size());

@@ -66,6 +66,7 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   ri.groupNames = groupNames;
   ri.tissues = options.tissues;
   ri.outlierVertices = rig.deformation().embedding().outliers();
+  ri.unreachableVertices = rig.deformation().solver().unconstrainedVertices();
   ri.rigidVertices = rig.influence().rigidVertices();
   const Eigen::Vector3d spacing = out.grid.spacing();
   nlohmann::json outputs = {{"posed_labels", "posed_G.nii.gz"},

@@ -171,6 +171,7 @@ static json makePoseReport(const PoseReportInput& in) {
   report["mesh"] = {{"vertices", in.mesh->vertices.rows()},
                     {"tets", in.mesh->tets.rows()},
                     {"outlier_vertices", in.outlierVertices},
+                    {"unreachable_vertices_left_at_rest", in.unreachableVertices},
                     {"vertices_moving_rigidly_with_a_group", in.rigidVertices},
                     {"inverted_tets", inverted}};
 

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <type_traits>
 
 namespace repose {
@@ -329,9 +330,23 @@ VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d&
   }
   VolumeGeometry g;
   Eigen::Vector3d start;
+  double voxels = 1;
   for (int c = 0; c < 3; ++c) {
     start[c] = std::floor(lo[c]) - marginVoxels;
-    g.dims[c] = static_cast<std::int64_t>(std::ceil(hi[c]) + marginVoxels - start[c]) + 1;
+    const double extent = std::ceil(hi[c]) + marginVoxels - start[c] + 1;
+    voxels *= extent;
+    // A handle dragged far away makes a body kilometres long: refuse the grid with its size
+    // before its dimensions overflow (a budget check refuses far smaller grids with its numbers).
+    if (!(extent < double(std::int64_t(1) << 31)) || !(voxels <= kMaxGridVoxels)) {
+      std::ostringstream m;
+      m.precision(3);
+      m << "the posed body spans "
+        << (hi - lo).cwiseProduct(M.colwise().norm().transpose()).maxCoeff()
+        << " mm: its grid would need more than " << kMaxGridVoxels
+        << " voxels (a handle moved very far?)";
+      throw Error(m.str());
+    }
+    g.dims[c] = static_cast<std::int64_t>(extent);
   }
   g.ijkToRas = Eigen::Matrix4d::Identity();
   g.ijkToRas.block<3, 3>(0, 0) = M;

@@ -9,7 +9,7 @@ namespace repose {
 std::vector<LabelCount> countLabels(const Volume& volume) {
   if (!isIntegerType(volume.scalarType()))
     throw Error("label statistics need an integer volume, not float32");
-  const double voxelMm3 = volume.geometry().spacing().prod();
+  const double voxelMm3 = volume.geometry().voxelVolumeMm3();
   std::vector<LabelCount> out;
   for (int layer = 0; layer < volume.layers(); ++layer) {
     std::map<int, std::int64_t> counts;
@@ -31,6 +31,14 @@ std::vector<LabelCount> countLabels(const Volume& volume) {
     for (const auto& [value, voxels] : counts)
       if (value != 0) out.push_back({layer, value, voxels, voxels * voxelMm3});
   }
+  return out;
+}
+
+std::vector<LabelCount> unnamedLabels(const Volume& volume) {
+  std::vector<LabelCount> out;
+  if (volume.labels().empty()) return out;
+  for (const LabelCount& c : countLabels(volume))
+    if (!volume.labels().find(c.value, c.layer)) out.push_back(c);
   return out;
 }
 

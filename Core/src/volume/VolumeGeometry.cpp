@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 namespace repose {
 
@@ -18,6 +19,32 @@ Eigen::Matrix3d VolumeGeometry::directions() const {
   Eigen::Matrix3d d = ijkToRas.block<3, 3>(0, 0);
   for (int c = 0; c < 3; ++c) d.col(c).normalize();
   return d;
+}
+
+double VolumeGeometry::voxelVolumeMm3() const {
+  return std::fabs(ijkToRas.block<3, 3>(0, 0).determinant());
+}
+
+double VolumeGeometry::axisSkewDegrees() const {
+  const Eigen::Matrix3d d = directions();
+  double worst = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = a + 1; b < 3; ++b)
+      worst = std::max(
+          worst, std::fabs(90.0 - std::acos(std::clamp(d.col(a).dot(d.col(b)), -1.0, 1.0)) * 180.0 /
+                                      M_PI));
+  return worst;
+}
+
+void VolumeGeometry::requireOrthogonalAxes(const std::string& context) const {
+  const double skew = axisSkewDegrees();
+  if (skew <= kMaxAxisSkewDegrees) return;
+  std::ostringstream m;
+  m.precision(3);
+  m << "voxel axes are not orthogonal (sheared by " << skew
+    << " degrees, as in a tilted-gantry CT): resample it onto an orthogonal grid first "
+       "(e.g. with Slicer's Resample Scalar/Vector/DWI Volume)";
+  throwFileError(context, m.str());
 }
 
 Eigen::Vector3d VolumeGeometry::voxelToRas(double i, double j, double k) const {

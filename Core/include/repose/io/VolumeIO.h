@@ -14,6 +14,10 @@ enum class FileFormat { Nifti, Nrrd, SegNrrd, DicomSeries };
 
 struct ReadOptions {
   ProgressFn progress;
+  // Bytes this read may allocate (0: no limit). Each reader estimates its need from the header
+  // (the volume, plus staging or the library's own copy) before allocating anything, and above
+  // the limit throws repose::Error naming the file with the numbers (issue 10, memory budgets).
+  double memoryLimitBytes = 0;
 };
 
 struct WriteOptions {

@@ -83,6 +83,9 @@ class CageDeformation {
                           GreenPrecision precision = GreenPrecision::Exact) const;
 
  private:
+  // Throws repose::Error for a wrong vertex count, a non-finite vertex, or a vertex more than
+  // 1000 cage sizes from the rest cage (a handle moved too far).
+  void checkPosedCage(const Eigen::MatrixX3d& deformedCage) const;
   TriangleMesh cage_;
   Embedding embedding_;
   std::unique_ptr<RigiditySolver> solver_;

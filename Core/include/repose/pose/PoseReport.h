@@ -28,6 +28,9 @@ struct PoseReportInput {
   std::vector<std::string> groupNames;
   const TissueTable* tissues = nullptr;  // null: no masses and no rigidity check
   int outlierVertices = 0;
+  // Vertices of mesh components with no vertex inside the cage: the cage cannot move them, so
+  // they stay at rest (RigiditySolver). Reported so a user sees a body part the cage missed.
+  int unreachableVertices = 0;
   int rigidVertices = 0;
 };
 

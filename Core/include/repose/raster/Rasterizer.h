@@ -20,6 +20,9 @@ namespace repose {
 // every axis when > 0), shifted by whole input voxels when the spacing is kept (so an identity or
 // a whole-voxel translation maps voxel centres onto voxel centres), and grown to contain every
 // deformed vertex plus `marginVoxels`: the body is never clipped.
+// Throws repose::Error, with the body's span, when the grid would exceed kMaxGridVoxels (2^40, a
+// terabyte of bytes: far beyond any budget, so only a handle dragged kilometres away gets there).
+constexpr double kMaxGridVoxels = 1099511627776.0;
 VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d& deformed,
                             double spacingMm = 0, int marginVoxels = 1);
 
