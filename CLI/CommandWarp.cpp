@@ -89,6 +89,12 @@ int runWarp(const Args& args) {
   if (!transformOut.empty() &&
       (transformOut.size() < 5 || transformOut.compare(transformOut.size() - 5, 5, ".nrrd") != 0))
     throw UsageError{"--transform-out must name a .nrrd file"};
+  for (const auto& [a, b] : {std::pair<const char*, const char*>{"out", "image-out"},
+                             {"out", "transform-out"},
+                             {"image-out", "transform-out"}})
+    if (p.has(a) && p.has(b) &&
+        std::filesystem::absolute(p.get(a)) == std::filesystem::absolute(p.get(b)))
+      throw UsageError{std::string("--") + a + " and --" + b + " name the same file"};
   for (const char* in : {"input", "mesh", "cage", "posed-cage", "image"})
     if (p.has(in))
       for (const char* o : {"out", "image-out", "transform-out"})
@@ -96,7 +102,13 @@ int runWarp(const Args& args) {
   const double spacing = p.getDouble("spacing-mm");
   if (spacing < 0) throw UsageError{"--spacing-mm must be >= 0"};
   const double budget = parseMemoryBudget(p.get("memory"));
-  AtomicOutput probe(out);  // an unwritable output fails before the work
+  // Every output is written into its own temporary folder and all are published together at the
+  // end (commitTogether): an interrupted or failed run leaves none of them. Unwritable outputs
+  // fail here, before the work.
+  AtomicOutput outFile(out);
+  std::optional<AtomicOutput> imageFile, transformFile;
+  if (p.has("image-out")) imageFile.emplace(p.get("image-out"));
+  if (!transformOut.empty()) transformFile.emplace(transformOut);
   const auto start = std::chrono::steady_clock::now();
 
   // The input's grid and type first: its voxels are read in core only if they fit the budget.
@@ -172,26 +184,28 @@ int runWarp(const Args& args) {
       const Volume image = readVolume(p.get("image"), readOptionsWithin(budget, false));
       const Volume posedImage =
           rasterizeImage(image, mesh, deformed, grid, p.getDouble("background"), ro);
-      writeVolume(posedImage, p.get("image-out"));
+      writeVolume(posedImage, imageFile->tempPath());
     }
     if (p.has("transform-out"))
       writeDisplacementFieldNrrd(
           rasterizeDisplacement(mesh, deformed, labels->geometry(), grid, ro), grid,
-          p.get("transform-out"));
-    writeVolume(posedLabels, out);
+          transformFile->tempPath());
+    writeVolume(posedLabels, outFile.tempPath());
     for (const LabelCount& c : countLabels(*labels))
       volumes[{c.layer, c.value}].first = c.volumeMm3;
     for (const LabelCount& c : countLabels(posedLabels))
       volumes[{c.layer, c.value}].second = c.volumeMm3;
   } else {
     SliceCache cache(input, static_cast<std::size_t>(available / 2));
-    rasterizeLabelsToFile(cache, mesh, deformed, grid, out, static_cast<std::size_t>(available / 4),
-                          ro, &report);
+    rasterizeLabelsToFile(cache, mesh, deformed, grid, outFile.tempPath(),
+                          static_cast<std::size_t>(available / 4), ro, &report);
     for (const auto& [value, mm3] : streamedLabelVolumes(cache)) volumes[{0, value}].first = mm3;
     const double voxelMm3 = grid.voxelVolumeMm3();
     for (const auto& [value, count] : report.labelVoxels)
       volumes[{0, value}].second = double(count) * voxelMm3;
   }
+  commitTogether(
+      {&outFile, imageFile ? &*imageFile : nullptr, transformFile ? &*transformFile : nullptr});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

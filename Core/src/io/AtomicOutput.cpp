@@ -45,6 +45,16 @@ void AtomicOutput::commit() {
   if (committed_) return;
   // An interrupted run never publishes: the destructor removes what was written.
   throwIfInterrupted();
+  move();
+}
+
+void commitTogether(const std::vector<AtomicOutput*>& outputs) {
+  throwIfInterrupted();
+  for (AtomicOutput* o : outputs)
+    if (o && !o->committed_) o->move();
+}
+
+void AtomicOutput::move() {
   const fs::path folder = fs::path(finalPath_).parent_path().empty()
                               ? fs::path(".")
                               : fs::path(finalPath_).parent_path();

@@ -98,7 +98,10 @@ TEST(WarpCommand, RefusesBadRequestsWithOneLineAndNoOutput) {
        {p.common(wrongCage) + " --out " + shellQuote(out),
         p.common(p.cage) + " --out " + shellQuote(out) + " --memory 1K",
         p.common(p.cage) + " --out " + shellQuote(out) + " --image " + shellQuote(p.organs),
-        p.common(p.cage) + " --out " + shellQuote(p.organs)}) {
+        p.common(p.cage) + " --out " + shellQuote(p.organs),
+        // Two outputs naming one file: the second would replace the first when both commit.
+        p.common(p.cage) + " --out " + shellQuote(out) + " --image " + shellQuote(p.organs) +
+            " --image-out " + shellQuote(out)}) {
     const CommandResult bad = runCommand("repose", cmd);
     EXPECT_NE(bad.exitCode, 0) << cmd;
     EXPECT_EQ(lineCount(bad.err), 1) << bad.err;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace repose {
 
@@ -20,14 +21,22 @@ class AtomicOutput {
   const std::string& tempPath() const { return tempPath_; }
   const std::string& finalPath() const { return finalPath_; }
   // Moves every file of the temporary folder into the target folder (rename, same filesystem).
+  // Throws Interrupted instead when the run was interrupted (nothing is moved).
   void commit();
 
  private:
+  friend void commitTogether(const std::vector<AtomicOutput*>& outputs);
+  void move();
   std::string finalPath_;
   std::string tempDir_;
   std::string tempPath_;
   bool committed_ = false;
 };
+
+// Several outputs of one run (a posed map, its image, its transform) as one unit: an interrupted
+// run publishes none of them; otherwise all are moved into place, with no interruption point
+// between two of them.
+void commitTogether(const std::vector<AtomicOutput*>& outputs);
 
 // Writes `text` to `path` through an AtomicOutput: the whole file or nothing. Throws repose::Error.
 void writeTextFileAtomically(const std::string& path, const std::string& text);
