@@ -17,10 +17,9 @@
 
 qReposeModuleDiscovery::qReposeModuleDiscovery() = default;
 
-qReposeModuleDiscovery::~qReposeModuleDiscovery() {
-  // Unloading a library whose objects (VTK, Qt) may still exist is unsafe; keep it mapped.
-  for (auto& loader : this->Loaders) loader.release();
-}
+// Deleting a QPluginLoader does not unload its library (only unload() would): the plugins and
+// the objects they made stay, and Qt's library registry lets them go at exit.
+qReposeModuleDiscovery::~qReposeModuleDiscovery() = default;
 
 QStringList qReposeModuleDiscovery::defaultSearchPaths(const QStringList& extraPaths) {
   QStringList paths = extraPaths;

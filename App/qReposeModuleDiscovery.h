@@ -22,7 +22,8 @@ struct qReposeModuleDescription {
 class qReposeModuleDiscovery {
  public:
   qReposeModuleDiscovery();
-  ~qReposeModuleDiscovery();  // plugins stay loaded: their objects may outlive this
+  ~qReposeModuleDiscovery();  // plugins stay loaded (never unloaded): their objects may outlive
+                              // this
 
   // Where modules are looked for, highest priority first: `extraPaths` (--module-path), then
   // REPOSE_MODULE_PATH (list separated by ':'), then <application dir>/../lib/repose-modules.

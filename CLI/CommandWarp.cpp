@@ -150,13 +150,14 @@ int runWarp(const Args& args) {
   const double fieldBytes = p.has("transform-out") ? 12.0 * double(grid.numVoxels()) : 0.0;
   const double used = peakResidentBytes();
   const double available = budget - used;
-  const bool inCore = inBytes + outBytes + imageBytes + fieldBytes <= available;
+  const double inCoreNeed = inBytes + outBytes + imageBytes + fieldBytes;
+  const bool inCore = inCoreNeed <= available;
   const bool niftiOutput = formatForPath(out) == FileFormat::Nifti;
   if (!inCore) {
-    const std::string why =
-        out + ": posing in memory needs " + gib(inBytes + outBytes + imageBytes + fieldBytes) +
-        " (" + std::to_string(grid.numVoxels()) + " output voxels) beyond the " + gib(used) +
-        " the mesh and cage use, more than the budget of " + gib(budget);
+    const std::string why = out + ": posing in memory needs " + gib(inCoreNeed) + " (" +
+                            std::to_string(grid.numVoxels()) + " output voxels) beyond the " +
+                            gib(used) + " the mesh and cage use, more than the budget of " +
+                            gib(budget);
     if (!niftiInput || !niftiOutput || layers > 1)
       throw Error(why + "; out of core needs NIfTI in and out");
     if (p.has("image") || p.has("transform-out"))
@@ -229,6 +230,8 @@ int runWarp(const Args& args) {
       {"voxels", grid.numVoxels()},
       {"out_of_core", !inCore},
       {"memory_budget_bytes", budget},
+      {"memory_in_use_before_volumes_bytes", used},
+      {"memory_volumes_need_in_core_bytes", inCoreNeed},
       {"peak_resident_bytes", peakResidentBytes()},
       {"voxels_inside_tets", report.voxelWrites},
       {"voxels_in_shell", report.shellVoxels},

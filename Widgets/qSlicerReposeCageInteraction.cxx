@@ -25,6 +25,7 @@
 #include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
 #include <vtkTransform.h>
+#include <vtkWeakPointer.h>
 
 #include <algorithm>
 #include <cmath>
@@ -41,7 +42,8 @@ class qSlicerReposeCageInteractionPrivate {
  public:
   vtkSmartPointer<vtkSlicerReposeLogic> Logic;
   vtkRenderer* Renderer = nullptr;
-  vtkRenderWindowInteractor* Interactor = nullptr;
+  // Weak: the interactor belongs to the 3D view's render window, which may go first.
+  vtkWeakPointer<vtkRenderWindowInteractor> Interactor;
   vtkSmartPointer<vtkCallbackCommand> Callback;
   // Selected vertices, drawn over the cage's.
   vtkSmartPointer<vtkPolyData> Selected;
@@ -154,6 +156,9 @@ qSlicerReposeCageInteraction::qSlicerReposeCageInteraction(vtkRenderer* renderer
 
 qSlicerReposeCageInteraction::~qSlicerReposeCageInteraction() {
   Q_D(qSlicerReposeCageInteraction);
+  // Without its interactor the box widget has already let go of it (it observes the
+  // interactor's deletion) and there is no observer left to remove.
+  if (!d->Interactor) return;
   d->Box->SetEnabled(0);
   d->Interactor->RemoveObserver(d->Callback);
 }

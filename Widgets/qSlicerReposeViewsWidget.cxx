@@ -124,6 +124,11 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
 
 qSlicerReposeViewsWidget::~qSlicerReposeViewsWidget() {
   this->setLogic(nullptr);
+  // Before the child widgets go (~QWidget, after this body): the 3D view and with it the
+  // interactor the cage interaction observes.
+  Q_D(qSlicerReposeViewsWidget);
+  delete d->CageInteraction;
+  d->CageInteraction = nullptr;
 }
 
 void qSlicerReposeViewsWidget::setLogic(vtkSlicerReposeLogic* logic) {
@@ -192,7 +197,7 @@ void qSlicerReposeViewsWidget::refresh() {
     d->Timing->VisibilityOff();
     for (qSlicerReposeSliceView* view : d->Slices) view->setSlice(nullptr, nullptr);
     d->CameraResetFor = nullptr;
-    d->CageInteraction->update();
+    if (d->CageInteraction) d->CageInteraction->update();
     d->RenderWindow->Render();
     return;
   }
@@ -242,7 +247,7 @@ void qSlicerReposeViewsWidget::refresh() {
     camera->SetViewUp(0, 0, 1);
     d->Renderer->ResetCamera();
   }
-  d->CageInteraction->update();
+  if (d->CageInteraction) d->CageInteraction->update();
   d->RenderWindow->Render();
   d->View3D->update();
 }

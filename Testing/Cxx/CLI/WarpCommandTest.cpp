@@ -129,7 +129,15 @@ TEST(WarpCommand, OutOfCoreStaysUnderTheBudgetAndEqualsInCore) {
   ASSERT_EQ(inCore.exitCode, 0) << inCore.err;
   EXPECT_FALSE(nlohmann::json::parse(inCore.out)["out_of_core"].get<bool>());
   ASSERT_GT(inCore.peakRssKb, 0);
-  const long budgetKb = inCore.peakRssKb * 85 / 100;
+  // 85 % of what the in-core run took; under AddressSanitizer, whose overhead the command does not
+  // plan for, half of what the volumes need on top of what the mesh and cage took.
+  const auto inCoreJson = nlohmann::json::parse(inCore.out);
+  const long budgetKb =
+      kPeakRssIsMeaningful
+          ? inCore.peakRssKb * 85 / 100
+          : long((inCoreJson["memory_in_use_before_volumes_bytes"].get<double>() +
+                  inCoreJson["memory_volumes_need_in_core_bytes"].get<double>() / 2) /
+                 1024);
   const CommandResult outOfCore =
       runCommand("repose",
                  p.common(posed) + " --out " + shellQuote(outOfCoreOut) + " --memory " +
@@ -138,7 +146,8 @@ TEST(WarpCommand, OutOfCoreStaysUnderTheBudgetAndEqualsInCore) {
   ASSERT_EQ(outOfCore.exitCode, 0) << outOfCore.err;
   const auto j = nlohmann::json::parse(outOfCore.out);
   EXPECT_TRUE(j["out_of_core"].get<bool>());
-  EXPECT_LT(outOfCore.peakRssKb, budgetKb) << "in core: " << inCore.peakRssKb << " KB";
+  if (kPeakRssIsMeaningful)
+    EXPECT_LT(outOfCore.peakRssKb, budgetKb) << "in core: " << inCore.peakRssKb << " KB";
   EXPECT_EQ(readVolume(inCoreOut).bytes(), readVolume(outOfCoreOut).bytes());
   EXPECT_EQ(j["labels"], nlohmann::json::parse(inCore.out)["labels"]);
 }
