@@ -3,6 +3,7 @@
 // before and after, so a dosimetry user sees at once whether a tissue lost or gained volume.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "InputChecks.h"
 #include "MemoryBudget.h"
 #include "TerminalProgress.h"
 
@@ -213,6 +214,7 @@ int runWarp(const Args& args) {
   // Per-label volumes before and after (layer 0 and others alike).
   nlohmann::json perLabel = nlohmann::json::array();
   int lost = 0;
+  std::vector<int> unnamed;  // labels with voxels that a label table present does not name
   for (const auto& [key, v] : volumes) {
     const Label* l = layout.labels.find(key.second, key.first);
     perLabel.push_back({{"layer", key.first},
@@ -222,7 +224,10 @@ int runWarp(const Args& args) {
                         {"output_mm3", v.second},
                         {"change_percent", v.first > 0 ? 100 * (v.second / v.first - 1) : 0.0}});
     lost += v.first > 0 && v.second == 0;
+    if (!l && !layout.labels.empty() && v.first > 0 && key.second != 0)
+      unnamed.push_back(key.second);
   }
+  warnUnnamedLabels(unnamed, input, "warp");
   const nlohmann::json j = {
       {"output", out},
       {"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}},
@@ -239,6 +244,7 @@ int runWarp(const Args& args) {
       {"flat_tets", report.flatTets},
       {"unreachable_vertices_left_at_rest", deformation.solver().unconstrainedVertices()},
       {"labels_lost", lost},
+      {"labels_unnamed", unnamed},
       {"labels", perLabel},
       {"seconds", seconds}};
   if (p.has("json")) {

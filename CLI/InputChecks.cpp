@@ -16,11 +16,17 @@ void requirePoseableLabels(const Volume& volume, const std::string& path) {
 }
 
 void warnUnnamedLabels(const Volume& volume, const std::string& path, const std::string& command) {
-  const std::vector<LabelCount> unnamed = unnamedLabels(volume);
+  std::vector<int> values;
+  for (const LabelCount& c : unnamedLabels(volume)) values.push_back(c.value);
+  warnUnnamedLabels(values, path, command);
+}
+
+void warnUnnamedLabels(const std::vector<int>& unnamed, const std::string& path,
+                       const std::string& command) {
   if (unnamed.empty()) return;
   std::string list;
   for (std::size_t i = 0; i < unnamed.size() && i < 10; ++i)
-    list += (i ? ", " : "") + std::to_string(unnamed[i].value);
+    list += (i ? ", " : "") + std::to_string(unnamed[i]);
   if (unnamed.size() > 10) list += " and " + std::to_string(unnamed.size() - 10) + " more";
   std::cerr << "repose " << command << ": warning: " << path << ": label"
             << (unnamed.size() > 1 ? "s " : " ") << list << (unnamed.size() > 1 ? " have" : " has")

@@ -5,6 +5,7 @@
 #include "repose/volume/Volume.h"
 
 #include <string>
+#include <vector>
 
 namespace repose::cli {
 
@@ -14,5 +15,8 @@ void requirePoseableLabels(const Volume& volume, const std::string& path);
 
 // "warning: <path>: labels 7, 9 have voxels but no name in its label table" on stderr.
 void warnUnnamedLabels(const Volume& volume, const std::string& path, const std::string& command);
+// The same for label values already counted (warp's out-of-core path never holds the volume).
+void warnUnnamedLabels(const std::vector<int>& values, const std::string& path,
+                       const std::string& command);
 
 }  // namespace repose::cli

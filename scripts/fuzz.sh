@@ -20,8 +20,14 @@ status=0
 for t in "${TARGETS[@]}"; do
   log="$DIR/campaign-$t.log"
   start=$(date +%s)
+  # teem leaks on almost every corrupt gzip input (lsan.supp); each leak makes libFuzzer run a
+  # full leak scan, which held NRRD to 50-60 inputs a second. Its campaigns skip leak checks;
+  # the smoke runs in make test and make test-asan still check leaks on these readers.
+  leaks=1
+  case $t in Nrrd | SegNrrd) leaks=0 ;; esac
   if build-fuzz/bin/Fuzz$t -runs="$RUNS" -timeout=10 -max_len=65536 -rss_limit_mb=2560 -malloc_limit_mb=2048 \
-      -print_final_stats=1 -artifact_prefix="$DIR/" "$DIR/corpus/$t" "$DIR/seeds/$t" >"$log" 2>&1; then
+      -detect_leaks=$leaks -print_final_stats=1 -artifact_prefix="$DIR/" "$DIR/corpus/$t" "$DIR/seeds/$t" \
+      >"$log" 2>&1; then
     result=clean
   else
     result="FINDING (see $log)"

@@ -72,6 +72,21 @@ TEST(InputValidation, LabelsTheTableDoesNotNameAreWarnedAbout) {
   EXPECT_NE(cage.err.find("warning: " + file + ": label 7 has voxels but no name"),
             std::string::npos)
       << cage.err;
+  // warp counts labels as it poses (out of core it never holds the volume) and says so too.
+  const std::string cageFile = shellQuote(dir.file("cage.obj")), mesh = dir.file("tm.vtu");
+  ASSERT_EQ(runCommand("repose", "mesh --parts " + shellQuote(file) + " --cage " + cageFile +
+                                     " --out " + shellQuote(mesh))
+                .exitCode,
+            0);
+  const CommandResult warp =
+      runCommand("repose", "warp --input " + shellQuote(file) + " --mesh " + shellQuote(mesh) +
+                               " --cage " + cageFile + " --posed-cage " + cageFile + " --out " +
+                               shellQuote(dir.file("posed.nii.gz")) + " --json");
+  ASSERT_EQ(warp.exitCode, 0) << warp.err;
+  EXPECT_EQ(nlohmann::json::parse(warp.out)["labels_unnamed"], nlohmann::json::array({7}));
+  EXPECT_NE(warp.err.find("repose warp: warning: " + file + ": label 7 has voxels but no name"),
+            std::string::npos)
+      << warp.err;
   // A named table has nothing to warn about; neither has a file with no table at all.
   writeVolume(twoParts(VolumeGeometry::make({40, 40, 40}, {3, 3, 3}, {0, 0, 0}), false),
               dir.file("named.nii.gz"));
