@@ -181,6 +181,31 @@ TEST(NiftiIO, BadInputGivesOneLineErrors) {
   std::memcpy(&fourD[40], dims, sizeof(dims));
   writeAll(dir.file("fourd.nii"), fourD);
   expectOneLineError(dir.file("fourd.nii"), "4D");
+  // Regression (Testing/Fuzz/FuzzNifti): a big-endian header without magic whose vox_offset is
+  // -1.7e38 passed the truncation check, and the 350-byte file allocated 1024^3 voxels. Now
+  // refused from the header, before the memory budget is even asked.
+  std::vector<char> negativeOffset(350, 0);
+  negativeOffset[0] = '\x5c', negativeOffset[1] = '\x01';  // sizeof_hdr as the fuzzer left it
+  auto putBigEndian = [&](std::size_t at, const void* value, std::size_t bytes) {
+    for (std::size_t i = 0; i < bytes; ++i)
+      negativeOffset[at + i] = static_cast<const char*>(value)[bytes - 1 - i];
+  };
+  const std::int16_t bigDims[4] = {3, 1024, 1024, 1024}, type[2] = {256, 8};  // DT_INT8
+  for (int i = 0; i < 4; ++i) putBigEndian(40 + 2 * std::size_t(i), &bigDims[i], 2);
+  putBigEndian(70, &type[0], 2);
+  putBigEndian(72, &type[1], 2);
+  const float offset = -1.7e38f;
+  putBigEndian(108, &offset, 4);
+  writeAll(dir.file("negative_offset.nii"), negativeOffset);
+  expectOneLineError(dir.file("negative_offset.nii"), "vox_offset");
+  ReadOptions small;
+  small.memoryLimitBytes = 1e6;
+  try {
+    (void)readVolume(dir.file("negative_offset.nii"), small);
+    ADD_FAILURE() << "read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("vox_offset"), std::string::npos) << e.what();
+  }
   expectOneLineError(dir.file("missing.nii.gz"), "not found");
   writeAll(dir.file("empty.nii"), {});
   expectOneLineError(dir.file("empty.nii"), "empty");
