@@ -16,17 +16,7 @@ namespace repose::test {
 // A peak resident set means nothing under AddressSanitizer (its shadow memory and a 256 MB
 // quarantine of freed blocks come on top of what the command needs): memory budgets are checked
 // in the plain build; the sanitized build (make test-asan) checks everything else in those tests.
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool kPeakRssIsMeaningful = false;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-inline constexpr bool kPeakRssIsMeaningful = false;
-#else
-inline constexpr bool kPeakRssIsMeaningful = true;
-#endif
-#else
-inline constexpr bool kPeakRssIsMeaningful = true;
-#endif
+inline constexpr bool kPeakRssIsMeaningful = !kAddressSanitizer;
 
 struct CommandResult {
   int exitCode = -1;

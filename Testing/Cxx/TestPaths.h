@@ -10,6 +10,20 @@
 
 namespace repose::test {
 
+// Whether the tests run under AddressSanitizer (make test-asan with GCC, or clang), whose
+// allocator and memory footprint some tests must allow for.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kAddressSanitizer = true;
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+#else
+inline constexpr bool kAddressSanitizer = false;
+#endif
+
 inline std::string dataPath(const std::string& relative) {
   return std::string(REPOSE_DATA_DIR) + "/" + relative;
 }

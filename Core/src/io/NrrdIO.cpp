@@ -165,6 +165,12 @@ void checkNrrdFieldLines(const std::string& path) {
   for (std::size_t n = 1; std::getline(in, line); ++n) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) return;  // end of an attached header
+    // teem reads a line as C text, up to its first NUL: "key\0...:=value" is a field to it, not a
+    // key:=value pair, and a long one smashes its stack the same way (found by FuzzSegNrrd). A
+    // header is text: a NUL byte in it is corruption.
+    if (line.find('\0') != std::string::npos)
+      throwFileError(path, "header line " + std::to_string(n) +
+                               " holds a NUL byte: not a NRRD header (corrupt file)");
     if (n == 1 || line[0] == '#' || line.find(":=") != std::string::npos) continue;
     if (line.size() > kMaxFieldLine)
       throwFileError(path, "header line " + std::to_string(n) + " (" +

@@ -186,6 +186,12 @@ TEST(NrrdIO, BadInputGivesOneLineErrors) {
                 head + "space origin: (" + std::string(n, '9') + ")\nencoding: raw\n\n" +
                     std::string(128, 'x'),
                 "(space origin) is " + std::to_string(n + 16) + " characters long");
+  // Regression (a FuzzSegNrrd campaign): a NUL byte before ":=" made teem read a long key:=value
+  // line as a field it could not parse, and the same stack buffer overflowed.
+  expectError("nul.nrrd",
+              head + "encoding: raw\nConversion" + std::string(1, '\0') +
+                  "s:=" + std::string(2000, 't') + "\n\n" + std::string(128, 'x'),
+              "header line 9 holds a NUL byte");
   // Long key:=value pairs are data, not fields: Slicer's segment tags are read as before.
   const std::string tags = head + "encoding: raw\nSegment0_Tags:=" + std::string(3000, 't') +
                            "\n\n" + std::string(128, 'x');
