@@ -5,7 +5,7 @@
 # (build-fuzz/Testing/Fuzz/corpus/<TARGET>, kept between campaigns), and prints one line per
 # target: executions, rate, wall time, result. A finding is saved as build-fuzz/Testing/Fuzz/
 # crash-*, leak-*, timeout-* or oom-*: reproduce with build-fuzz/bin/Fuzz<TARGET> <file>, then
-# make it a regression test.
+# make it a regression test. Campaigns can run side by side (one per core).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RUNS=${1:-1000000}
@@ -27,11 +27,16 @@ for t in "${TARGETS[@]}"; do
   # one process to 1.7 GB in 250,000 inputs.
   leaks=1 chunk=$RUNS
   case $t in Nrrd | SegNrrd) leaks=0 chunk=100000 ;; esac
+  # The campaign runs a private copy of the target and its library: a rebuild of build-fuzz
+  # while it runs (another campaign's make fuzz-build) rewrote the mapped library under a running
+  # target, which died with a SEGV and an empty stack.
+  snap="$DIR/campaign-bin/$t"
+  rm -rf "$snap" && mkdir -p "$snap" && cp build-fuzz/bin/Fuzz$t build-fuzz/lib/*.so "$snap/"
   : >"$log"
   result=clean
   for ((done_runs = 0; done_runs < RUNS; done_runs += chunk)); do
     n=$((RUNS - done_runs < chunk ? RUNS - done_runs : chunk))
-    if ! build-fuzz/bin/Fuzz$t -runs="$n" -timeout=10 -max_len=65536 -rss_limit_mb=2560 \
+    if ! LD_LIBRARY_PATH="$PWD/$snap" "$snap/Fuzz$t" -runs="$n" -timeout=10 -max_len=65536 -rss_limit_mb=2560 \
         -malloc_limit_mb=2048 -detect_leaks=$leaks -print_final_stats=1 -artifact_prefix="$DIR/" \
         "$DIR/corpus/$t" "$DIR/seeds/$t" >>"$log" 2>&1; then
       result="FINDING (see $log)"
