@@ -156,28 +156,45 @@ std::map<std::string, std::string> keyValues(const Nrrd& nrrd) {
 // parse it: a field value of ~1,000-1,900 characters smashes its stack (found by
 // Testing/Fuzz/FuzzSegNrrd). Real field lines are a few hundred characters at most (sizes, space
 // directions of a 3D volume); key:=value pairs and comments are stored, not parsed, and may be
-// long (Slicer's segment tags). So field lines are checked before teem reads the header.
+// long (Slicer's segment tags). So field lines are checked before teem reads the header, split
+// and classified exactly as teem does (every case below was a campaign finding):
+// - a line ends at "\n", "\r" or "\r\n" (a lone "\r" inside a long key:=value line made its
+//   tail a field line to teem);
+// - a line is a key:=value pair only when its first ':' is followed by '=' ("a:b ... :=c" is a
+//   field to teem, and an unparseable one);
+// - teem reads a line as C text, up to its first NUL ("key\0...:=value" is a field to it): a
+//   header is text, and a NUL byte in it is corruption.
 constexpr std::size_t kMaxFieldLine = 800;
+
+void checkNrrdFieldLine(const std::string& path, std::size_t n, const std::string& line) {
+  if (line.find('\0') != std::string::npos)
+    throwFileError(path, "header line " + std::to_string(n) +
+                             " holds a NUL byte: not a NRRD header (corrupt file)");
+  if (n == 1 || line[0] == '#') return;
+  const std::size_t colon = line.find(':');
+  if (colon != std::string::npos && colon + 1 < line.size() && line[colon + 1] == '=') return;
+  if (line.size() > kMaxFieldLine)
+    throwFileError(path, "header line " + std::to_string(n) + " (" +
+                             line.substr(0, std::min<std::size_t>(colon, 40)) + ") is " +
+                             std::to_string(line.size()) +
+                             " characters long: not a NRRD field (corrupt header)");
+}
 
 void checkNrrdFieldLines(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
-  for (std::size_t n = 1; std::getline(in, line); ++n) {
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) return;  // end of an attached header
-    // teem reads a line as C text, up to its first NUL: "key\0...:=value" is a field to it, not a
-    // key:=value pair, and a long one smashes its stack the same way (found by FuzzSegNrrd). A
-    // header is text: a NUL byte in it is corruption.
-    if (line.find('\0') != std::string::npos)
-      throwFileError(path, "header line " + std::to_string(n) +
-                               " holds a NUL byte: not a NRRD header (corrupt file)");
-    if (n == 1 || line[0] == '#' || line.find(":=") != std::string::npos) continue;
-    if (line.size() > kMaxFieldLine)
-      throwFileError(path, "header line " + std::to_string(n) + " (" +
-                               line.substr(0, std::min<std::size_t>(line.find(':'), 40)) + ") is " +
-                               std::to_string(line.size()) +
-                               " characters long: not a NRRD field (corrupt header)");
+  std::size_t n = 1;
+  for (int c = in.get(); c != std::char_traits<char>::eof(); c = in.get()) {
+    if (c != '\n' && c != '\r') {
+      line.push_back(char(c));
+      continue;
+    }
+    if (c == '\r' && in.peek() == '\n') in.get();  // "\r\n" is one line end
+    if (line.empty()) return;                      // end of an attached header
+    checkNrrdFieldLine(path, n++, line);
+    line.clear();
   }
+  if (!line.empty()) checkNrrdFieldLine(path, n, line);  // a detached header's last line
 }
 
 }  // namespace

@@ -192,7 +192,24 @@ TEST(NrrdIO, BadInputGivesOneLineErrors) {
               head + "encoding: raw\nConversion" + std::string(1, '\0') +
                   "s:=" + std::string(2000, 't') + "\n\n" + std::string(128, 'x'),
               "header line 9 holds a NUL byte");
-  // Long key:=value pairs are data, not fields: Slicer's segment tags are read as before.
+  // Regressions (FuzzSegNrrd campaigns): teem ends a line at a lone "\r" too, which made the
+  // tail of a long key:=value line a field; and a line whose first ':' is not followed by '=' is
+  // a field to teem even with a ":=" further on. Both overflowed the same buffer.
+  expectError("cr.nrrd",
+              head + "encoding: raw\nSegment0_Tags:=Segmentation\rion" + std::string(1500, 't') +
+                  "\n\n" + std::string(128, 'x'),
+              "header line 10 (ion");
+  expectError("colon.nrrd",
+              head + "encoding: raw\nSegment1_Ext:" + std::string(1500, 't') + ":=x\n\n" +
+                  std::string(128, 'x'),
+              "header line 9 (Segment1_Ext) is 1516 characters long");
+  // Long key:=value pairs are data, not fields: Slicer's segment tags are read as before, with
+  // "\r\n" line ends too.
+  std::string crlf = head + "encoding: raw\nSegment0_Tags:=" + std::string(3000, 't') + "\n\n";
+  for (std::size_t i = crlf.find('\n'); i != std::string::npos; i = crlf.find('\n', i + 2))
+    crlf.insert(i, 1, '\r');
+  std::ofstream(dir.file("crlf.nrrd"), std::ios::binary) << crlf + std::string(128, 'x');
+  EXPECT_NO_THROW(readVolume(dir.file("crlf.nrrd")));
   const std::string tags = head + "encoding: raw\nSegment0_Tags:=" + std::string(3000, 't') +
                            "\n\n" + std::string(128, 'x');
   std::ofstream(dir.file("longtags.nrrd"), std::ios::binary) << tags;
