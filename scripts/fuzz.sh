@@ -5,7 +5,8 @@
 # (build-fuzz/Testing/Fuzz/corpus/<TARGET>, kept between campaigns), and prints one line per
 # target: executions, rate, wall time, result. A finding is saved as build-fuzz/Testing/Fuzz/
 # crash-*, leak-*, timeout-* or oom-*: reproduce with build-fuzz/bin/Fuzz<TARGET> <file>, then
-# make it a regression test. Campaigns can run side by side (one per core).
+# make it a regression test. A target that dies without a crash-* file (a smashed stack) leaves
+# the input it died on in its /tmp/repose-fuzz-* folder. Campaigns can run side by side.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 RUNS=${1:-1000000}
@@ -27,9 +28,9 @@ for t in "${TARGETS[@]}"; do
   # one process to 1.7 GB in 250,000 inputs.
   leaks=1 chunk=$RUNS
   case $t in Nrrd | SegNrrd) leaks=0 chunk=100000 ;; esac
-  # The campaign runs a private copy of the target and its library: a rebuild of build-fuzz
-  # while it runs (another campaign's make fuzz-build) rewrote the mapped library under a running
-  # target, which died with a SEGV and an empty stack.
+  # The campaign runs a private copy of the target and its library, so that all its processes
+  # (NRRD campaigns start one per 100,000 inputs) test the build it started with, whatever is
+  # rebuilt meanwhile (another campaign's make fuzz-build).
   snap="$DIR/campaign-bin/$t"
   rm -rf "$snap" && mkdir -p "$snap" && cp build-fuzz/bin/Fuzz$t build-fuzz/lib/*.so "$snap/"
   : >"$log"
