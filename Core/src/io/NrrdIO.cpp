@@ -197,6 +197,28 @@ void checkNrrdFieldLines(const std::string& path) {
   if (!line.empty()) checkNrrdFieldLine(path, n, line);  // a detached header's last line
 }
 
+// The header's voxel count, refused above 2^40 voxels (also where the product of the sizes would
+// overflow): no scanner or phantom comes near it, and teem would allocate a wrapped-around size.
+std::int64_t checkedVoxelCount(const std::string& path, const Nrrd& nrrd) {
+  constexpr std::uint64_t kMaxVoxels = std::uint64_t(1) << 40;
+  std::uint64_t voxels = 1;
+  std::string sizes;
+  bool tooMany = false;
+  for (unsigned a = 0; a < nrrd.dim && a < NRRD_DIM_MAX; ++a) {
+    const std::uint64_t n = nrrd.axis[a].size;
+    sizes += (a ? " " : "") + std::to_string(n);
+    if (n == 0 || n > kMaxVoxels / voxels)
+      tooMany = tooMany || n != 0;
+    else
+      voxels *= n;
+  }
+  if (tooMany)
+    throwFileError(path, "sizes " + sizes +
+                             " hold more than 2^40 voxels: not a volume Repose can read (corrupt "
+                             "header?)");
+  return std::int64_t(voxels);
+}
+
 }  // namespace
 
 Volume readNrrd(const std::string& path, const ReadOptions& options) {
@@ -204,21 +226,23 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
   reportProgress(options.progress, 0.0, "reading");
   checkNrrdFieldLines(path);
   NrrdPtr nrrd(nrrdNew());
-  if (options.memoryLimitBytes > 0) {
-    // teem allocates the voxels as it reads them: the header alone first, for the estimate
-    // (teem's copy of the voxels, then Repose's volume in its memory type).
+  {
+    // teem allocates the voxels as it reads them, at the product of the header's sizes, which can
+    // overflow (a fuzzed "sizes: 5555...554 4 4" asked malloc for 1.4e19 bytes): the header alone
+    // first, for the voxel count (checked) and the memory estimate (teem's copy of the voxels,
+    // then Repose's volume in its memory type).
     std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
                                                                      &nrrdIoStateNix);
     nio->skipData = AIR_TRUE;
     if (nrrdLoad(nrrd.get(), path.c_str(), nio.get()) != 0) {
       takeBiffMessage();  // a header teem cannot read is reported by the full read below
     } else {
+      const std::int64_t voxels = checkedVoxelCount(path, *nrrd);
       io::DiskType t;
       const double memBytes = diskTypeFromNrrd(nrrd->type, t)
                                   ? double(scalarSize(io::memoryTypeFor(t)))
                                   : double(nrrdElementSize(nrrd.get()));
-      io::checkReadMemory(path, std::int64_t(nrrdElementNumber(nrrd.get())),
-                          double(nrrdElementSize(nrrd.get())) + memBytes, options);
+      io::checkReadMemory(path, voxels, double(nrrdElementSize(nrrd.get())) + memBytes, options);
     }
     nrrd.reset(nrrdNew());
   }

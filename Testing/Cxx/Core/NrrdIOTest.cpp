@@ -203,6 +203,17 @@ TEST(NrrdIO, BadInputGivesOneLineErrors) {
               head + "encoding: raw\nSegment1_Ext:" + std::string(1500, 't') + ":=x\n\n" +
                   std::string(128, 'x'),
               "header line 9 (Segment1_Ext) is 1516 characters long");
+  // Regression (a FuzzNrrd campaign): sizes whose product overflows made teem ask malloc for
+  // 1.4e19 bytes; sizes beyond 2^40 voxels are refused from the header, with or without a budget.
+  // (teem itself refuses a count beyond size_t; the fuzzed one wrapped to 8.8e17 x 4 x 4).
+  for (const auto& [sizes, fragment] : std::vector<std::pair<std::string, std::string>>{
+           {"5555555555555555555555555554 4 4", "too large"},
+           {"876950927440754914 4 4", "sizes 876950927440754914 4 4 hold more than 2^40 voxels"},
+           {"1048576 1048576 2", "hold more than 2^40 voxels"}})
+    expectError("huge.nrrd",
+                "NRRD0004\ntype: unsigned char\ndimension: 3\nsizes: " + sizes +
+                    "\nencoding: raw\n\n" + std::string(64, 'x'),
+                fragment);
   // Long key:=value pairs are data, not fields: Slicer's segment tags are read as before, with
   // "\r\n" line ends too.
   std::string crlf = head + "encoding: raw\nSegment0_Tags:=" + std::string(3000, 't') + "\n\n";
