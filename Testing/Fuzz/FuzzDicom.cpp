@@ -7,7 +7,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace repose;
   fuzz::writeInput("series/1.dcm", data, size);
   try {
-    const Volume v = readDicomSeries((fuzz::workFolder() / "series").string());
+    const Volume v = readDicomSeries((fuzz::workFolder() / "series").string(), fuzz::readOptions());
     (void)v.numVoxels();
   } catch (const Error&) {
   }

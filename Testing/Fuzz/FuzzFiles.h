@@ -4,6 +4,7 @@
 // crash, a sanitizer report, a hang, an allocation past libFuzzer's limit) is a finding.
 #pragma once
 
+#include "repose/io/VolumeIO.h"
 #include "repose/util/Error.h"
 
 #include <cstddef>
@@ -15,6 +16,16 @@
 #include <unistd.h>
 
 namespace repose::fuzz {
+
+// Volumes are read as the command line reads them, under a memory budget (--memory, never unset
+// there): a header claiming 300 GB is then refused from the header. Without one a reader is told
+// to allocate what the file claims, which teem does (a FuzzSegNrrd campaign finding). 1 GB stays
+// under libFuzzer's 2 GB malloc limit.
+inline ReadOptions readOptions() {
+  ReadOptions options;
+  options.memoryLimitBytes = 1e9;
+  return options;
+}
 
 // A folder of this process (removed at exit), made once.
 inline const std::filesystem::path& workFolder() {

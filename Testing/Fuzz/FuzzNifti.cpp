@@ -7,7 +7,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string path =
       fuzz::writeInput(fuzz::isGzip(data, size) ? "in.nii.gz" : "in.nii", data, size);
   try {
-    const Volume v = readVolume(path);
+    const Volume v = readVolume(path, fuzz::readOptions());
     (void)v.numVoxels();
   } catch (const Error&) {
   }

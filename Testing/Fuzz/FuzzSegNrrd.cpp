@@ -6,7 +6,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace repose;
   const std::string path = fuzz::writeInput("in.seg.nrrd", data, size);
   try {
-    const Volume v = readVolume(path);
+    const Volume v = readVolume(path, fuzz::readOptions());
     (void)v.labels();
   } catch (const Error&) {
   }
