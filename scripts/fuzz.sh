@@ -26,8 +26,13 @@ for t in "${TARGETS[@]}"; do
   # (the smoke runs in make test and the NRRD tests under make test-asan still check leaks) and
   # run in processes of 100,000 inputs on the shared corpus: the leaks they no longer catch grew
   # one process to 1.7 GB in 250,000 inputs.
-  leaks=1 chunk=$RUNS
+  leaks=1 chunk=$RUNS asan=$ASAN_OPTIONS
   case $t in Nrrd | SegNrrd) leaks=0 chunk=100000 ;; esac
+  # FuzzDicom forks once per input (the GDCM sandbox): a smaller ASan quarantine and shorter
+  # allocation stacks make the fuzzer's footprint, and so each fork, smaller. Measured over 60 s
+  # on the same corpus: 52 inputs a second by default, 126 with these (a freed block is then
+  # caught reused only within the last 16 MB freed).
+  case $t in Dicom) asan=$asan:quarantine_size_mb=16:malloc_context_size=5 ;; esac
   # The campaign runs a private copy of the target and its library, so that all its processes
   # (NRRD campaigns start one per 100,000 inputs) test the build it started with, whatever is
   # rebuilt meanwhile (another campaign's make fuzz-build).
@@ -37,7 +42,7 @@ for t in "${TARGETS[@]}"; do
   result=clean
   for ((done_runs = 0; done_runs < RUNS; done_runs += chunk)); do
     n=$((RUNS - done_runs < chunk ? RUNS - done_runs : chunk))
-    if ! LD_LIBRARY_PATH="$PWD/$snap" "$snap/Fuzz$t" -runs="$n" -timeout=10 -max_len=65536 -rss_limit_mb=2560 \
+    if ! ASAN_OPTIONS=$asan LD_LIBRARY_PATH="$PWD/$snap" "$snap/Fuzz$t" -runs="$n" -timeout=10 -max_len=65536 -rss_limit_mb=2560 \
         -malloc_limit_mb=2048 -detect_leaks=$leaks -print_final_stats=1 -artifact_prefix="$DIR/" \
         "$DIR/corpus/$t" "$DIR/seeds/$t" >>"$log" 2>&1; then
       result="FINDING (see $log)"
