@@ -9,11 +9,8 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/util/Error.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdlib>
-#include <fstream>
 #include <sstream>
 
 namespace repose::cli {
@@ -23,7 +20,7 @@ void declareMemoryOption(ArgParser& p, const std::string& aboveIt) {
 }
 
 double parseMemoryBudget(const std::string& text) {
-  if (text.empty()) return 0.5 * double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (text.empty()) return memoryBudgetByDefault();
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   const std::string unit = end ? std::string(end) : "";
@@ -38,20 +35,6 @@ double parseMemoryBudget(const std::string& text) {
     throw UsageError{"--memory: unknown unit in '" + text + "' (use K, M or G)"};
   if (!(v > 0)) throw UsageError{"--memory must be positive"};
   return v * scale;
-}
-
-double peakResidentBytes() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmHWM:") {
-      double kb = 0;
-      status >> kb;
-      return kb * 1024;
-    }
-    status.ignore(1 << 20, '\n');
-  }
-  return 0;
 }
 
 std::string gib(double bytes) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "repose/io/VolumeIO.h"
+#include "repose/util/Memory.h"
 #include "repose/volume/Volume.h"
 
 #include <string>
@@ -16,8 +17,6 @@ void declareMemoryOption(ArgParser& p, const std::string& aboveIt);
 
 // "512M", "1G", "2.5G", "300K", or bytes; empty: half the physical memory. Throws UsageError.
 double parseMemoryBudget(const std::string& text);
-// The process's peak resident set so far (VmHWM), in bytes; 0 if unknown.
-double peakResidentBytes();
 std::string gib(double bytes);
 
 // Read options for a volume read in core under `budget`: the reader refuses, naming the file and

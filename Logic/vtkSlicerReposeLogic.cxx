@@ -6,6 +6,7 @@
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeJob.h"
+#include "vtkSlicerReposeLogicRead.h"
 
 #include <repose/io/VolumeIO.h>
 #include <repose/util/Error.h>
@@ -76,7 +77,7 @@ bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
   this->LastErrorMessage.clear();
   try {
     if (path.empty()) throw repose::Error("no input file given");
-    const repose::Volume volume = repose::readVolume(path);
+    const repose::Volume volume = vtkSlicerReposeLogicRead::ReadVolume(path);
     this->VolumeImageData = vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =
         vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);

@@ -10,6 +10,7 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeJob.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicRead.h"
 #include "vtkSlicerReposeLogicInputs.h"
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
@@ -128,7 +129,7 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
                                                                      const std::string& image) {
   this->LastErrorMessage.clear();
   try {
-    const repose::Volume G = repose::readVolume(labels);
+    const repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels);
     if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
     auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
     node->SetName(stemOf(labels));
@@ -137,7 +138,7 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
          {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
           std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
       if (path.empty()) continue;
-      const repose::Volume v = repose::readVolume(path);
+      const repose::Volume v = vtkSlicerReposeLogicRead::ReadVolume(path);
       if (v.dims() != G.dims() || !v.geometry().ijkToRas.isApprox(G.geometry().ijkToRas, 1e-6))
         throw repose::Error(path + ": not on the grid of " + labels);
       (node->*setter)(Conversion::ToImageData(v));
@@ -514,14 +515,14 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
     for (int n = 0; n < loaded->GetNumberOfNodes(); ++n) {
       vtkMRMLReposeNode* node = loaded->GetNthNode(n);
       if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
-        seg->SetLabelMap(
-            Conversion::ToImageData(repose::readVolume(need(seg->GetLabelMapFileName(), seg))));
+        seg->SetLabelMap(Conversion::ToImageData(
+            vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg))));
         if (!seg->GetBodyPartMapFileName().empty())
-          seg->SetBodyPartMap(Conversion::ToImageData(
-              repose::readVolume((dir / seg->GetBodyPartMapFileName()).string())));
+          seg->SetBodyPartMap(Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(
+              (dir / seg->GetBodyPartMapFileName()).string())));
         if (!seg->GetImageFileName().empty())
           seg->SetImage(Conversion::ToImageData(
-              repose::readVolume((dir / seg->GetImageFileName()).string())));
+              vtkSlicerReposeLogicRead::ReadVolume((dir / seg->GetImageFileName()).string())));
       } else if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node)) {
         cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(
             repose::readTriangleMesh(need(cage->GetFileName(), cage))));

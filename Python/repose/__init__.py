@@ -137,18 +137,19 @@ class Scene(NamedTuple):
 
 
 def load_scene(folder, pose: Optional[Pose] = None, *, tissues="auto", joint_rings: int = -1,
-               threads: int = 0) -> Scene:
+               threads: int = 0, memory_bytes: Optional[float] = None) -> Scene:
     """Opens a scene folder (the workbench's File > Save Scene, `repose pose --scene`,
     Rig.save_scene): reads G, S and the image it names and prepares its cage and transfer mesh
     for its pose, or for `pose` (which may differ in transforms and keyframes, not separations).
+    `memory_bytes` is read_volume's budget for each of the three reads.
     """
     folder = os.fspath(folder)
     inputs = _repose._scene_inputs(folder)
-    organs = read_volume(inputs["organs"])
-    parts = read_volume(inputs["parts"]) if inputs["parts"] else None
+    organs = read_volume(inputs["organs"], memory_bytes=memory_bytes)
+    parts = read_volume(inputs["parts"], memory_bytes=memory_bytes) if inputs["parts"] else None
     if parts is None:
         raise Error(f"{folder}: the scene names no body-part map")
-    image = read_volume(inputs["image"]) if inputs["image"] else None
+    image = read_volume(inputs["image"], memory_bytes=memory_bytes) if inputs["image"] else None
     path, if_covering = _tissues(tissues)
     rig, inputs = _repose._rig_from_scene(folder, organs, parts, pose, joint_rings=joint_rings,
                                           threads=threads, _tissues_path=path,

@@ -6,6 +6,7 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/phantom/Phantom.h"
 #include "repose/util/Error.h"
+#include "repose/util/Memory.h"
 #include "repose/volume/Volume.h"
 
 #include <pybind11/eigen.h>
@@ -13,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <optional>
 #include <sstream>
 
 namespace repose::python {
@@ -205,10 +207,14 @@ nibabel gives them); writing into it changes the volume.)doc")
 
   m.def(
       "read_volume",
-      [](const std::string& path, py::object progress) {
+      [](const std::string& path, py::object progress, std::optional<double> memoryBytes) {
+        if (memoryBytes && !(*memoryBytes > 0))
+          throw py::value_error("read_volume: memory_bytes must be positive");
         PythonProgress p(std::move(progress));
         ReadOptions o;
         o.progress = p.fn();
+        o.memoryLimitBytes = memoryLeftWithin(memoryBytes.value_or(0.0));
+        o.budgetHint = "pass a larger memory_bytes= to read_volume";
         Volume v;
         try {
           py::gil_scoped_release release;
@@ -219,10 +225,14 @@ nibabel gives them); writing into it changes the volume.)doc")
         }
         return v;
       },
-      py::arg("path"), py::arg("progress") = py::none(),
+      py::arg("path"), py::arg("progress") = py::none(), py::arg("memory_bytes") = py::none(),
       R"doc(Reads a NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), 3D Slicer segmentation
 (.seg.nrrd) or a DICOM series folder into RAS millimetres. Raises repose.Error with the command
-line's one-line message (the file and the problem).)doc");
+line's one-line message (the file and the problem).
+
+memory_bytes: the budget (default: half the physical memory, as the command line's
+--memory). The read may use what the budget leaves beyond the process's resident memory; a file
+that needs more is refused with the numbers before anything is allocated.)doc");
   m.def(
       "write_volume",
       [](const Volume& v, const std::string& path, int niftiVersion) {

@@ -85,6 +85,27 @@ def test_bad_input_raises_the_command_lines_message(tmp_path, repose):
         rp.volume_from_array(np.zeros((4, 4)), np.eye(4))
 
 
+def test_reads_stay_within_a_memory_budget(tmp_path, data_dir):
+    # A 150-byte NRRD whose header claims 4000^3 voxels (64 GB): refused from the header alone
+    # under the default budget (half the physical memory), naming the file and the numbers.
+    claim = tmp_path / "claims-64GB.nrrd"
+    claim.write_bytes(b"NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4000 4000 4000\n"
+                      b"space: left-posterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n"
+                      b"encoding: raw\n\n" + bytes(64))
+    with pytest.raises(rp.Error) as refused:
+        rp.read_volume(str(claim))
+    message = str(refused.value)
+    assert str(claim) in message and "reading it needs" in message and "64000000000 voxels" in message
+    assert "memory_bytes=" in message and "\n" not in message
+    # An explicit budget: too small for a real file, then enough for it.
+    seg = str(data_dir / "totalsegmentator" / "example_seg.nii.gz")
+    with pytest.raises(rp.Error, match="memory budget is already used up"):
+        rp.read_volume(seg, memory_bytes=1e6)
+    assert rp.read_volume(seg, memory_bytes=64e9).shape == (122, 101, 30)
+    with pytest.raises(ValueError, match="memory_bytes must be positive"):
+        rp.read_volume(seg, memory_bytes=0)
+
+
 def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose, phantom):
     g, s = phantom["organs"], phantom["parts"]
     rp.write_volume(g, str(tmp_path / "G.nii.gz"))

@@ -116,10 +116,10 @@ void checkReadMemory(const std::string& path, std::int64_t voxels, double bytesP
   m << "reading it needs " << size(need) << " (" << voxels << " voxels x " << bytesPerVoxel
     << " bytes), ";
   if (options.memoryLimitBytes <= 1)
-    m << "but the memory budget is already used up (raise --memory)";
+    m << "but the memory budget is already used up (" << options.budgetHint << ")";
   else
-    m << "more than the " << size(options.memoryLimitBytes)
-      << " the memory budget leaves (raise --memory)";
+    m << "more than the " << size(options.memoryLimitBytes) << " the memory budget leaves ("
+      << options.budgetHint << ")";
   throwFileError(path, m.str());
 }
 

@@ -93,7 +93,9 @@ void expectFiniteAndConsistent(const Eigen::MatrixX3d& posedCage, const std::str
   }
   // The report counts a voxel once per tet that holds it: the folds are where it counts twice.
   EXPECT_GE(report.voxelWrites, covered);
-  if (folded > 0) EXPECT_GT(report.invertedTets, 0);
+  if (folded > 0) {
+    EXPECT_GT(report.invertedTets, 0);
+  }
 }
 
 }  // namespace

@@ -112,6 +112,32 @@ TEST(vtkSlicerReposeLogic, MissingOrBadFileGivesOneLineError) {
   EXPECT_FALSE(logic->GetLastErrorMessage().empty());
 }
 
+TEST(vtkSlicerReposeLogic, AFileClaimingMoreThanTheMemoryBudgetIsRefusedUnread) {
+  // 150 bytes whose header claims 4000^3 voxels (64 GB): the workbench reads within half the
+  // physical memory, so this is refused from the header, before teem allocates anything.
+  repose::test::ScratchDir scratch;
+  const std::string claim = scratch.file("claims-64GB.nrrd");
+  std::ofstream(claim, std::ios::binary)
+      << "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 4000 4000 4000\n"
+         "space: left-posterior-superior\nspace directions: (1,0,0) (0,1,0) (0,0,1)\n"
+         "encoding: raw\n\n"
+      << std::string(64, '\0');
+  vtkNew<vtkSlicerReposeLogic> logic;
+  EXPECT_FALSE(logic->LoadVolume(claim));
+  const std::string& error = logic->GetLastErrorMessage();
+  EXPECT_EQ(error.rfind(claim, 0), 0u) << error;
+  EXPECT_NE(error.find("reading it needs"), std::string::npos) << error;
+  EXPECT_NE(error.find("64000000000 voxels"), std::string::npos) << error;
+  EXPECT_NE(error.find("the workbench reads within half the physical memory"), std::string::npos)
+      << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  EXPECT_EQ(logic->GetVolumeImageData(), nullptr);
+  // Adding it as a segmentation to the scene is refused the same way.
+  EXPECT_EQ(logic->AddSegmentation(claim, "", ""), nullptr);
+  EXPECT_NE(logic->GetLastErrorMessage().find("reading it needs"), std::string::npos)
+      << logic->GetLastErrorMessage();
+}
+
 TEST(vtkSlicerReposeLogic, FollowsParameterNode) {
   vtkNew<vtkSlicerReposeLogic> logic;
   vtkNew<vtkMRMLReposeParametersNode> node;

@@ -18,6 +18,8 @@ struct ReadOptions {
   // (the volume, plus staging or the library's own copy) before allocating anything, and above
   // the limit throws repose::Error naming the file with the numbers (issue 10, memory budgets).
   double memoryLimitBytes = 0;
+  // How the caller's user gets a larger budget, ending that error (the command line's option).
+  std::string budgetHint = "raise --memory";
 };
 
 struct WriteOptions {

@@ -1,0 +1,20 @@
+// The process's memory as the readers' budgets see it (Linux /proc and sysconf; 0 when unknown).
+// The command line takes its budget from --memory; the workbench and Python, which have no such
+// option by default, read within memoryBudgetByDefault() less what the process already holds, so
+// a header that claims tens of gigabytes is refused with the numbers instead of attempted.
+#pragma once
+
+namespace repose {
+
+double physicalMemoryBytes();
+// The resident set now (VmRSS) and its peak so far (VmHWM).
+double residentBytes();
+double peakResidentBytes();
+// Half the physical memory: --memory's default.
+double memoryBudgetByDefault();
+// What a read may still allocate under `budget` bytes (0: memoryBudgetByDefault()) in a
+// long-lived process: the budget less the resident set now, at least 1 byte (0 is ReadOptions'
+// "no limit"), or 0 when the physical memory is unknown.
+double memoryLeftWithin(double budget = 0);
+
+}  // namespace repose
