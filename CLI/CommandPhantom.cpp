@@ -64,7 +64,18 @@ int runPhantom(const Args& args) {
                    "not grow with the voxel count.");
   parser.option("out", "DIR", "output folder (created if missing; its parent must exist)")
       .option("voxel", "MM", "isotropic voxel size in mm (1 mm gives ~160M voxels)", "2")
+      .option("spacing", "X,Y,Z",
+              "voxel size per axis instead, e.g. 1.8,1.8,4.8 for thick slices like a "
+              "reference phantom's")
       .flag("arms-touching", "hands pressed against the hips (the limb-separation case)")
+      .flag("arms-resting",
+            "real anatomy's contacts and scales: arms against the trunk along their length, hands "
+            "on the thighs, thighs touching; long bones as cortical shells around marrow, blood "
+            "vessels of a few mm")
+      .option("labels", "NAME",
+              "phantom (its own labels, named in the file) or icrp110 (ICRP 110 organ IDs on "
+              "ICRP's array order, no label table: a converted reference phantom)",
+              "phantom")
       .flag("image",
             "also a CT-like image <P>CT.<ext> (int16 HU per tissue, small fixed noise) to pose "
             "alongside G and show under the labels")
@@ -81,6 +92,25 @@ int runPhantom(const Args& args) {
   options.voxelMm = parser.getDouble("voxel");
   options.marginMm = parser.getDouble("margin");
   options.armsTouching = parser.has("arms-touching");
+  options.armsResting = parser.has("arms-resting");
+  if (options.armsTouching && options.armsResting)
+    throw UsageError{"--arms-touching and --arms-resting exclude each other"};
+  if (parser.has("spacing")) {
+    const std::string text = parser.get("spacing");
+    double v[3];
+    char tail = 0;
+    if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3)
+      throw UsageError{"--spacing expects X,Y,Z in mm, not " + text};
+    for (int c = 0; c < 3; ++c)
+      if (!std::isfinite(v[c]) || v[c] < kMinVoxelMm)
+        throw UsageError{"--spacing " + text + ": each size must be at least 0.2 mm"};
+    options.spacingMm = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  const std::string labels = parser.get("labels");
+  if (labels == "icrp110")
+    options.labels = PhantomLabelling::Icrp110;
+  else if (labels != "phantom")
+    throw UsageError{"--labels must be phantom or icrp110, not " + labels};
   options.threads = static_cast<int>(parser.getInt("threads"));
   if (!std::isfinite(options.voxelMm) || options.voxelMm <= 0)
     throw UsageError{"--voxel must be a positive size in mm, not " + parser.get("voxel")};
@@ -97,6 +127,8 @@ int runPhantom(const Args& args) {
     throw UsageError{"--prefix names files, not folders: " + prefix};
   const std::string out = parser.get("out");
   const bool json = parser.has("json");
+  if (parser.has("image") && options.labels != PhantomLabelling::Phantom)
+    throw UsageError{"--image needs the phantom's own labels (not --labels icrp110)"};
 
   const Phantom phantom(options);
   const VolumeGeometry& g = phantom.geometry();
@@ -112,7 +144,8 @@ int runPhantom(const Args& args) {
                             humanBytes(static_cast<double>(space.available)) + " are free");
   if (!json)
     std::cout << "phantom " << g.dims[0] << " x " << g.dims[1] << " x " << g.dims[2] << " = "
-              << g.numVoxels() << " voxels of " << options.voxelMm << " mm; writing about "
+              << g.numVoxels() << " voxels of " << options.spacing().x() << " x "
+              << options.spacing().y() << " x " << options.spacing().z() << " mm; writing about "
               << humanBytes(estimate) << (format == "nii" ? "" : " (gzip, estimated)") << " to "
               << out << std::endl;
 
@@ -133,7 +166,11 @@ int runPhantom(const Args& args) {
                             {"skeleton", files.skeleton},
                             {"image", files.image}}},
                           {"dims", g.dims},
-                          {"voxelMm", options.voxelMm},
+                          {"voxelMm", options.spacing().maxCoeff()},
+                          {"spacingMm",
+                           {options.spacing().x(), options.spacing().y(), options.spacing().z()}},
+                          {"armsResting", options.armsResting},
+                          {"labels", labels},
                           {"originRas", {o.x(), o.y(), o.z()}},
                           {"numVoxels", g.numVoxels()},
                           {"armsTouching", options.armsTouching},

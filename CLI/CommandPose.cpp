@@ -17,6 +17,7 @@
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
 #include "repose/pose/PoseFrame.h"
+#include "repose/pose/PoseJob.h"
 #include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRig.h"
 #include "repose/pose/SceneFolder.h"
@@ -38,15 +39,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// The default tissue table applies only to the phantom: every label of G must carry its name.
-std::optional<TissueTable> defaultTissues(const Volume& organs) {
-  const std::string path = std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
-  if (!fs::exists(path)) return std::nullopt;
-  TissueTable t = readTissueTable(path);
-  if (!tissueTableCovers(t, organs.labels())) return std::nullopt;
-  return t;
-}
-
 }  // namespace
 
 int runPose(const Args& args) {
@@ -65,8 +57,16 @@ int runPose(const Args& args) {
               "reuse the cage and mesh saved here when they match S and the settings, else "
               "build them and save them here")
       .option("tissues", "CSV",
-              "label,name,density_kg_m3,rigid (default: the phantom's table when G's labels "
-              "are the phantom's)")
+              "label,name,density_kg_m3,rigid[,bone] (default: tissues.csv beside S, as "
+              "`repose rig` writes it, else the phantom's table when G's labels are the "
+              "phantom's)")
+      .option("skeleton", "JSON",
+              "the joints a pose file names (default: skeleton.json beside S, as `repose rig` "
+              "and `repose phantom` write it)")
+      .option("spacing-mm", "MM",
+              "write the posed maps on an isotropic grid of this voxel size (0: the input's "
+              "spacing; a finer grid keeps thin structures of thick-slice inputs)",
+              "0")
       .option("cage-vertices", "N", "cage size", "300")
       .option("dilate-mm", "MM", "cage distance from the body", "10")
       .option("mesh-mm", "MM", "transfer-mesh tet size (0: 5% of S's diagonal)", "0")
@@ -79,6 +79,9 @@ int runPose(const Args& args) {
             "mesh the organs with the soft tissue around them, so a joint's bend may reach them "
             "(by default bones and organs that lie in one body part move as whole pieces; "
             "docs/QUALITY.md)")
+      .flag("no-auto-separate",
+            "do not cut apart the body parts that move with different groups where they touch "
+            "(by default they are, except across their own joint: docs/POSES.md)")
       .flag("keep-pockets",
             "keep the background pockets a bent joint traps inside the body (by default they "
             "are filled from their neighbours; docs/QUALITY.md)")
@@ -94,7 +97,10 @@ int runPose(const Args& args) {
   };
 
   // Everything that can be refused is checked before the work.
-  const Pose pose = readPoseFile(p.get("pose"));
+  Pose pose = readPoseFile(p.get("pose"));
+  const std::optional<Skeleton> skeleton = skeletonFor(p.get("parts"), p.get("skeleton"));
+  const double spacingMm = p.getDouble("spacing-mm");
+  if (!(spacingMm >= 0)) throw UsageError{"--spacing-mm must be >= 0"};
   const int jointRings = static_cast<int>(p.getInt("joint-rings")) >= 0
                              ? static_cast<int>(p.getInt("joint-rings"))
                              : pose.jointRings;
@@ -128,25 +134,33 @@ int runPose(const Args& args) {
   if (parts.dims() != organs.dims() ||
       !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
     throw Error(p.get("parts") + ": not on the grid of " + p.get("input"));
+  // The joints a pose names are those of this body's skeleton.
+  resolveJointsWith(pose, skeleton ? &*skeleton : nullptr, p.get("parts"));
   std::optional<Volume> image;
   if (p.has("image")) {
     image = readVolume(p.get("image"), readOptionsWithin(budget, !quiet));
     if (image->dims() != organs.dims())
       throw Error(p.get("image") + ": not on the grid of " + p.get("input"));
   }
-  std::optional<TissueTable> tissues;
-  if (p.has("tissues"))
-    tissues = readTissueTable(p.get("tissues"));
-  else
-    tissues = defaultTissues(organs);
-
+  const TissueChoice tissueChoice =
+      chooseTissues(organs, p.has("tissues") ? p.get("tissues") : "", p.get("parts"));
+  if (!tissueChoice.warning.empty())
+    std::cerr << "repose pose: warning: " << tissueChoice.warning << "\n";
+  const std::optional<TissueTable>& tissues = tissueChoice.table;
   // Bones are meshed as rigid pieces when the tissue table says which labels they are.
-  if (tissues)
-    for (const auto& [label, tissue] : *tissues)
-      if (tissue.rigid) rs.rigidLabels.push_back(label);
+  if (tissues) rs.rigidLabels = rigidLabelsOf(*tissues);
+  // The pose's separations and, unless turned off, the contacts between parts that move apart.
+  const PoseSeparations cuts =
+      poseSeparations(pose, parts, skeleton ? &*skeleton : nullptr, !p.has("no-auto-separate"));
+  for (const std::string& why : cuts.automatic.skipped)
+    std::cerr << "repose pose: warning: not separated: " << why << "\n";
+  for (const ContactSeparation& c : cuts.automatic.made)
+    say("separating " + c.names[0] + " from " + c.names[1] + " where they touch (" +
+        std::to_string(c.contactVoxels) + " contact voxels" +
+        (c.joint.empty() ? std::string() : ", outside the " + c.joint + " joint") + ")");
+  const std::vector<LimbSeparation>& separations = cuts.all;
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
-  const std::vector<LimbSeparation> separations = resolveSeparations(pose, parts.labels());
-  const std::string key = sceneRigKey(p.get("parts"), pose, rs);
+  const std::string key = sceneRigKey(p.get("parts"), separations, rs);
   std::optional<RigGeometry> fromScene;
   if (p.has("scene")) fromScene = readSceneRig(p.get("scene"), key);
   const bool reused = fromScene.has_value();
@@ -170,7 +184,8 @@ int runPose(const Args& args) {
   fo.image = image ? &*image : nullptr;
   fo.background = p.getDouble("background");
   fo.tissues = tissues ? &*tissues : nullptr;
-  fo.tissueTableName = p.has("tissues") ? p.get("tissues") : "phantom default";
+  fo.tissueTableName = tissueChoice.name;
+  fo.spacingMm = spacingMm;
   fo.fillPockets = !p.has("keep-pockets");
   fo.threads = threads;
   json summary = json::array();
@@ -194,6 +209,8 @@ int runPose(const Args& args) {
     report["input"] = p.get("input");
     report["scene_reused"] = reused;
     report["joint_rings"] = jointRings;
+    report["separations"] = json::parse(cuts.reportJson());
+    report["skeleton"] = skeleton ? json(skeleton->source) : json();
     posed.reportJson = report.dump();
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
     writePosedFrame(posed, dir.string());

@@ -16,6 +16,7 @@ int runCage(const Args& args);
 int runMesh(const Args& args);
 int runWarp(const Args& args);
 int runPose(const Args& args);
+int runRig(const Args& args);
 
 struct Command {
   const char* name;
@@ -29,6 +30,8 @@ inline const Command kCommands[] = {
     {"convert", "convert a volume between NIfTI, NRRD and .seg.nrrd (or from DICOM)", runConvert},
     {"phantom", "generate the synthetic whole-body mannequin (organs G, parts S, skeleton)",
      runPhantom},
+    {"rig", "make S, the skeleton and the tissue table of a segmentation from its bones",
+     runRig},
     {"cage", "build the control cage around the body (optionally separating two parts)", runCage},
     {"mesh", "build the transfer mesh and embed it in the cage", runMesh},
     {"warp", "pose a label map (and image) at full resolution from a posed cage", runWarp},

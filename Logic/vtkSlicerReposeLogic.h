@@ -214,6 +214,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   void OnLivePoseModified();
   void ReleaseLivePose();  // StopLivePose without the ModifiedEvent
   repose::RigSettings RigSettingsFor(const repose::Volume& G) const;
+  // S's file as the parameter node names it ("" without one): where a tissue table from
+  // `repose rig` is looked for.
+  std::string PartsPath() const;
   vtkMRMLReposePoseNode* AddPoseNode(const std::string& name, const std::string& json);
   // Pushes an undo step (or extends the current drag's) and sets the pose node's JSON.
   void RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after);

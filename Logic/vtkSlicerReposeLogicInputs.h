@@ -4,7 +4,10 @@
 #ifndef vtkSlicerReposeLogicInputs_h
 #define vtkSlicerReposeLogicInputs_h
 
+#include <repose/pose/Skeleton.h>
 #include <repose/volume/LabelTable.h>
+
+#include <optional>
 
 class vtkMRMLReposeCageNode;
 class vtkMRMLReposePoseNode;
@@ -22,6 +25,9 @@ struct PoseNodes {
 
 // The nodes the pose references; throws repose::Error naming the pose when one is missing.
 PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose);
+
+// The segmentation's skeleton (its SkeletonJSON), or none.
+std::optional<repose::Skeleton> SkeletonOf(vtkMRMLReposeSegmentationNode* seg);
 
 // S's label table, or the one-label table of the body mask when the segmentation has no S.
 repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg);

@@ -20,6 +20,7 @@
 #include <repose/io/NrrdIO.h>
 #include <repose/io/VolumeIO.h>
 #include <repose/pose/PoseFrame.h>
+#include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseReport.h>
 #include <repose/pose/PoseRig.h>
 #include <repose/raster/PocketFilling.h>
@@ -48,15 +49,11 @@ std::string stemOf(const std::string& path) {
   return name;
 }
 
-// Densities and rigid tissues: the table set, else the phantom's when G's labels are the
-// phantom's (as `repose pose` does); null when neither applies.
-std::shared_ptr<repose::TissueTable> tissuesFor(const std::string& path, const repose::Volume& G) {
-  const std::string table =
-      !path.empty() ? path : std::string(REPOSE_RESOURCE_DIR) + "/Tissues/phantom.csv";
-  if (!fs::exists(table)) return nullptr;
-  auto t = std::make_shared<repose::TissueTable>(repose::readTissueTable(table));
-  if (!path.empty() || repose::tissueTableCovers(*t, G.labels())) return t;
-  return nullptr;
+// Densities and rigid tissues: the table set, else the one `repose rig` wrote beside S, else the
+// phantom's when G's labels are the phantom's (Core's pose-job policy, as `repose pose` does).
+repose::TissueChoice tissuesFor(const std::string& path, const repose::Volume& G,
+                                const std::string& partsPath) {
+  return repose::chooseTissues(G, path, partsPath);
 }
 
 // S of a segmentation node, or the body mask of G (label 1 where G is not 0) when it has none.
@@ -101,6 +98,11 @@ PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose) {
   return nodes;
 }
 
+std::optional<repose::Skeleton> SkeletonOf(vtkMRMLReposeSegmentationNode* seg) {
+  if (!seg || seg->GetSkeletonJSON().empty()) return std::nullopt;
+  return repose::parseSkeleton(seg->GetSkeletonJSON(), seg->GetName() + " skeleton");
+}
+
 repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg) {
   if (seg->GetBodyPartMap()) return Conversion::GetLabelTable(seg->GetBodyPartMap());
   repose::LabelTable table;
@@ -143,6 +145,9 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
         throw repose::Error(path + ": not on the grid of " + labels);
       (node->*setter)(Conversion::ToImageData(v));
     }
+    // The joints pose files name: the skeleton beside S, as `repose pose` finds it.
+    if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())
+      node->SetSkeletonJSON(readText(skeleton));
     this->Scene->AddNode(node);
     return node;
   } catch (const std::exception& e) {
@@ -154,7 +159,19 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
 vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {
   this->LastErrorMessage.clear();
   try {
-    const repose::Pose pose = repose::readPoseFile(path);
+    repose::Pose pose = repose::readPoseFile(path);
+    // Named joints become numbers with the skeleton of the newest segmentation that has one;
+    // without one they stay named until the rig is built for a segmentation (StartBuildRig).
+    if (repose::poseNamesJoints(pose)) {
+      const auto segs = this->Scene->GetNodesByClass("vtkMRMLReposeSegmentationNode");
+      for (auto it = segs.rbegin(); it != segs.rend(); ++it)
+        if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(*it);
+            seg && !seg->GetSkeletonJSON().empty()) {
+          repose::resolvePoseJoints(pose, repose::parseSkeleton(seg->GetSkeletonJSON(),
+                                                                seg->GetName() + " skeleton"));
+          break;
+        }
+    }
     return this->AddPoseNode(pose.name.empty() ? stemOf(path) : pose.name,
                              repose::poseToJson(pose));
   } catch (const std::exception& e) {
@@ -181,9 +198,18 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
     auto parts = std::make_shared<repose::Volume>(partsOf(seg));
     auto G = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
-    const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    const std::optional<repose::Skeleton> skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
+    if (repose::poseNamesJoints(pose)) {
+      if (!skeleton)
+        throw repose::Error("pose " + poseNode->GetName() + " names joints, but segmentation " +
+                            seg->GetName() + " has no skeleton (skeleton.json beside its S)");
+      repose::resolvePoseJoints(pose, *skeleton);
+      poseNode->SetPoseJSON(repose::poseToJson(pose));  // the rig's pose, in numbers
+    }
+    // The pose's separations and the automatic ones: parts moving apart are cut where they touch.
     const std::vector<repose::LimbSeparation> separations =
-        repose::resolveSeparations(pose, parts->labels());
+        repose::poseSeparations(pose, *parts, skeleton ? &*skeleton : nullptr, true).all;
     const repose::RigSettings settings = this->RigSettingsFor(*G);
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
@@ -225,6 +251,10 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
   }
 }
 
+std::string vtkSlicerReposeLogic::PartsPath() const {
+  return this->ParameterNode ? this->ParameterNode->GetBodyPartMapPath() : std::string();
+}
+
 repose::RigSettings vtkSlicerReposeLogic::RigSettingsFor(const repose::Volume& G) const {
   repose::RigSettings settings;
   if (this->ParameterNode) {
@@ -233,9 +263,8 @@ repose::RigSettings vtkSlicerReposeLogic::RigSettingsFor(const repose::Volume& G
     settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
   }
   // Bones (the tissue table's rigid labels) and organs move as whole pieces, as in `repose pose`.
-  if (const auto tissues = tissuesFor(this->TissueTablePath, G))
-    for (const auto& [label, tissue] : *tissues)
-      if (tissue.rigid) settings.rigidLabels.push_back(label);
+  const repose::TissueChoice tissues = tissuesFor(this->TissueTablePath, G, this->PartsPath());
+  if (tissues.table) settings.rigidLabels = repose::rigidLabelsOf(*tissues.table);
   return settings;
 }
 
@@ -252,7 +281,10 @@ bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int 
     auto G = std::make_shared<repose::Volume>(
         Conversion::FromImageData(nodes.Segmentation->GetLabelMap()));
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
-    const auto separations = repose::resolveSeparations(pose, parts->labels());
+    const std::optional<repose::Skeleton> skeleton =
+        vtkSlicerReposeLogicInputs::SkeletonOf(nodes.Segmentation);
+    const auto separations =
+        repose::poseSeparations(pose, *parts, skeleton ? &*skeleton : nullptr, true).all;
     const repose::RigSettings settings = this->RigSettingsFor(*G);
     auto cage = std::make_shared<repose::TriangleMesh>(
         vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()));
@@ -323,9 +355,10 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
-    const std::shared_ptr<repose::TissueTable> tissues = tissuesFor(this->TissueTablePath, *G);
-    const std::string tissueTableName =
-        this->TissueTablePath.empty() ? "phantom default" : this->TissueTablePath;
+    const repose::TissueChoice choice = tissuesFor(this->TissueTablePath, *G, this->PartsPath());
+    const std::shared_ptr<repose::TissueTable> tissues =
+        choice.table ? std::make_shared<repose::TissueTable>(*choice.table) : nullptr;
+    const std::string tissueTableName = choice.name;
     // Memory: the posed G, S and image and the displacement field (3 floats a voxel), refused
     // above the budget with the numbers: first on the input's grid (here), then on the frame's
     // (on the worker, before any voxel is written).
@@ -517,9 +550,15 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
       if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
         seg->SetLabelMap(Conversion::ToImageData(
             vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg))));
-        if (!seg->GetBodyPartMapFileName().empty())
-          seg->SetBodyPartMap(Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(
-              (dir / seg->GetBodyPartMapFileName()).string())));
+        if (!seg->GetBodyPartMapFileName().empty()) {
+          const std::string parts = (dir / seg->GetBodyPartMapFileName()).string();
+          seg->SetBodyPartMap(
+              Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(parts)));
+          // A scene the command line wrote names S where it is; its skeleton is beside it.
+          if (seg->GetSkeletonJSON().empty())
+            if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())
+              seg->SetSkeletonJSON(readText(skeleton));
+        }
         if (!seg->GetImageFileName().empty())
           seg->SetImage(Conversion::ToImageData(
               vtkSlicerReposeLogicRead::ReadVolume((dir / seg->GetImageFileName()).string())));

@@ -12,7 +12,8 @@ vtkSmartPointer<vtkImageData> copyOf(vtkImageData* image) {
   copy->DeepCopy(image);
   return copy;
 }
-const char* const kFileFields[] = {"LabelMapFileName", "BodyPartMapFileName", "ImageFileName"};
+const char* const kFileFields[] = {"LabelMapFileName", "BodyPartMapFileName", "ImageFileName",
+                                   "SkeletonJSON"};
 }  // namespace
 
 void vtkMRMLReposeSegmentationNode::SetLabelMap(vtkImageData* image) {
@@ -32,6 +33,7 @@ void vtkMRMLReposeSegmentationNode::WriteFields(nlohmann::ordered_json& json) co
   json["LabelMapFileName"] = this->LabelMapFileName;
   json["BodyPartMapFileName"] = this->BodyPartMapFileName;
   json["ImageFileName"] = this->ImageFileName;
+  json["SkeletonJSON"] = this->SkeletonJSON;
 }
 
 bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool apply,
@@ -45,6 +47,7 @@ bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool 
   if (json.contains("BodyPartMapFileName"))
     this->SetBodyPartMapFileName(json["BodyPartMapFileName"]);
   if (json.contains("ImageFileName")) this->SetImageFileName(json["ImageFileName"]);
+  if (json.contains("SkeletonJSON")) this->SetSkeletonJSON(json["SkeletonJSON"]);
   return true;
 }
 
@@ -53,6 +56,7 @@ void vtkMRMLReposeSegmentationNode::CopyContent(vtkMRMLReposeNode* other) {
   this->SetLabelMapFileName(o->LabelMapFileName);
   this->SetBodyPartMapFileName(o->BodyPartMapFileName);
   this->SetImageFileName(o->ImageFileName);
+  this->SetSkeletonJSON(o->SkeletonJSON);
   this->SetLabelMap(copyOf(o->LabelMap));
   this->SetBodyPartMap(copyOf(o->BodyPartMap));
   this->SetImage(copyOf(o->Image));

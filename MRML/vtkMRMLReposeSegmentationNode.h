@@ -2,7 +2,7 @@
 // table in the image's field data, as the Logic's volume conversion stores it), the optional
 // body-part map S that the cage and transfer mesh follow, and an optional intensity image I posed
 // alongside; each a vtkImageData in RAS mm (origin, spacing, direction) and a file name for the
-// scene folder.
+// scene folder. With S comes its skeleton (skeleton.json's text): the joints a pose names.
 #pragma once
 
 #include "vtkMRMLReposeNode.h"
@@ -36,6 +36,10 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
   const std::string& GetImageFileName() const { return this->ImageFileName; }
   void SetImageFileName(const std::string& name) { this->SetField(this->ImageFileName, name); }
 
+  // The body's skeleton as skeleton.json text (`repose rig`, `repose phantom`); empty: none.
+  const std::string& GetSkeletonJSON() const { return this->SkeletonJSON; }
+  void SetSkeletonJSON(const std::string& text) { this->SetField(this->SkeletonJSON, text); }
+
  protected:
   vtkMRMLReposeSegmentationNode() = default;
   void WriteFields(nlohmann::ordered_json& json) const override;
@@ -44,5 +48,5 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
 
  private:
   vtkSmartPointer<vtkImageData> LabelMap, BodyPartMap, Image;
-  std::string LabelMapFileName, BodyPartMapFileName, ImageFileName;
+  std::string LabelMapFileName, BodyPartMapFileName, ImageFileName, SkeletonJSON;
 };

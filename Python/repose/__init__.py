@@ -6,11 +6,12 @@ solves, and its posed volumes, displacement field and report come out at full re
 same files as the command line (`repose pose`) and the workbench, from the same C++ core.
 
     import repose
-    g = repose.read_volume("G.nii.gz"); s = repose.read_volume("S.nii.gz")
-    pose = repose.Pose.read("walk.pose.json")
-    rig = repose.build_rig(g, s, pose)                       # cage + mesh, embedded
+    g = repose.read_volume("G.nii.gz")
+    body = repose.rig_body(g)                                # S, skeleton, tissues from the bones
+    pose = repose.Pose.read("walk.pose.json")                # joints named: "elbow_left", ...
+    rig = repose.build_rig(g, body.parts, pose, body=body)   # cage + mesh, embedded
     for i, name in enumerate(rig.frame_names):
-        frame = rig.pose_frame(g, s, i, spacing_mm=2.0)      # posed G, S, field, report
+        frame = rig.pose_frame(g, body.parts, i)              # posed G, S, field, report
         frame.write(f"out/{name}")
 
 Long calls release the GIL, take `progress=callable(fraction, stage)` (return False to cancel:
@@ -29,18 +30,21 @@ from ._repose import (  # noqa: F401  (re-exported)
     Pose,
     PosedFrame,
     Rig,
+    RiggedBody,
+    Skeleton,
     Volume,
     __version__,
     make_phantom,
     read_volume,
+    rig_body,
     write_volume,
 )
 from . import _repose
 
 __all__ = [
-    "Cancelled", "Error", "Pose", "PosedFrame", "Rig", "Scene", "Volume", "__version__",
-    "build_rig", "from_nibabel", "load_scene", "make_phantom", "read_volume", "to_nibabel",
-    "volume_from_array", "write_volume",
+    "Cancelled", "Error", "Pose", "PosedFrame", "Rig", "RiggedBody", "Scene", "Skeleton",
+    "Volume", "__version__", "build_rig", "from_nibabel", "load_scene", "make_phantom",
+    "read_volume", "rig_body", "to_nibabel", "volume_from_array", "write_volume",
 ]
 
 _PHANTOM_TISSUES = os.path.join(os.path.dirname(__file__), "phantom_tissues.csv")
@@ -110,20 +114,33 @@ def _tissues(tissues):
     return os.fspath(tissues), False
 
 
-def build_rig(organs: Volume, parts: Volume, pose: Pose, *, tissues="auto",
+def build_rig(organs: Volume, parts: Volume, pose: Pose, *, body: Optional[RiggedBody] = None,
+              skeleton=None, tissues="auto", auto_separate: bool = True,
               cage_vertices: int = 300, dilate_mm: float = 10.0, mesh_mm: float = 0.0,
               whole_organs: bool = True, joint_rings: int = -1, threads: int = 0,
               progress=None) -> Rig:
-    """Builds the cage and the transfer mesh of S for the pose (its separations made), meshes
-    bones and one-part organs as whole pieces, embeds the mesh and resolves the pose's groups.
+    """Builds the cage and the transfer mesh of S for the pose (its separations made, and the
+    automatic ones: parts that move apart are cut free where they touch, except across their own
+    joint), meshes bones and one-part organs as whole pieces, embeds the mesh and resolves the
+    pose's groups.
 
-    tissues: a tissue table CSV (label,name,density_kg_m3,rigid) for masses and bones, "auto"
-    (the phantom's table when G's labels are the phantom's) or None. The rest as `repose pose`.
+    body: what rig_body made (its skeleton and tissue table are used). skeleton: a Skeleton or a
+    skeleton.json path, for the joints the pose names. tissues: a tissue table CSV
+    (label,name,density_kg_m3,rigid[,bone]) for masses and bones, "auto" (the phantom's table
+    when G's labels are the phantom's) or None. The rest as `repose pose`.
     """
     path, if_covering = _tissues(tissues)
+    csv = ""
+    if body is not None:
+        skeleton = body.skeleton if skeleton is None else skeleton
+        if tissues == "auto":
+            path, if_covering, csv = "", False, body.tissues_csv
+    if isinstance(skeleton, (str, os.PathLike)):
+        skeleton = Skeleton.read(os.fspath(skeleton))
     return Rig(organs, parts, pose, cage_vertices=cage_vertices, dilate_mm=dilate_mm,
                mesh_mm=mesh_mm, _tissues_path=path, _tissues_if_covering=if_covering,
-               whole_organs=whole_organs, joint_rings=joint_rings, threads=threads,
+               _tissues_csv=csv, whole_organs=whole_organs, joint_rings=joint_rings,
+               threads=threads, skeleton=skeleton, auto_separate=auto_separate,
                progress=progress)
 
 

@@ -30,5 +30,6 @@ class PythonProgress {
 
 void bindVolumes(py::module_& m);
 void bindPoses(py::module_& m);
+void bindRigs(py::module_& m);
 
 }  // namespace repose::python

@@ -62,5 +62,6 @@ PYBIND11_MODULE(_repose, m) {
     }
   });
   bindVolumes(m);
+  bindRigs(m);
   bindPoses(m);
 }

@@ -8,6 +8,7 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/pose/Pose.h"
 #include "repose/pose/PoseFrame.h"
+#include "repose/pose/PoseJob.h"
 #include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRig.h"
 #include "repose/pose/SceneFolder.h"
@@ -180,9 +181,15 @@ set_transform; write with write.)doc")
           py::arg("group"), py::arg("keyframe") = py::none(),
           "Sets any of axis=, angle_deg=, pivot=, translation= of the group's transform (in a "
           "keyframe by index or name, or the base pose).")
+      .def_property_readonly("names_joints", &poseNamesJoints,
+                             "Whether a group turns about a joint named in the skeleton.")
+      .def(
+          "resolve_joints", [](Pose& p, const Skeleton& s) { resolvePoseJoints(p, s); },
+          py::arg("skeleton"),
+          "Gives the joints the pose names their places and axes from the skeleton (in place).")
       .def("__repr__", [](const Pose& p) {
         return "<repose.Pose " + p.name + ": " + std::to_string(p.groups.size()) + " groups, " +
-               std::to_string(p.frames().size()) + " frames>";
+               std::to_string(std::max<std::size_t>(1, p.keyframes.size())) + " frames>";
       });
 
   py::class_<PosedFrame>(m, "PosedFrame", R"doc(
@@ -225,10 +232,12 @@ A body rigged for a pose: the cage and transfer mesh (built from the body-part m
 separations the pose asks for, bones and one-part organs as whole pieces), embedded, the pose's
 groups resolved. Each frame of the pose is then a few solves: `deform` gives the posed cage and
 mesh, `pose_frame` the full-resolution volumes and report.)doc")
-      .def(py::init([](const Volume& organs, const Volume& parts, const Pose& pose,
+      .def(py::init([](const Volume& organs, const Volume& parts, const Pose& named,
                        int cageVertices, double dilateMm, double meshMm,
-                       const std::string& tissuesPath, bool tissuesIfCovering, bool wholeOrgans,
-                       int jointRings, int threads, const py::object& progress) {
+                       const std::string& tissuesPath, bool tissuesIfCovering,
+                       const std::string& tissuesCsv, bool wholeOrgans, int jointRings,
+                       int threads, const py::object& skeleton, bool autoSeparate,
+                       const py::object& progress) {
              if (parts.dims() != organs.dims() ||
                  !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
                throw Error("the body-part map is not on the organ map's grid");
@@ -242,8 +251,16 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
              r->settings.wholeOrgans = wholeOrgans;
              r->jointRings = jointRings;
              applyTissues(*r, organs, tissuesPath, tissuesIfCovering);
+             if (!tissuesCsv.empty()) {
+               r->tissues = parseTissueTable(tissuesCsv, "the rigged body's tissues");
+               r->tissueTableName = "rig_body";
+               r->settings.rigidLabels = rigidLabelsOf(*r->tissues);
+             }
+             const Skeleton* body = skeleton.is_none() ? nullptr : skeleton.cast<const Skeleton*>();
+             Pose pose = named;
+             resolveJointsWith(pose, body, "");
              withProgress(progress, [&](const ProgressFn& fn) {
-               const auto separations = resolveSeparations(pose, parts.labels());
+               const auto separations = poseSeparations(pose, parts, body, autoSeparate).all;
                RigGeometry g = buildRigGeometry(parts, separations, r->settings, fn, &organs);
                r->rig = std::make_unique<PoseRig>(std::move(g), pose, parts.labels(), threads,
                                                   jointRings);
@@ -254,7 +271,9 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
            py::arg("organs"), py::arg("parts"), py::arg("pose"), py::kw_only(),
            py::arg("cage_vertices") = 300, py::arg("dilate_mm") = 10.0, py::arg("mesh_mm") = 0.0,
            py::arg("_tissues_path") = "", py::arg("_tissues_if_covering") = false,
-           py::arg("whole_organs") = true, py::arg("joint_rings") = -1, py::arg("threads") = 0,
+           py::arg("_tissues_csv") = "", py::arg("whole_organs") = true,
+           py::arg("joint_rings") = -1, py::arg("threads") = 0,
+           py::arg("skeleton") = py::none(), py::arg("auto_separate") = true,
            py::arg("progress") = py::none())
       .def_property_readonly("frame_count", [](const Rig& r) { return r.rig->frameCount(); })
       .def_property_readonly("frame_names",
@@ -345,7 +364,10 @@ slabs), so label maps larger than memory can be posed.)doc")
           "save_scene",
           [](const Rig& r, const std::string& folder, const std::string& organsPath,
              const std::string& partsPath, const std::string& imagePath) {
-            const std::string key = sceneRigKey(partsPath, r.rig->pose(), r.settings);
+            const Volume parts = readVolume(partsPath);
+            const std::string key =
+                sceneRigKey(partsPath, resolveSeparations(r.rig->pose(), parts.labels()),
+                            r.settings);
             writeSceneFolder(folder, *r.rig, key, {organsPath, partsPath, imagePath}, r.settings);
           },
           py::arg("folder"), py::arg("organs_path"), py::arg("parts_path"),

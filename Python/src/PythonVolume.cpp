@@ -246,26 +246,36 @@ that needs more is refused with the numbers before anything is allocated.)doc");
 
   m.def(
       "make_phantom",
-      [](double voxelMm, bool armsTouching, bool image) {
+      [](double voxelMm, bool armsTouching, bool image, bool armsResting,
+         const py::object& spacing) {
         PhantomOptions o;
         o.voxelMm = voxelMm;
         o.armsTouching = armsTouching;
+        o.armsResting = armsResting;
+        if (!spacing.is_none()) o.spacingMm = spacing.cast<Eigen::Vector3d>();
         std::pair<Volume, Volume> maps;
         std::optional<Volume> ct;
+        Skeleton skeleton;
         {
           py::gil_scoped_release release;
-          maps = Phantom(o).makeVolumes();
+          const Phantom phantom(o);
+          maps = phantom.makeVolumes();
+          skeleton = phantom.skeleton();
           if (image) ct = syntheticCT(maps.first);
         }
         py::dict out;
         out["organs"] = std::move(maps.first);
         out["parts"] = std::move(maps.second);
+        out["skeleton"] = std::move(skeleton);
         if (ct) out["image"] = std::move(*ct);
         return out;
       },
       py::arg("voxel_mm") = 2.0, py::arg("arms_touching") = false, py::arg("image") = false,
-      R"doc(The synthetic mannequin in memory: {'organs': G, 'parts': S[, 'image': CT]}
-(`repose phantom` writes the same to files).)doc");
+      py::arg("arms_resting") = false, py::arg("spacing_mm") = py::none(),
+      R"doc(The synthetic mannequin in memory: {'organs': G, 'parts': S, 'skeleton': Skeleton[,
+'image': CT]} (`repose phantom` writes the same to files). arms_resting: the arms against the
+trunk, hands on the thighs, thighs touching, with vessels and bone marrow; spacing_mm: (x, y, z)
+voxel sizes instead of voxel_mm.)doc");
 }
 
 }  // namespace repose::python

@@ -14,6 +14,7 @@
 #include "vtkSlicerReposeLogic.h"
 
 #include <QVTKOpenGLNativeWidget.h>
+#include <repose/io/AtomicOutput.h>
 #include <repose/io/VolumeIO.h>
 #include <repose/phantom/Phantom.h>
 
@@ -91,8 +92,11 @@ struct Session {
   explicit Session(double voxelMm) {
     repose::PhantomOptions po;
     po.voxelMm = voxelMm;
-    volumes = repose::Phantom(po).makeVolumes();
+    const repose::Phantom phantom(po);
+    volumes = phantom.makeVolumes();
     G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz"), CT = dir.filePath("CT.nii.gz");
+    repose::writeTextFileAtomically(dir.filePath("skeleton.json").toStdString(),
+                                    phantom.skeletonJson());
     repose::writeVolume(volumes.first, G.toStdString());
     repose::writeVolume(volumes.second, S.toStdString());
     repose::writeVolume(repose::syntheticCT(volumes.first), CT.toStdString());

@@ -24,7 +24,8 @@ def phantom():
 
 @pytest.fixture(scope="module")
 def elbow_rig(phantom):
-    return rp.build_rig(phantom["organs"], phantom["parts"], rp.Pose.read(str(POSES / "elbow90.pose.json")))
+    return rp.build_rig(phantom["organs"], phantom["parts"],
+                        rp.Pose.read(str(POSES / "elbow90.pose.json")), skeleton=phantom["skeleton"])
 
 
 def test_version_is_the_projects():
@@ -163,7 +164,8 @@ def test_progress_cancellation_and_the_gil(phantom, elbow_rig):
         raise Stop(stage)
 
     with pytest.raises(Stop):
-        rp.build_rig(g, s, rp.Pose.read(str(POSES / "elbow90.pose.json")), progress=stop)
+        rp.build_rig(g, s, rp.Pose.read(str(POSES / "elbow90.pose.json")),
+                     skeleton=phantom["skeleton"], progress=stop)
     # The GIL is released during the work: another Python thread runs meanwhile.
     ticks = []
     done = threading.Event()
@@ -189,7 +191,7 @@ def test_pose_edits_move_the_frame(phantom):
     assert rp.Pose.from_json(pose.to_json()).transform("left forearm and hand")["angle_deg"] == 0
     with pytest.raises(rp.Error, match="fixed"):
         pose.set_transform("body", angle_deg=5)
-    rig = rp.build_rig(phantom["organs"], phantom["parts"], pose)
+    rig = rp.build_rig(phantom["organs"], phantom["parts"], pose, skeleton=phantom["skeleton"])
     cage, deformed = rig.deform(0)
     # At 0 degrees the mesh stays where it was (the solve is the identity up to round-off).
     np.testing.assert_allclose(deformed, rig.mesh_vertices, atol=1e-6)

@@ -14,11 +14,25 @@
 namespace repose {
 
 bool Region::contains(const Eigen::Vector3d& p) const {
-  if (shape == Shape::Sphere) return (p - a).norm() <= b.x();
+  switch (shape) {
+    case Shape::Sphere:
+      return (p - a).norm() <= b.x();
+    case Shape::OutsideSphere:
+      return (p - a).norm() > b.x();
+    case Shape::Everywhere:
+      return true;
+    case Shape::Box:
+      break;
+  }
   return (p.array() >= a.array()).all() && (p.array() <= b.array()).all();
 }
 
 Region Region::parse(const std::string& text) {
+  if (text == "everywhere") {
+    Region r;
+    r.shape = Shape::Everywhere;
+    return r;
+  }
   const auto colon = text.find(':');
   if (colon == std::string::npos)
     throw Error("region '" + text + "': expected box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r");
@@ -40,12 +54,14 @@ Region Region::parse(const std::string& text) {
               .cwiseMin(Eigen::Vector3d(values[3], values[4], values[5]));
     r.b = Eigen::Vector3d(values[0], values[1], values[2])
               .cwiseMax(Eigen::Vector3d(values[3], values[4], values[5]));
-  } else if (kind == "sphere" && values.size() == 4 && values[3] > 0) {
-    r.shape = Shape::Sphere;
+  } else if ((kind == "sphere" || kind == "outside") && values.size() == 4 && values[3] > 0) {
+    r.shape = kind == "sphere" ? Shape::Sphere : Shape::OutsideSphere;
     r.a = Eigen::Vector3d(values[0], values[1], values[2]);
     r.b = Eigen::Vector3d(values[3], 0, 0);
   } else {
-    throw Error("region '" + text + "': expected box:x0,y0,z0,x1,y1,z1 or sphere:x,y,z,r (r > 0)");
+    throw Error("region '" + text +
+                "': expected box:x0,y0,z0,x1,y1,z1, sphere:x,y,z,r or outside:x,y,z,r (r > 0), "
+                "or everywhere");
   }
   return r;
 }

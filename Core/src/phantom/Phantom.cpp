@@ -10,6 +10,7 @@
 #include "repose/phantom/Phantom.h"
 
 #include "PhantomBody.h"
+#include "PhantomIcrp.h"
 #include "PhantomLabels.h"
 
 #include "repose/util/Error.h"
@@ -31,13 +32,41 @@ struct Phantom::Impl {
   phantom::BodyModel model;
   VolumeGeometry geometry;
   int threads = 1;
+  bool anisotropic = false;
+  std::unique_ptr<phantom::IcrpLabeller> icrp;
 
   // Classifies p against candidate segments and structures (indices) whose boxes hold p's row.
   void evaluate(const Eigen::Vector3d& p, const std::vector<int>& segs,
                 const std::vector<int>& structs, std::uint8_t& organ, std::uint8_t& part) const;
   void fillRow(std::int64_t j, std::int64_t k, std::uint8_t* organ, std::uint8_t* part,
                std::vector<int>& segs, std::vector<int>& structs) const;
+  double bodyDistance(const Eigen::Vector3d& p, const std::vector<int>& segs) const;
+  // The skin's thickness at a surface point: one voxel along the surface's normal on a
+  // thick-slice grid, so a horizontal surface still gets its layer of skin.
+  double skinAt(const Eigen::Vector3d& p, const std::vector<int>& segs) const;
 };
+
+double Phantom::Impl::bodyDistance(const Eigen::Vector3d& p, const std::vector<int>& segs) const {
+  double body = 1e300;
+  for (int i : segs) {
+    const Segment& s = model.segments[i];
+    if (s.box.containsX(p.x())) body = phantom::smoothMin(body, s.shape.distance(p), model.blendMm);
+  }
+  return body;
+}
+
+double Phantom::Impl::skinAt(const Eigen::Vector3d& p, const std::vector<int>& segs) const {
+  const double h = 0.25;
+  Eigen::Vector3d n;
+  for (int c = 0; c < 3; ++c) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    d[c] = h;
+    n[c] = bodyDistance(p + d, segs) - bodyDistance(p - d, segs);
+  }
+  if (n.norm() < 1e-12) return model.skinMm;
+  n.normalize();
+  return std::max(2.0, 1.05 * n.cwiseProduct(model.spacing).norm());
+}
 
 void Phantom::Impl::evaluate(const Eigen::Vector3d& p, const std::vector<int>& segs,
                              const std::vector<int>& structs, std::uint8_t& organ,
@@ -53,35 +82,42 @@ void Phantom::Impl::evaluate(const Eigen::Vector3d& p, const std::vector<int>& s
     if (d < best) {
       best = d;
       owner = s.cut && (p - s.cutPoint).dot(s.cutNormal) < 0 ? s.cutOwner : s.part;
+      if (s.neckSplit)
+        owner = (p - model.neckCentre).dot(model.neckNormal) > 0 ? kPartHead : kPartTorso;
     }
   }
   if (!(body < 0)) return;
   part = owner;
   const double depth = -body;
-  if (depth < model.skinMm) {
+  const double skin =
+      anisotropic && depth < 1.05 * model.spacing.maxCoeff() ? skinAt(p, segs) : model.skinMm;
+  if (depth < skin) {
     organ = phantom::kSkin;
-    return;
-  }
-  if (depth < model.skinMm + model.fatMm[part]) {
+  } else if (depth < skin + model.fatMm[part]) {
     organ = phantom::kFat;
-    return;
-  }
-  for (int i : structs) {
-    const Structure& s = model.structures[i];
-    if (s.part == part && s.box.containsX(p.x()) && s.contains(p, depth)) {
+  } else {
+    organ = phantom::kMuscle;
+    for (int i : structs) {
+      const Structure& s = model.structures[i];
+      if (!(s.part == part || s.claimsPart || s.anyPart)) continue;
+      if (!s.box.containsX(p.x()) || !s.contains(p, depth)) continue;
       organ = s.label;
-      return;
+      if (s.claimsPart) part = s.part;  // a bone's end across its joint is still its part's
+      if (s.anyPart) organ = phantom::vesselLabel(part);
+      break;
     }
   }
-  organ = phantom::kMuscle;
+  if (icrp) organ = icrp->label(organ, part, p);
 }
 
 void Phantom::Impl::fillRow(std::int64_t j, std::int64_t k, std::uint8_t* organ, std::uint8_t* part,
                             std::vector<int>& segs, std::vector<int>& structs) const {
   const std::int64_t nx = geometry.dims[0];
-  const double v = options.voxelMm;
+  // Axis-aligned grid, possibly running against x and y (ICRP's array order).
+  const double dx = geometry.ijkToRas(0, 0);
   const Eigen::Vector3d o = geometry.origin();
-  const double y = o.y() + j * v, z = o.z() + k * v;
+  const double y = o.y() + double(j) * geometry.ijkToRas(1, 1);
+  const double z = o.z() + double(k) * geometry.ijkToRas(2, 2);
   segs.clear();
   structs.clear();
   double xlo = 1e300, xhi = -1e300;
@@ -99,22 +135,32 @@ void Phantom::Impl::fillRow(std::int64_t j, std::int64_t k, std::uint8_t* organ,
     const phantom::Box& b = model.structures[i].box;
     if (b.containsY(y) && b.containsZ(z)) structs.push_back(i);
   }
-  const std::int64_t i0 = std::max<std::int64_t>(0, static_cast<std::int64_t>((xlo - o.x()) / v));
+  const double ia = (xlo - o.x()) / dx, ib = (xhi - o.x()) / dx;
+  const std::int64_t i0 =
+      std::max<std::int64_t>(0, static_cast<std::int64_t>(std::floor(std::min(ia, ib))));
   const std::int64_t i1 =
-      std::min<std::int64_t>(nx - 1, static_cast<std::int64_t>((xhi - o.x()) / v) + 1);
+      std::min<std::int64_t>(nx - 1, static_cast<std::int64_t>(std::ceil(std::max(ia, ib))));
   for (std::int64_t i = i0; i <= i1; ++i)
-    evaluate({o.x() + i * v, y, z}, segs, structs, organ[i], part[i]);
+    evaluate({o.x() + double(i) * dx, y, z}, segs, structs, organ[i], part[i]);
 }
 
 Phantom::Phantom(const PhantomOptions& options) : impl_(std::make_unique<Impl>()) {
   if (!std::isfinite(options.voxelMm) || options.voxelMm <= 0)
     throw Error("phantom: the voxel size must be a positive number of mm, not " +
                 std::to_string(options.voxelMm));
+  const Eigen::Vector3d spacing = options.spacing();
+  if (!spacing.allFinite() || spacing.minCoeff() <= 0)
+    throw Error("phantom: every voxel spacing must be a positive number of mm");
+  if (options.armsTouching && options.armsResting)
+    throw Error("phantom: the arms either touch the hips or rest along the body, not both");
   if (!std::isfinite(options.marginMm) || options.marginMm < 0)
     throw Error("phantom: the margin must be zero or more mm");
   if (options.threads < 0) throw Error("phantom: the thread count cannot be negative");
   impl_->options = options;
   impl_->model = phantom::buildBody(options);
+  impl_->anisotropic = spacing.maxCoeff() > spacing.minCoeff() * (1 + 1e-9);
+  if (options.labels == PhantomLabelling::Icrp110)
+    impl_->icrp = std::make_unique<phantom::IcrpLabeller>(impl_->model);
   const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
   impl_->threads = options.threads > 0 ? options.threads : static_cast<int>(hw);
 
@@ -125,14 +171,21 @@ Phantom::Phantom(const PhantomOptions& options) : impl_(std::make_unique<Impl>()
   std::array<std::int64_t, 3> dims{};
   for (int w = 0; w < 3; ++w) {
     const double extent = std::max(b.hi[w] - centre[w], centre[w] - b.lo[w]) * 2;
-    const double n = std::ceil((extent + 2 * options.marginMm) / options.voxelMm);
+    const double n = std::ceil((extent + 2 * options.marginMm) / spacing[w]);
     if (n > 1e6)
-      throw Error("phantom: a voxel of " + std::to_string(options.voxelMm) +
+      throw Error("phantom: a voxel of " + std::to_string(spacing[w]) +
                   " mm makes the grid too large");
     dims[w] = static_cast<std::int64_t>(n);
-    origin[w] = centre[w] - 0.5 * (dims[w] - 1) * options.voxelMm;
+    origin[w] = centre[w] - 0.5 * double(dims[w] - 1) * spacing[w];
   }
-  impl_->geometry = VolumeGeometry::make(dims, Eigen::Vector3d::Constant(options.voxelMm), origin);
+  impl_->geometry = VolumeGeometry::make(dims, spacing, origin);
+  if (options.labels == PhantomLabelling::Icrp110) {
+    // ICRP's array order: columns from the body's right (+x) to its left, rows front to back.
+    for (int w = 0; w < 2; ++w) {
+      impl_->geometry.ijkToRas(w, w) = -spacing[w];
+      impl_->geometry.ijkToRas(w, 3) = centre[w] + 0.5 * double(dims[w] - 1) * spacing[w];
+    }
+  }
 }
 
 Phantom::~Phantom() = default;
@@ -154,7 +207,8 @@ const Joint& Phantom::joint(const std::string& name) const {
 }
 
 LabelTable Phantom::organLabels() const {
-  return phantom::makeOrganLabels();
+  if (impl_->options.labels == PhantomLabelling::Icrp110) return LabelTable();  // IDs only
+  return phantom::makeOrganLabels(impl_->options.armsResting);
 }
 LabelTable Phantom::partLabels() const {
   return phantom::makePartLabels();
@@ -217,16 +271,41 @@ std::pair<Volume, Volume> Phantom::makeVolumes(const ProgressFn& progress) const
   return maps;
 }
 
+Skeleton Phantom::skeleton() const {
+  const LabelTable parts = partLabels();
+  auto partName = [&](std::uint8_t p) {
+    const Label* l = parts.find(p);
+    return l ? l->name : std::string();
+  };
+  Skeleton out;
+  for (const Joint& j : impl_->model.joints) {
+    SkeletonJoint s;
+    s.name = j.name;
+    s.parent = j.parent;
+    s.centre = j.ras;
+    s.method = "phantom";
+    for (const auto& [name, info] : impl_->model.jointInfo) {
+      if (name != j.name) continue;
+      s.axes = jointAxes(info.kind, info.distal, Eigen::Vector3d::UnitY(),
+                         Eigen::Vector3d::UnitZ(), info.side, info.palmar);
+      s.parts = {partName(info.proximal), partName(info.distalPart)};
+      s.radiusMm = info.radiusMm;
+    }
+    out.joints.push_back(s);
+  }
+  return out;
+}
+
 std::string Phantom::skeletonJson() const {
-  nlohmann::json joints = nlohmann::json::array();
-  for (const Joint& j : impl_->model.joints)
-    joints.push_back(
-        {{"name", j.name}, {"parent", j.parent}, {"ras", {j.ras.x(), j.ras.y(), j.ras.z()}}});
-  nlohmann::json doc = {{"units", "mm"},
-                        {"space", "RAS"},
-                        {"armsTouching", impl_->options.armsTouching},
-                        {"joints", joints}};
-  return doc.dump(2) + "\n";
+  const PhantomOptions& o = impl_->options;
+  const Eigen::Vector3d sp = o.spacing();
+  nlohmann::json made = {
+      {"made_by", "repose phantom"},
+      {"armsTouching", o.armsTouching},
+      {"armsResting", o.armsResting},
+      {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
+      {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
+  return skeletonToJson(skeleton(), made.dump());
 }
 
 }  // namespace repose

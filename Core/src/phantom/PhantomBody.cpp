@@ -1,5 +1,10 @@
 // Dimensions of the mannequin: a standing child of about 1.30 m (soles at z = 0, RAS mm), built
 // from the skeleton outwards so every limb primitive and bone runs through its joints.
+//
+// Joints are congruent, as in a real skeleton: at each joint one bone ends in a convex articular
+// surface centred on the joint (the humeral and femoral heads, the humeral and femoral condyles
+// across the flexion axis, the carpals, the talus) and its partner stops a cartilage gap beyond
+// it, so turning a limb about its joint never drives one bone into the other.
 #include "PhantomBody.h"
 
 #include "PhantomLabels.h"
@@ -17,6 +22,8 @@ using V = Eigen::Vector3d;
 
 bool Structure::contains(const V& p, double depth) const {
   if (p.z() < zmin || p.z() > zmax) return false;
+  for (const auto& [c, r] : holes)
+    if ((p - c).squaredNorm() < r * r) return false;
   switch (kind) {
     case StructureKind::Cone:
       return cone.inside(p);
@@ -40,14 +47,24 @@ V mirror(const V& p) {
   return {-p.x(), p.y(), p.z()};
 }
 
+// Cartilage between the articular ends of a joint's two bones.
+constexpr double kCartilageMm = 3;
+
 // Right-side (+x) joint positions of the default pose; the left side is their mirror image.
 struct SideJoints {
   V shoulder{148, 0, 1030}, elbow{176, -14, 806}, wrist{194, 4, 602}, handTip{202, 14, 454};
   V hip{74, 0, 700}, knee{72, 6, 385}, ankle{70, 0, 76}, toe{70, 145, 20};
 };
 
+// Radii of the limb segments at their joints (mm): the body surface primitives.
+constexpr double kUpperArmR[2] = {40, 31}, kForearmR[2] = {31, 22}, kHandR[2] = {24, 22};
+constexpr double kThighR[2] = {68, 44}, kShankR[2] = {44, 27};
+constexpr double kHandThin = 0.5;  // the hand's thickness over its width
+
 struct Builder {
   BodyModel m;
+  bool detailed = false;
+  std::vector<RoundCone> trunk, thighs;  // what a resting arm lies against
 
   void segment(std::uint8_t part, const RoundCone& c) {
     Segment s;
@@ -72,8 +89,39 @@ struct Builder {
     m.structures.push_back(s);
     return m.structures.back();
   }
-  void cone(std::uint8_t label, std::uint8_t part, const RoundCone& c) {
-    structure(StructureKind::Cone, label, part).cone = c;
+  Structure& cone(std::uint8_t label, std::uint8_t part, const RoundCone& c) {
+    Structure& s = structure(StructureKind::Cone, label, part);
+    s.cone = c;
+    return s;
+  }
+  // A limb bone piece: claims its voxels for its part. With the detailed anatomy its marrow is
+  // the same shape `cortex` mm thinner. The pieces of a limb are queued and flushed marrow first
+  // (flushBones), so the bone is one cortical shell around one continuous marrow canal.
+  std::vector<Structure> marrowQueue, cortexQueue;
+  void bone(std::uint8_t label, std::uint8_t marrow, std::uint8_t part, const RoundCone& c,
+            double cortex) {
+    Structure s;
+    s.kind = StructureKind::Cone;
+    s.part = part;
+    s.claimsPart = true;
+    if (detailed && marrow) {
+      s.label = marrow;
+      s.cone = c;
+      s.cone.r1 -= cortex;
+      s.cone.r2 -= cortex;
+      s.cone.sinT = (s.cone.r1 - s.cone.r2) / s.cone.len;
+      s.cone.cosT = std::sqrt(1 - s.cone.sinT * s.cone.sinT);
+      marrowQueue.push_back(s);
+    }
+    s.label = label;
+    s.cone = c;
+    cortexQueue.push_back(s);
+  }
+  void flushBones() {
+    for (auto* queue : {&marrowQueue, &cortexQueue}) {
+      m.structures.insert(m.structures.end(), queue->begin(), queue->end());
+      queue->clear();
+    }
   }
   void ellipsoid(std::uint8_t label, std::uint8_t part, const V& c, const V& r,
                  double zmin = -1e300) {
@@ -81,8 +129,30 @@ struct Builder {
     s.outer = {c, r};
     s.zmin = zmin;
   }
+  // A vessel as a chain of tapered tubes through these points (any part; the label is set by
+  // the region of the part the voxel lies in).
+  void vessel(const std::vector<V>& points, double r0, double r1) {
+    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+      const double a = r0 + (r1 - r0) * double(i) / double(points.size() - 1);
+      const double b = r0 + (r1 - r0) * double(i + 1) / double(points.size() - 1);
+      cone(kVesselsTrunk, 0, RoundCone::make(points[i], points[i + 1], a, b)).anyPart = true;
+    }
+  }
   void joint(const std::string& name, const std::string& parent, const V& ras) {
     m.joints.push_back({name, parent, ras});
+  }
+  void info(const std::string& name, JointKind kind, int side, const V& distal,
+            std::uint8_t proximal, std::uint8_t distalPart, double radius,
+            const V& palmar = V::Zero()) {
+    BodyModel::JointInfo i;
+    i.kind = kind;
+    i.side = side;
+    i.distal = distal.normalized();
+    i.palmar = palmar;
+    i.proximal = proximal;
+    i.distalPart = distalPart;
+    i.radiusMm = radius;
+    m.jointInfo.emplace_back(name, i);
   }
   // Distance to the body assembled so far, restricted to some parts.
   double distanceTo(const V& p, std::initializer_list<std::uint8_t> parts) const {
@@ -94,9 +164,14 @@ struct Builder {
   }
 };
 
+RoundCone ball(const V& c, double r) {
+  return RoundCone::make(c - V(0, 0, 0.01), c + V(0, 0, 0.01), r, r);
+}
+
 RoundCone hand(const V& wrist, const V& tip, const V& across, double shrink) {
   const V u = (tip - wrist).normalized();
-  return RoundCone::make(wrist + 8 * u, tip - 22 * u, 24 * shrink, 22 * shrink, across, 0.5, 1);
+  return RoundCone::make(wrist + 8 * u, tip - 22 * u, kHandR[0] * shrink, kHandR[1] * shrink,
+                         across, kHandThin, 1);
 }
 
 // Rotates the arm below the shoulder about the antero-posterior axis until the palm presses
@@ -129,15 +204,70 @@ void pressArmToHip(SideJoints& j, V& across, const Builder& b, double press) {
   across = Eigen::AngleAxisd(hi, V::UnitY()) * across;
 }
 
+// How deep a limb segment from p to q (radii r0 to r1 towards the body) reaches into `body` at
+// its deepest, over the part of its length beyond `skip`.
+double reach(const V& p, const V& q, double r0, double r1, const std::vector<RoundCone>& body,
+             double skip) {
+  double deepest = -1e300;
+  for (int s = 0; s <= 40; ++s) {
+    const double t = skip + (1 - skip) * s / 40.0;
+    const V a = p + t * (q - p);
+    double d = 1e300;
+    for (const RoundCone& c : body) d = std::min(d, c.distance(a));
+    deepest = std::max(deepest, r0 + t * (r1 - r0) - d);
+  }
+  return deepest;
+}
+
+// Moves `moving` along x (outwards for larger values) until the segment from `fixed` presses
+// `press` mm into `body`: the arms-resting posture, one segment at a time.
+void restOn(const V& fixed, V& moving, double r0, double r1, const std::vector<RoundCone>& body,
+            double skip, double press) {
+  double lo = fixed.x() - 120, hi = fixed.x() + 120;  // too far in, too far out
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    V q = moving;
+    q.x() = mid;
+    (reach(fixed, q, r0, r1, body, skip) > press ? lo : hi) = mid;
+  }
+  moving.x() = hi;
+}
+
+// The arms against the trunk along their length (the upper arm on the chest wall, the forearm
+// on the hip), the hands on the thighs, the thighs touching from the groin to the knees, as in
+// the ICRP 110 reference phantoms and most supine CT. Legs first: the hands rest on them.
+void restLegs(SideJoints& j) {
+  j.knee.x() = 38;  // the inner thighs meet from mid-thigh down, the knees press together
+  j.ankle.x() = 50;
+  j.toe.x() = 50;
+}
+void restArms(SideJoints& j, const Builder& b, double press) {
+  restOn(j.shoulder, j.elbow, kUpperArmR[0], kUpperArmR[1], b.trunk, 0.2, press);
+  std::vector<RoundCone> hip = b.trunk;
+  hip.insert(hip.end(), b.thighs.begin(), b.thighs.end());
+  restOn(j.elbow, j.wrist, kForearmR[0], kForearmR[1], hip, 0.15, press);
+  // The hand's thin side faces the thigh; it starts 8 mm past the wrist.
+  restOn(j.wrist, j.handTip, kHandR[0] * kHandThin, kHandR[1] * kHandThin, b.thighs, 0.1, press);
+}
+
 void addTorsoAndHead(Builder& b) {
   const V Y = V::UnitY(), X = V::UnitX();
   b.segment(kPartTorso, RoundCone::make({0, 0, 775}, {0, 0, 885}, 114, 106, Y, 0.7, 1));
+  b.trunk.push_back(b.m.segments.back().shape);
   b.segment(kPartTorso, RoundCone::make({0, 0, 885}, {0, 0, 945}, 106, 110, Y, 0.76, 1));
+  b.trunk.push_back(b.m.segments.back().shape);
   for (double side : {1.0, -1.0})  // shoulder girdle: trapezius and clavicle line
     b.segment(kPartTorso,
               RoundCone::make({side * 40, -5, 1040}, {side * 148, 0, 1030}, 50, 42, Y, 0.8, 1));
   b.segment(kPartTorso, RoundCone::make({0, 0, 1045}, {0, 0, 1140}, 44, 40));
+  b.m.segments.back().neckSplit = true;
   b.segment(kPartHead, RoundCone::make({0, 20, 1162}, {0, -5, 1212}, 58, 88, X, 0.85, 1));
+  b.m.segments.back().neckSplit = true;
+  // The head-neck border: a plane through the joint between the spine and the skull base,
+  // 15 degrees lower in front (the jaw line) than behind.
+  b.m.neckCentre = V(0, -10, 1150);
+  const double tilt = 15 * M_PI / 180;
+  b.m.neckNormal = V(0, std::sin(tilt), std::cos(tilt));
 }
 
 void addArm(Builder& b, const SideJoints& j, const V& across, bool left) {
@@ -148,12 +278,26 @@ void addArm(Builder& b, const SideJoints& j, const V& across, bool left) {
   const std::uint8_t handPart = left ? kPartHandLeft : kPartHandRight;
   const V s = P(j.shoulder), e = P(j.elbow), w = P(j.wrist), t = P(j.handTip);
   const V uu = (e - s).normalized(), uf = (w - e).normalized(), uh = (t - w).normalized();
-  b.cutSegment(upper, RoundCone::make(s, e, 40, 31), s, uu, kPartTorso);
-  b.segment(fore, RoundCone::make(e, w, 31, 22));
+  b.cutSegment(upper, RoundCone::make(s, e, kUpperArmR[0], kUpperArmR[1]), s, uu, kPartTorso);
+  b.segment(fore, RoundCone::make(e, w, kForearmR[0], kForearmR[1]));
   b.segment(handPart, hand(w, t, ac, 1.0));
-  b.cone(kHumerus, upper, RoundCone::make(s + 4 * uu, e - 4 * uu, 11, 10));
-  b.cone(kRadiusUlna, fore, RoundCone::make(e + 5 * uf, w - 4 * uf, 10, 9, ac, 1, 0.9));
-  b.cone(kHandBones, handPart, RoundCone::make(w + 5 * uh, t - 12 * uh, 10, 6, ac, 0.55, 1));
+  // Humerus: the head (a ball on the shoulder joint), the shaft, and the condyles across the
+  // elbow's flexion axis; the forearm bones start a cartilage gap beyond the condyles and end
+  // one before the carpals, whose rounded end is centred on the wrist joint.
+  const V flex = uf.cross(V::UnitY()).normalized();
+  const double head = 13, condyle = 10, carpal = 10;
+  b.bone(kHumerus, kHumerusMarrow, upper, ball(s, head), 3);
+  b.bone(kHumerus, kHumerusMarrow, upper, RoundCone::make(s, e, 11, condyle), 3);
+  b.bone(kHumerus, kHumerusMarrow, upper,
+         RoundCone::make(e - 12 * flex, e + 12 * flex, condyle, condyle), 3);
+  const double rf0 = 10, rf1 = 9;
+  b.bone(kRadiusUlna, kRadiusUlnaMarrow, fore,
+         RoundCone::make(e + (condyle + kCartilageMm + rf0) * uf,
+                         w - (carpal + kCartilageMm + rf1) * uf, rf0, rf1, ac, 1, 0.9),
+         3);
+  // The carpals' rounded proximal surface is the hand bones' end, centred on the wrist.
+  b.bone(kHandBones, 0, handPart, RoundCone::make(w, t - 12 * uh, carpal, 6, ac, 0.55, 1), 0);
+  b.flushBones();
 }
 
 void addLeg(Builder& b, const SideJoints& j, bool left) {
@@ -168,15 +312,32 @@ void addLeg(Builder& b, const SideJoints& j, bool left) {
   // the pelvic organs above the crotch stay in the torso, clear of the thigh's border.
   const V medial = P(V(-1, 0, 0));
   const V groin = (std::cos(M_PI / 6) * ut - std::sin(M_PI / 6) * medial).normalized();
-  b.cutSegment(thigh, RoundCone::make(h, k, 68, 44), h, groin, kPartTorso);
+  b.cutSegment(thigh, RoundCone::make(h, k, kThighR[0], kThighR[1]), h, groin, kPartTorso);
+  b.thighs.push_back(b.m.segments.back().shape);
   // The heel below the ankle belongs to the foot, whose bones start there.
-  b.cutSegment(shank, RoundCone::make(k, a, 44, 27), a, -us, foot);
+  b.cutSegment(shank, RoundCone::make(k, a, kShankR[0], kShankR[1]), a, -us, foot);
   const V heel(a.x(), -18, 28), toeCentre = t - V(0, 24, 0);
   b.segment(foot, RoundCone::make(heel, toeCentre, 36, 24, Z, 0.72, 1));
   b.segment(foot, RoundCone::make(a, V(a.x(), 55, 30), 27, 24, Z, 0.9, 1));  // ankle and instep
-  b.cone(kFemur, thigh, RoundCone::make(h + 3 * ut, k - 5 * ut, 13, 12));
-  b.cone(kTibiaFibula, shank, RoundCone::make(k + 5 * us, a - 5 * us, 13, 9));
-  b.cone(kFootBones, foot, RoundCone::make(a + 5 * uf, t - 14 * uf, 12, 7, Z, 0.6, 1));
+  // Femur: the head (a ball on the hip joint, in the pelvis's socket), the shaft and the
+  // condyles across the knee's flexion axis; tibia and fibula a cartilage gap below, ending one
+  // above the talus (across the ankle's axis) from which the foot bones run.
+  const V knee = us.cross(-V::UnitY()).normalized();
+  const V ankle = uf.cross(V::UnitZ()).normalized();
+  const double head = 15, condyle = 12, talus = 10;
+  b.bone(kFemur, kFemurMarrow, thigh, ball(h, head), 4);
+  b.bone(kFemur, kFemurMarrow, thigh, RoundCone::make(h, k, 13, condyle), 4);
+  b.bone(kFemur, kFemurMarrow, thigh,
+         RoundCone::make(k - 16 * knee, k + 16 * knee, condyle, condyle), 4);
+  const double rt0 = 13, rt1 = 9;
+  b.bone(kTibiaFibula, kTibiaFibulaMarrow, shank,
+         RoundCone::make(k + (condyle + kCartilageMm + rt0) * us,
+                         a - (talus + kCartilageMm + rt1) * us, rt0, rt1),
+         3);
+  b.bone(kFootBones, 0, foot, RoundCone::make(a - 8 * ankle, a + 8 * ankle, talus, talus), 0);
+  b.bone(kFootBones, 0, foot, RoundCone::make(a, t - 14 * uf, talus, 7, Z, 0.6, 1), 0);
+  b.bone(kFootBones, 0, foot, RoundCone::make(a, V(a.x(), -22, 30), talus, 10), 0);  // heel
+  b.flushBones();
 }
 
 void addHeadStructures(Builder& b, const BodyModel& m) {
@@ -198,10 +359,45 @@ void addHeadStructures(Builder& b, const BodyModel& m) {
   b.ellipsoid(kBrain, kPartHead, skull.inner.c, skull.inner.r, skull.innerZmin);
 }
 
-void addTorsoStructures(Builder& b) {
+// Blood vessels of a few millimetres (detailed anatomy): the aorta and carotids in the trunk,
+// the axillary-brachial artery down the inner upper arm, through the elbow's crease and on as
+// the radial and ulnar arteries, and the iliac-femoral artery in front of the hip, down the inner
+// thigh, behind the knee and down the calf.
+void addVessels(Builder& b, const SideJoints& j) {
+  b.vessel({{-6, 8, 985}, {0, -20, 955}, {0, -22, 850}, {0, -22, 765}}, 8, 7);  // aorta
+  for (const double side : {1.0, -1.0}) {
+    auto P = [&](const V& p) { return V(side * p.x(), p.y(), p.z()); };
+    b.vessel({P({6, 6, 985}), P({16, 10, 1060}), P({18, 12, 1135})}, 3, 3);  // carotid
+    const V s = P(j.shoulder), e = P(j.elbow), w = P(j.wrist);
+    const V uu = (e - s).normalized(), uf = (w - e).normalized();
+    auto across = [](const V& axis, const V& dir) {
+      return V((dir - dir.dot(axis) * axis).normalized());
+    };
+    const V med = across(uu, P(V(-1, 0, 0))), ant = across(uu, V::UnitY());
+    const V medF = across(uf, P(V(-1, 0, 0))), antF = across(uf, V::UnitY());
+    b.vessel({P({6, 6, 985}), P({70, 2, 1000}), s + 35 * uu + 16 * med + 6 * ant,
+              e - 60 * uu + 15 * med + 10 * ant, e + 16 * ant + 4 * med},
+             4, 2.5);
+    for (const double to : {1.0, -1.0})  // ulnar (medial) and radial (lateral)
+      b.vessel({e + 16 * ant + 4 * med, e + 40 * uf + 14 * antF + to * 9 * medF,
+                w - 25 * uf + 12 * antF + to * 11 * medF},
+               2.2, 2);
+    const V h = P(j.hip), k = P(j.knee), a = P(j.ankle);
+    const V ut = (k - h).normalized(), us = (a - k).normalized();
+    const V medT = across(ut, P(V(-1, 0, 0))), antT = across(ut, V::UnitY());
+    b.vessel({{0, -22, 765}, P({40, 10, 725}), h + 22 * antT + 14 * medT - 10 * ut,
+              h + 150 * ut + 25 * medT + 12 * antT, k - 70 * ut + 22 * medT - 5 * antT,
+              k - 20 * V::UnitY() + 5 * medT, k + 80 * us - 18 * V::UnitY(),
+              a - 30 * us - 14 * V::UnitY() + 8 * medT},
+             5, 2.5);
+  }
+}
+
+void addTorsoStructures(Builder& b, const SideJoints& j) {
   const V Y = V::UnitY();
-  // Spine: lumbar-thoracic column, then the cervical part curving forward into the neck.
-  const V l0(0, -50, 700), t1(0, -48, 1000), c1(0, -10, 1150);
+  // Spine: lumbar-thoracic column, then the cervical part curving forward into the neck and
+  // stopping below the skull base (the neck joint is the gap between them).
+  const V l0(0, -50, 700), t1(0, -48, 1000), c1(0, -10, 1138);
   b.cone(kSpinalCord, kPartTorso, RoundCone::make(l0, t1, 5, 5));
   b.cone(kSpinalCord, kPartTorso, RoundCone::make(t1, c1, 5, 4));
   b.cone(kVertebrae, kPartTorso, RoundCone::make(l0, t1, 16, 14));
@@ -221,6 +417,9 @@ void addTorsoStructures(Builder& b) {
   pelvis.inner = {{0, -5, 735}, {85, 57, 80}};
   pelvis.zmin = 700;
   pelvis.zmax = 770;
+  for (const V& hip : {j.hip, mirror(j.hip)})  // the sockets of the femoral heads
+    pelvis.holes.emplace_back(hip, 15 + kCartilageMm);
+  if (b.detailed) addVessels(b, j);
   b.ellipsoid(kHeart, kPartTorso, {-18, 26, 948}, {40, 32, 45});
   b.ellipsoid(kLiver, kPartTorso, {26, 8, 850}, {66, 50, 48});
   b.ellipsoid(kStomach, kPartTorso, {-42, 22, 875}, {34, 28, 40});
@@ -233,13 +432,56 @@ void addTorsoStructures(Builder& b) {
   b.ellipsoid(kSmallBowel, kPartTorso, {0, 18, 760}, {85, 50, 58});
 }
 
+// Joints of the skeleton and, for the posable ones, their kind, parts and reach.
+void addJoints(Builder& b, const SideJoints& j, const V& across) {
+  b.joint("pelvis", "", {0, 0, 720});
+  b.joint("spine", "pelvis", {0, 0, 885});
+  b.joint("chest", "spine", {0, 0, 1045});
+  b.joint("neck", "chest", b.m.neckCentre);
+  b.joint("head_top", "neck", {0, -5, 1300});
+  b.info("neck", JointKind::Neck, 0, b.m.neckNormal, kPartTorso, kPartHead, 1.3 * 44);
+  for (bool left : {true, false}) {
+    const std::string sfx = left ? "_left" : "_right";
+    auto P = [&](const V& p) { return left ? mirror(p) : p; };
+    const int side = left ? -1 : 1;
+    const V s = P(j.shoulder), e = P(j.elbow), w = P(j.wrist), t = P(j.handTip);
+    const V h = P(j.hip), k = P(j.knee), a = P(j.ankle), toe = P(j.toe);
+    b.joint("shoulder" + sfx, "chest", s);
+    b.joint("elbow" + sfx, "shoulder" + sfx, e);
+    b.joint("wrist" + sfx, "elbow" + sfx, w);
+    b.joint("hand_tip" + sfx, "wrist" + sfx, t);
+    b.joint("hip" + sfx, "pelvis", h);
+    b.joint("knee" + sfx, "hip" + sfx, k);
+    b.joint("ankle" + sfx, "knee" + sfx, a);
+    b.joint("toe" + sfx, "ankle" + sfx, toe);
+    const auto u = [&](std::uint8_t p) { return left ? p : std::uint8_t(p + 3); };
+    const std::uint8_t upper = u(kPartUpperArmLeft), fore = u(kPartForearmLeft),
+                       handP = u(kPartHandLeft);
+    const std::uint8_t thigh = u(kPartThighLeft), shank = u(kPartShankLeft),
+                       foot = u(kPartFootLeft);
+    // The palm faces the hand's thin side towards the body's midline.
+    V palm = left ? mirror(across) : across;
+    if (palm.dot(P(V(-1, 0, 0))) < 0) palm = -palm;
+    b.info("shoulder" + sfx, JointKind::Shoulder, side, e - s, kPartTorso, upper,
+           1.3 * kUpperArmR[0]);
+    b.info("elbow" + sfx, JointKind::Elbow, side, w - e, upper, fore, 1.3 * kForearmR[0]);
+    b.info("wrist" + sfx, JointKind::Wrist, side, t - w, fore, handP, 1.3 * kHandR[0], palm);
+    b.info("hip" + sfx, JointKind::Hip, side, k - h, kPartTorso, thigh, 1.3 * kThighR[0]);
+    b.info("knee" + sfx, JointKind::Knee, side, a - k, thigh, shank, 1.3 * kShankR[0]);
+    b.info("ankle" + sfx, JointKind::Ankle, side, toe - a, shank, foot, 1.3 * 36);
+  }
+}
+
 }  // namespace
 
 BodyModel buildBody(const PhantomOptions& options) {
   Builder b;
   BodyModel& m = b.m;
-  // The skin is at least one voxel thick so every boundary voxel is skin at any voxel size.
-  m.skinMm = std::max(2.0, 1.05 * options.voxelMm);
+  b.detailed = options.armsResting;
+  m.spacing = options.spacing();
+  // The skin is at least one voxel thick so every boundary voxel is skin at any voxel size (on a
+  // thick-slice grid, the voxel's extent along the surface's normal: Phantom.cpp).
+  m.skinMm = std::max(2.0, 1.05 * m.spacing.minCoeff());
   m.fatMm.fill(5);
   m.fatMm[kPartHead] = 3;
   m.fatMm[kPartTorso] = 7;
@@ -251,30 +493,15 @@ BodyModel buildBody(const PhantomOptions& options) {
   V across = V::UnitX();  // the hand's thin axis: palms face the thighs
   addTorsoAndHead(b);
   addHeadStructures(b, m);
+  if (options.armsResting) restLegs(j);
   addLeg(b, j, false);
   addLeg(b, j, true);
   if (options.armsTouching) pressArmToHip(j, across, b, 3.0);
+  if (options.armsResting) restArms(j, b, 3.0);
   addArm(b, j, across, false);
   addArm(b, j, across, true);
-  addTorsoStructures(b);
-
-  b.joint("pelvis", "", {0, 0, 720});
-  b.joint("spine", "pelvis", {0, 0, 885});
-  b.joint("chest", "spine", {0, 0, 1045});
-  b.joint("neck", "chest", {0, 0, 1140});
-  b.joint("head_top", "neck", {0, -5, 1300});
-  for (bool left : {true, false}) {
-    const std::string sfx = left ? "_left" : "_right";
-    auto P = [&](const V& p) { return left ? mirror(p) : p; };
-    b.joint("shoulder" + sfx, "chest", P(j.shoulder));
-    b.joint("elbow" + sfx, "shoulder" + sfx, P(j.elbow));
-    b.joint("wrist" + sfx, "elbow" + sfx, P(j.wrist));
-    b.joint("hand_tip" + sfx, "wrist" + sfx, P(j.handTip));
-    b.joint("hip" + sfx, "pelvis", P(j.hip));
-    b.joint("knee" + sfx, "hip" + sfx, P(j.knee));
-    b.joint("ankle" + sfx, "knee" + sfx, P(j.ankle));
-    b.joint("toe" + sfx, "ankle" + sfx, P(j.toe));
-  }
+  addTorsoStructures(b, j);
+  addJoints(b, j, across);
 
   for (Segment& s : m.segments) {
     const Box tight = s.shape.bounds();

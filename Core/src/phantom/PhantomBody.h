@@ -23,15 +23,22 @@ struct Segment {
   bool cut = false;
   std::uint8_t cutOwner = 0;
   Eigen::Vector3d cutPoint = Eigen::Vector3d::Zero(), cutNormal = Eigen::Vector3d::UnitZ();
+  // The head and the neck are divided by the neck plane (BodyModel::neck*), not by distance.
+  bool neckSplit = false;
   Box box;  // bounds grown by the blend radius: beyond it the segment cannot change a voxel
 };
 
 enum class StructureKind { Cone, Ellipsoid, Shell, Ribs };
 
-// A bone or organ, applied only inside its own body part and below the skin and fat.
+// A bone or organ, applied only inside its own body part and below the skin and fat. A limb bone
+// claims its voxels for its own part wherever they are (its articular end reaches across the
+// joint plane, as a humeral head does), and a vessel runs through any part.
 struct Structure {
   StructureKind kind = StructureKind::Ellipsoid;
   std::uint8_t label = 0, part = 0;
+  bool claimsPart = false;  // a limb bone: its voxels are its part's
+  bool anyPart = false;     // a vessel: applied in every part (its label follows the region)
+  std::vector<std::pair<Eigen::Vector3d, double>> holes;  // balls cut out (a joint's socket)
   RoundCone cone;
   Ellipsoid outer, inner;              // Ellipsoid uses outer; Shell is outer minus inner
   double zmin = -1e300, zmax = 1e300;  // clips the structure to a height range
@@ -45,6 +52,18 @@ struct Structure {
 
 struct BodyModel {
   std::vector<Joint> joints;
+  // Joint -> the direction of its distal segment (for the axes), the body parts it connects and
+  // the radius within which they meet.
+  struct JointInfo {
+    JointKind kind;
+    int side = 0;  // +1 right, -1 left
+    Eigen::Vector3d distal = Eigen::Vector3d::UnitZ(), palmar = Eigen::Vector3d::Zero();
+    std::uint8_t proximal = 0, distalPart = 0;
+    double radiusMm = 0;
+  };
+  std::vector<std::pair<std::string, JointInfo>> jointInfo;
+  Eigen::Vector3d neckCentre = Eigen::Vector3d::Zero(), neckNormal = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d spacing = Eigen::Vector3d::Constant(2);  // the grid's, for the skin layer
   std::vector<Segment> segments;
   std::vector<Structure> structures;  // first match wins
   double blendMm = 10;                // smooth-union radius between segments

@@ -12,7 +12,8 @@ namespace repose {
 
 namespace {
 
-// Typical CT values (HU) of adult tissue; bone is the mean of cortex and marrow at this scale.
+// Typical CT values (HU) of adult tissue; a bone without marrow of its own is the mean of cortex
+// and marrow at this scale.
 constexpr std::array<std::int16_t, phantom::kOrganCount> kHounsfield = [] {
   std::array<std::int16_t, phantom::kOrganCount> hu{};
   hu[0] = -1000;  // air
@@ -43,6 +44,10 @@ constexpr std::array<std::int16_t, phantom::kOrganCount> kHounsfield = [] {
   hu[phantom::kBladder] = 5;
   hu[phantom::kSmallBowel] = 30;
   hu[phantom::kSpinalCord] = 35;
+  for (auto m : {phantom::kHumerusMarrow, phantom::kRadiusUlnaMarrow, phantom::kFemurMarrow,
+                 phantom::kTibiaFibulaMarrow})
+    hu[m] = 250;  // spongiosa and yellow marrow together
+  for (auto v : {phantom::kVesselsTrunk, phantom::kVesselsArms, phantom::kVesselsLegs}) hu[v] = 45;
   return hu;
 }();
 

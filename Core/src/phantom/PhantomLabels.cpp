@@ -18,7 +18,41 @@ void add(LabelTable& table, int value, const char* name, int r, int g, int b) {
 
 }  // namespace
 
-LabelTable makeOrganLabels() {
+Region regionOf(std::uint8_t part) {
+  switch (part) {
+    case kPartHead:
+      return Region::Head;
+    case kPartUpperArmLeft:
+    case kPartForearmLeft:
+    case kPartHandLeft:
+    case kPartUpperArmRight:
+    case kPartForearmRight:
+    case kPartHandRight:
+      return Region::Arms;
+    case kPartThighLeft:
+    case kPartShankLeft:
+    case kPartFootLeft:
+    case kPartThighRight:
+    case kPartShankRight:
+    case kPartFootRight:
+      return Region::Legs;
+    default:
+      return Region::Trunk;
+  }
+}
+
+std::uint8_t vesselLabel(std::uint8_t part) {
+  switch (regionOf(part)) {
+    case Region::Arms:
+      return kVesselsArms;
+    case Region::Legs:
+      return kVesselsLegs;
+    default:
+      return kVesselsTrunk;
+  }
+}
+
+LabelTable makeOrganLabels(bool detailed) {
   LabelTable t;
   add(t, kSkin, "skin", 177, 122, 101);
   add(t, kFat, "subcutaneous_fat", 235, 225, 60);
@@ -47,6 +81,14 @@ LabelTable makeOrganLabels() {
   add(t, kBladder, "urinary_bladder", 222, 154, 132);
   add(t, kSmallBowel, "small_bowel", 205, 167, 142);
   add(t, kSpinalCord, "spinal_cord", 200, 160, 240);
+  if (!detailed) return t;
+  add(t, kHumerusMarrow, "humerus_marrow", 196, 138, 90);
+  add(t, kRadiusUlnaMarrow, "radius_ulna_marrow", 200, 146, 96);
+  add(t, kFemurMarrow, "femur_marrow", 188, 132, 84);
+  add(t, kTibiaFibulaMarrow, "tibia_fibula_marrow", 204, 150, 100);
+  add(t, kVesselsTrunk, "blood_vessels_trunk", 200, 40, 40);
+  add(t, kVesselsArms, "blood_vessels_arms", 216, 60, 60);
+  add(t, kVesselsLegs, "blood_vessels_legs", 180, 30, 50);
   return t;
 }
 

@@ -37,10 +37,28 @@ enum Organ : std::uint8_t {
   kBladder = 25,
   kSmallBowel = 26,
   kSpinalCord = 27,
-  kOrganCount = 28  // one past the last value
+  // The detailed anatomy of `--arms-resting` only: the marrow (spongiosa and medullary cavity)
+  // inside the long bones' cortical shells, and blood vessels by body region (as ICRP 110 splits
+  // them).
+  kHumerusMarrow = 28,
+  kRadiusUlnaMarrow = 29,
+  kFemurMarrow = 30,
+  kTibiaFibulaMarrow = 31,
+  kVesselsTrunk = 32,
+  kVesselsArms = 33,
+  kVesselsLegs = 34,
+  kOrganCount = 35  // one past the last value
 };
+constexpr int kBasicOrganCount = 28;  // the labels of the basic anatomy
 
-LabelTable makeOrganLabels();
+// Body regions, as ICRP 110 splits skin, muscle, adipose and vessels.
+enum class Region { Head, Trunk, Arms, Legs };
+Region regionOf(std::uint8_t part);
+// The vessel label of a body part's region.
+std::uint8_t vesselLabel(std::uint8_t part);
+
+// The labels of G: the basic anatomy's 27, or with `detailed` all 34.
+LabelTable makeOrganLabels(bool detailed = false);
 LabelTable makePartLabels();
 
 }  // namespace repose::phantom

@@ -28,6 +28,8 @@ PhantomFiles writePhantom(const Phantom& phantom, const std::string& outDir, con
     throw Error("phantom: unsupported output extension '" + ext + "' (use .nii.gz or .nii)");
   if (prefix.find('/') != std::string::npos)
     throw Error("phantom: the file prefix '" + prefix + "' must not contain a folder");
+  if (image && phantom.options().labels != PhantomLabelling::Phantom)
+    throw Error("phantom: the synthetic CT needs the phantom's own labels, not ICRP's");
   std::error_code ec;
   if (!std::filesystem::is_directory(outDir, ec))
     throwFileError(outDir, "output folder does not exist");

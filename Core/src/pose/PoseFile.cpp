@@ -4,6 +4,7 @@
 #include "repose/io/AtomicOutput.h"
 #include "repose/pose/Pose.h"
 #include "repose/util/Error.h"
+#include "util/JsonFields.h"
 
 #include <nlohmann/json.hpp>
 
@@ -20,11 +21,7 @@ namespace {
 
 using nlohmann::json;
 
-struct Reader {
-  std::string source;
-  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
-    throw Error(source + ": " + field + ": " + problem);
-  }
+struct Reader : JsonFields {
   const json& object(const json& j, const std::string& field) const {
     if (!j.is_object()) fail(field, "expected an object");
     return j;
@@ -32,20 +29,6 @@ struct Reader {
   void onlyKeys(const json& j, const std::string& field, std::set<std::string> allowed) const {
     for (const auto& [key, value] : j.items())
       if (!allowed.count(key)) fail(field.empty() ? key : field + "." + key, "unknown field");
-  }
-  double number(const json& j, const std::string& field) const {
-    if (!j.is_number()) fail(field, "expected a number");
-    const double v = j.get<double>();
-    if (!std::isfinite(v)) fail(field, "not a finite number");
-    return v;
-  }
-  std::string string(const json& j, const std::string& field) const {
-    if (!j.is_string()) fail(field, "expected a string");
-    return j.get<std::string>();
-  }
-  Eigen::Vector3d vector3(const json& j, const std::string& field) const {
-    if (!j.is_array() || j.size() != 3) fail(field, "expected an array of 3 numbers");
-    return {number(j[0], field + "[0]"), number(j[1], field + "[1]"), number(j[2], field + "[2]")};
   }
   int integer(const json& j, const std::string& field) const {
     if (!j.is_number_integer()) fail(field, "expected an integer");
@@ -59,10 +42,14 @@ struct Reader {
 
   Region region(const json& j, const std::string& field) const {
     object(j, field);
-    onlyKeys(j, field, {"box", "sphere"});
-    if (j.size() != 1) fail(field, "expected exactly one of box, sphere");
+    onlyKeys(j, field, {"box", "sphere", "outside_sphere", "everywhere"});
+    if (j.size() != 1) fail(field, "expected exactly one of box, sphere, outside_sphere, everywhere");
     Region r;
-    if (j.contains("box")) {
+    if (j.contains("everywhere")) {
+      if (!j["everywhere"].is_boolean() || !j["everywhere"].get<bool>())
+        fail(field + ".everywhere", "expected true");
+      r.shape = Region::Shape::Everywhere;
+    } else if (j.contains("box")) {
       const json& b = j["box"];
       if (!b.is_array() || b.size() != 6) fail(field + ".box", "expected [x0,y0,z0,x1,y1,z1]");
       for (int c = 0; c < 3; ++c) {
@@ -71,13 +58,14 @@ struct Reader {
         if (r.b[c] < r.a[c]) fail(field + ".box", "max below min");
       }
     } else {
-      const json& s = j["sphere"];
-      if (!s.is_array() || s.size() != 4) fail(field + ".sphere", "expected [x,y,z,radius]");
-      r.shape = Region::Shape::Sphere;
-      for (int c = 0; c < 3; ++c)
-        r.a[c] = number(s[c], field + ".sphere[" + std::to_string(c) + "]");
-      r.b.x() = number(s[3], field + ".sphere[3]");
-      if (r.b.x() <= 0) fail(field + ".sphere[3]", "radius must be positive");
+      const std::string key = j.contains("sphere") ? "sphere" : "outside_sphere";
+      const std::string f = field + "." + key;
+      const json& s = j[key];
+      if (!s.is_array() || s.size() != 4) fail(f, "expected [x,y,z,radius]");
+      r.shape = key == "sphere" ? Region::Shape::Sphere : Region::Shape::OutsideSphere;
+      for (int c = 0; c < 3; ++c) r.a[c] = number(s[c], f + "[" + std::to_string(c) + "]");
+      r.b.x() = number(s[3], f + "[3]");
+      if (r.b.x() <= 0) fail(f + "[3]", "radius must be positive");
     }
     return r;
   }
@@ -119,19 +107,46 @@ struct Reader {
     return s;
   }
 
+  // "elbow_left" (a joint) or, for an axis, "elbow_left.flexion" (a joint's axis).
+  std::string jointName(const json& j, const std::string& field, bool axis) const {
+    const std::string name = string(j, field);
+    const auto dot = name.find('.');
+    const bool valid = !name.empty() && (axis ? dot != std::string::npos && dot > 0 &&
+                                                    dot + 1 < name.size() &&
+                                                    name.find('.', dot + 1) == std::string::npos
+                                              : dot == std::string::npos);
+    if (!valid)
+      fail(field, axis ? "expected [x, y, z] or a joint's axis such as \"elbow_left.flexion\""
+                       : "expected [x, y, z] or a joint such as \"elbow_left\"");
+    return name;
+  }
+
   // A transform's fields over `base` (keyframes change only what they name).
   PoseTransform transform(const json& j, const std::string& field, PoseTransform t) const {
     if (j.contains("rotation")) {
       const std::string f = field.empty() ? "rotation" : field + ".rotation";
       const json& r = object(j["rotation"], f);
       onlyKeys(r, f, {"axis", "angle_deg", "pivot"});
+      // Axis and pivot are numbers, or names of the skeleton's joint and axis.
       if (r.contains("axis")) {
-        const Eigen::Vector3d axis = vector3(r["axis"], f + ".axis");
-        if (axis.norm() < 1e-9) fail(f + ".axis", "zero vector");
-        t.axis = axis.normalized();
+        if (r["axis"].is_string()) {
+          t.axisName = jointName(r["axis"], f + ".axis", true);
+        } else {
+          const Eigen::Vector3d axis = vector3(r["axis"], f + ".axis");
+          if (axis.norm() < 1e-9) fail(f + ".axis", "zero vector");
+          t.axis = axis.normalized();
+          t.axisName.clear();
+        }
       }
       if (r.contains("angle_deg")) t.angleDeg = number(r["angle_deg"], f + ".angle_deg");
-      if (r.contains("pivot")) t.pivot = vector3(r["pivot"], f + ".pivot");
+      if (r.contains("pivot")) {
+        if (r["pivot"].is_string()) {
+          t.pivotJoint = jointName(r["pivot"], f + ".pivot", false);
+        } else {
+          t.pivot = vector3(r["pivot"], f + ".pivot");
+          t.pivotJoint.clear();
+        }
+      }
     }
     if (j.contains("translation"))
       t.translation =
@@ -145,24 +160,73 @@ json vec(const Eigen::Vector3d& v) {
 }
 
 json transformJson(const PoseTransform& t) {
-  return {{"rotation", {{"axis", vec(t.axis)}, {"angle_deg", t.angleDeg}, {"pivot", vec(t.pivot)}}},
+  return {{"rotation",
+           {{"axis", t.axisName.empty() ? vec(t.axis) : json(t.axisName)},
+            {"angle_deg", t.angleDeg},
+            {"pivot", t.pivotJoint.empty() ? vec(t.pivot) : json(t.pivotJoint)}}},
           {"translation", vec(t.translation)}};
 }
 
-json regionJson(const Region& r) {
-  if (r.shape == Region::Shape::Box)
-    return {{"box", {r.a.x(), r.a.y(), r.a.z(), r.b.x(), r.b.y(), r.b.z()}}};
-  return {{"sphere", {r.a.x(), r.a.y(), r.a.z(), r.b.x()}}};
+// Every transform of a pose with where it is, for resolving and for messages.
+template <class PoseT, class F>
+void forEachTransform(PoseT& pose, F&& f) {
+  for (auto& g : pose.groups)
+    if (!g.fixed) f(g.transform, "group \"" + g.name + "\"");
+  for (auto& k : pose.keyframes)
+    for (auto& [group, t] : k.transforms)
+      f(t, "keyframe \"" + k.name + "\", group \"" + group + "\"");
 }
 
 }  // namespace
+
+static json regionJson(const Region& r) {
+  switch (r.shape) {
+    case Region::Shape::Box:
+      return {{"box", {r.a.x(), r.a.y(), r.a.z(), r.b.x(), r.b.y(), r.b.z()}}};
+    case Region::Shape::Sphere:
+      return {{"sphere", {r.a.x(), r.a.y(), r.a.z(), r.b.x()}}};
+    case Region::Shape::OutsideSphere:
+      return {{"outside_sphere", {r.a.x(), r.a.y(), r.a.z(), r.b.x()}}};
+    case Region::Shape::Everywhere:
+      break;
+  }
+  return {{"everywhere", true}};
+}
+
+std::string regionToJson(const Region& r) {
+  return regionJson(r).dump();
+}
 
 Eigen::Isometry3d PoseTransform::isometry() const {
   return Eigen::Translation3d(translation + pivot) *
          Eigen::AngleAxisd(angleDeg * M_PI / 180, axis.normalized()) * Eigen::Translation3d(-pivot);
 }
 
+bool poseNamesJoints(const Pose& pose) {
+  bool names = false;
+  forEachTransform(pose, [&](const PoseTransform& t, const std::string&) {
+    names = names || t.namesJoints();
+  });
+  return names;
+}
+
+void resolvePoseJoints(Pose& pose, const Skeleton& skeleton) {
+  const std::string who = "pose " + (pose.name.empty() ? std::string("(unnamed)") : pose.name);
+  forEachTransform(pose, [&](PoseTransform& t, const std::string& where) {
+    if (!t.pivotJoint.empty()) t.pivot = skeleton.centre(t.pivotJoint, who + ", " + where);
+    if (!t.axisName.empty()) t.axis = skeleton.axis(t.axisName, who + ", " + where);
+    t.pivotJoint.clear();
+    t.axisName.clear();
+  });
+}
+
 std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> Pose::frames() const {
+  forEachTransform(*this, [&](const PoseTransform& t, const std::string& where) {
+    if (t.namesJoints())
+      throw Error("pose " + name + ", " + where + ": turns about the joint \"" +
+                  (t.pivotJoint.empty() ? t.axisName : t.pivotJoint) +
+                  "\": it needs the body's skeleton (skeleton.json beside S, or --skeleton)");
+  });
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> out;
   auto base = [&] {
     std::vector<Eigen::Isometry3d> m;
@@ -185,7 +249,7 @@ std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> Pose::frames
 }
 
 Pose parsePose(const std::string& text, const std::string& source) {
-  const Reader r{source};
+  const Reader r{{source}};
   json j;
   try {
     j = json::parse(text);

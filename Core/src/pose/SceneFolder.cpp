@@ -16,9 +16,12 @@ namespace repose {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string sceneRigKey(const std::string& partsPath, const Pose& pose,
-                        const RigSettings& settings) {
-  const json separations = json::parse(poseToJson(pose)).value("separations", json::array());
+std::string sceneRigKey(const std::string& partsPath,
+                        const std::vector<LimbSeparation>& cuts, const RigSettings& settings) {
+  json separations = json::array();
+  for (const LimbSeparation& s : cuts)
+    separations.push_back(
+        {{"labels", {s.labelA, s.labelB}}, {"region", json::parse(regionToJson(s.region))}});
   const json key = {{"parts", fs::absolute(partsPath).string()},
                     {"parts_bytes", fs::file_size(partsPath)},
                     {"parts_mtime", fs::last_write_time(partsPath).time_since_epoch().count()},

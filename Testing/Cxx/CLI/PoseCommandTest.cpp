@@ -53,7 +53,7 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   // The forearm bones follow the forearm.
   bool forearm = false;
   for (const auto& t : report["rigid_tissues"])
-    if (t["name"] == "radius_ulna" && t["group"] == "left forearm and hand") {
+    if (t["bone"] == "radius_ulna" && t["group"] == "left forearm and hand") {
       forearm = true;
       EXPECT_EQ(t["checked"].get<bool>(), t["voxels"].get<int>() >= 1000);
       EXPECT_GE(t["dice"].get<double>(), 0.95);

@@ -2,6 +2,7 @@
 // into frames, every kind of bad field is refused with a message naming the field, and groups
 // resolve to cage vertices and body parts of the phantom.
 #include "TestPaths.h"
+#include "TestPoses.h"
 
 #include "repose/cage/CageBuilder.h"
 #include "repose/mesh/TransferMesh.h"
@@ -48,7 +49,16 @@ TEST(PoseFile, TheSuiteParsesAndSurvivesARoundTrip) {
     writePoseFile(pose, copy);
     EXPECT_EQ(poseToJson(readPoseFile(copy)), poseToJson(pose)) << name;
   }
-  const Pose walk = readPoseFile(suite("walk"));
+  // Its joints are named: a skeleton gives them their places, each frame of the phantom's.
+  const Pose named = readPoseFile(suite("walk"));
+  EXPECT_TRUE(poseNamesJoints(named));
+  EXPECT_THROW(named.frames(), Error);
+  PhantomOptions po;
+  po.voxelMm = 8;
+  const Phantom phantom(po);
+  const Pose walk = suitePose("walk", phantom);
+  EXPECT_FALSE(poseNamesJoints(walk));
+  EXPECT_EQ(walk.groups[0].transform.pivot, phantom.joint("hip_left").ras);
   EXPECT_EQ(walk.frames().size(), 7u);
   EXPECT_EQ(readPoseFile(suite("hand_from_hip")).separations.size(), 4u);
 }
@@ -129,7 +139,7 @@ TEST(PoseFile, GroupsResolveToCageVerticesAndBodyParts) {
   const auto [organs, parts] = phantom.makeVolumes();
   const TriangleMesh cage = buildCage(parts, {}).mesh;
   const TransferMesh mesh = buildTransferMesh(parts, {});
-  const Pose pose = readPoseFile(suite("elbow90"));
+  const Pose pose = suitePose("elbow90", phantom);
   const std::vector<RigidHandle> handles = resolveHandles(pose, cage, mesh, parts.labels());
   ASSERT_EQ(handles.size(), 2u);
   EXPECT_EQ(handles[0].parts, (std::vector<int>{kPartForearmLeft, kPartHandLeft}));

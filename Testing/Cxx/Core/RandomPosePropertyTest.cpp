@@ -6,6 +6,7 @@
 // that accounts for every input label, whose voxel counts are the output's own.
 // The seed is fixed so a failure reproduces; the poses are printed.
 #include "TestPaths.h"
+#include "TestPoses.h"
 
 #include "repose/phantom/Phantom.h"
 #include "repose/pose/PoseFrame.h"
@@ -31,7 +32,9 @@ constexpr int kFrames = 6;
 
 // The walk's groups (both legs, both arms, the rest fixed) with kFrames random keyframes.
 Pose randomPoses(unsigned seed) {
-  Pose pose = readPoseFile(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/walk.pose.json");
+  PhantomOptions po;
+  po.voxelMm = 8;
+  Pose pose = suitePose("walk", Phantom(po));
   pose.keyframes.clear();
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(-1, 1);

@@ -14,11 +14,32 @@ using namespace repose;
 TEST(TissueTable, ThePhantomTableNamesEveryPhantomLabelWithBonesRigid) {
   const TissueTable t =
       readTissueTable(std::string(REPOSE_SOURCE_DIR) + "/Resources/Tissues/phantom.csv");
-  EXPECT_EQ(t.size(), 27u);
+  EXPECT_EQ(t.size(), 34u);  // 27 labels, and 7 more of the detailed anatomy (--arms-resting)
   EXPECT_EQ(t.at(12).name, "radius_ulna");
   EXPECT_TRUE(t.at(12).rigid);
   EXPECT_FALSE(t.at(3).rigid);  // muscle
   for (const auto& [label, tissue] : t) EXPECT_GT(tissue.densityKgM3, 300) << label;
+  // A bone's marrow is part of that bone; vessels are soft.
+  EXPECT_TRUE(t.at(28).rigid);
+  EXPECT_EQ(t.at(28).boneName(), "humerus");
+  EXPECT_EQ(t.at(11).boneName(), "humerus");
+  EXPECT_FALSE(t.at(33).rigid);
+  // The table compiled into Core is this file.
+  EXPECT_EQ(tissueTableCsv(phantomTissueTable()), tissueTableCsv(t));
+}
+
+TEST(TissueTable, TheBoneColumnIsOptionalAndRoundTrips) {
+  const TissueTable four = parseTissueTable("label,name,density_kg_m3,rigid\n4,skull,1908,1\n", "a");
+  EXPECT_EQ(four.at(4).boneName(), "skull");
+  const TissueTable five =
+      parseTissueTable("label,name,density_kg_m3,rigid,bone\n13,cortex,1920,1,humerus\n"
+                       "14,spongiosa,1185,1,humerus\n2,fat,911,0,\n",
+                       "b");
+  EXPECT_EQ(five.at(14).boneName(), "humerus");
+  EXPECT_EQ(five.at(2).bone, "");
+  const TissueTable again = parseTissueTable(tissueTableCsv(five, "a comment\nover two lines"), "c");
+  EXPECT_EQ(tissueTableCsv(again), tissueTableCsv(five));
+  EXPECT_THROW(parseTissueTable("label,name,density_kg_m3,rigid,b\n", "d"), Error);
 }
 
 TEST(TissueTable, MalformedLinesAreRefusedWithTheirLineNumber) {

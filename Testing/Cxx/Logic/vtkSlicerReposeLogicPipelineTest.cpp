@@ -13,6 +13,7 @@
 #include "CommandRunner.h"
 #include "TestPaths.h"
 
+#include <repose/io/AtomicOutput.h>
 #include <repose/io/VolumeIO.h>
 #include <repose/phantom/Phantom.h>
 
@@ -42,10 +43,12 @@ struct PhantomFiles {
   PhantomFiles() {
     repose::PhantomOptions po;
     po.voxelMm = 8;
-    const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+    const repose::Phantom phantom(po);
+    const auto [organs, parts] = phantom.makeVolumes();
     G = dir.file("G.nii.gz"), S = dir.file("S.nii.gz");
     repose::writeVolume(organs, G);
     repose::writeVolume(parts, S);
+    repose::writeTextFileAtomically(dir.file("skeleton.json"), phantom.skeletonJson());
   }
 };
 

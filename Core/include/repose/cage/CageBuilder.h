@@ -11,13 +11,16 @@
 
 namespace repose {
 
-// A region of space in RAS mm: an axis-aligned box [min, max] or a sphere (centre, radius).
+// A region of space in RAS mm: an axis-aligned box [min, max], a sphere (centre, radius),
+// everything outside a sphere (a contact away from the joint at the sphere's centre), or all of
+// space.
 struct Region {
-  enum class Shape { Box, Sphere } shape = Shape::Box;
+  enum class Shape { Box, Sphere, OutsideSphere, Everywhere } shape = Shape::Box;
   Eigen::Vector3d a = Eigen::Vector3d::Zero();  // box min, or sphere centre
   Eigen::Vector3d b = Eigen::Vector3d::Zero();  // box max; b.x() is the sphere radius
   bool contains(const Eigen::Vector3d& p) const;
-  // "box:x0,y0,z0,x1,y1,z1" or "sphere:cx,cy,cz,r"; throws repose::Error on bad text.
+  // "box:x0,y0,z0,x1,y1,z1", "sphere:cx,cy,cz,r", "outside:cx,cy,cz,r" or "everywhere";
+  // throws repose::Error on bad text.
   static Region parse(const std::string& text);
 };
 

@@ -2,6 +2,7 @@
 // and a skeleton of named joints in RAS mm, all defined analytically so tests can pose it exactly.
 #pragma once
 
+#include "repose/pose/Skeleton.h"
 #include "repose/util/Progress.h"
 #include "repose/volume/Volume.h"
 
@@ -12,11 +13,29 @@
 
 namespace repose {
 
+// How G's voxels are numbered: the phantom's own labels (with names in the file), or the organ
+// IDs of the ICRP 110 adult reference phantoms (bones split by region and tissue but not by side,
+// skin, muscle, adipose and vessels split by body region) on ICRP's array order (columns from
+// the body's right to its left, rows front to back, slices feet to head) and without a label
+// table, as a user's converted ICRP file arrives.
+enum class PhantomLabelling { Phantom, Icrp110 };
+
 struct PhantomOptions {
-  double voxelMm = 2.0;       // isotropic voxel size; 1 mm gives ~160M voxels (1.3 m child)
+  double voxelMm = 2.0;  // isotropic voxel size; 1 mm gives ~160M voxels (1.3 m child)
+  // Voxel size per array axis (columns, rows, slices), e.g. 1.8 x 1.8 x 4.8 mm for thick
+  // slices; zero: voxelMm on every axis.
+  Eigen::Vector3d spacingMm = Eigen::Vector3d::Zero();
   bool armsTouching = false;  // hands pressed against the hips (the limb-separation case)
-  double marginMm = 10.0;     // empty border around the body
-  int threads = 0;            // 0: all cores
+  // Real anatomy's contacts and scales: the arms rest against the trunk along their length, the
+  // hands on the thighs, the thighs touch; the long bones are cortical shells around marrow and
+  // blood vessels of a few millimetres run through the limbs (labels 28-34).
+  bool armsResting = false;
+  PhantomLabelling labels = PhantomLabelling::Phantom;
+  double marginMm = 10.0;  // empty border around the body
+  int threads = 0;         // 0: all cores
+  Eigen::Vector3d spacing() const {
+    return spacingMm.isZero() ? Eigen::Vector3d::Constant(voxelMm) : spacingMm;
+  }
 };
 
 struct Joint {
@@ -64,7 +83,10 @@ class Phantom {
 
   // In-core maps (G then S), with label tables; for tests and small sizes.
   std::pair<Volume, Volume> makeVolumes(const ProgressFn& progress = {}) const;
-  // Skeleton as JSON text: {"units":"mm","space":"RAS","joints":[{"name","parent","ras"}...]}.
+  // The joints with their anatomical axes (pose files name them), the body parts each connects
+  // and how far from its centre they meet.
+  Skeleton skeleton() const;
+  // skeleton.json (docs/FORMATS.md): the Skeleton and how the phantom was made.
   std::string skeletonJson() const;
 
  private:

@@ -9,6 +9,7 @@
 #include "repose/cage/TriangleMesh.h"
 #include "repose/mesh/RigidHandles.h"
 #include "repose/mesh/TransferMesh.h"
+#include "repose/pose/Skeleton.h"
 #include "repose/volume/LabelTable.h"
 
 #include <Eigen/Geometry>
@@ -32,6 +33,11 @@ struct PoseTransform {
   double angleDeg = 0;
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();        // RAS mm
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();  // mm, applied after the rotation
+  // Named in the pose file instead of numbers: a joint of the body's skeleton ("elbow_left") and
+  // one of its axes ("elbow_left.flexion"). resolvePoseJoints turns them into pivot and axis and
+  // clears them; until then the transform has no motion (Pose::frames throws).
+  std::string pivotJoint, axisName;
+  bool namesJoints() const { return !pivotJoint.empty() || !axisName.empty(); }
   Eigen::Isometry3d isometry() const;
 };
 
@@ -61,8 +67,16 @@ struct Pose {
   std::vector<PoseGroup> groups;
   std::vector<PoseKeyframe> keyframes;
   // One frame per keyframe (groups it does not name keep their base transform), or the base.
+  // Throws repose::Error when a transform still names a joint (resolvePoseJoints first).
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames() const;
 };
+
+// Whether any group or keyframe names a joint of the skeleton (pivot or axis).
+bool poseNamesJoints(const Pose& pose);
+// Replaces every joint name by the skeleton's numbers (pivot: the joint's centre; axis: the
+// joint's axis) and clears the names. Throws repose::Error naming the pose, the group and the
+// joint or axis the skeleton lacks.
+void resolvePoseJoints(Pose& pose, const Skeleton& skeleton);
 
 // Whether two poses have the same handle groups (names, fixed, selections) in the same order:
 // a rig prepared for one solves frames of the other.
@@ -72,6 +86,8 @@ bool sameHandleGroups(const Pose& a, const Pose& b);
 Pose parsePose(const std::string& jsonText, const std::string& source);
 Pose readPoseFile(const std::string& path);
 std::string poseToJson(const Pose& pose);
+// A region as the pose file writes it ({"box": [...]}, {"sphere": [...]}, ...), JSON text.
+std::string regionToJson(const Region& region);
 void writePoseFile(const Pose& pose, const std::string& path);  // atomic
 
 // The pose's groups as rigid handles of this cage and mesh, in group order, with the motions of

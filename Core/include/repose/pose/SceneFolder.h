@@ -17,9 +17,11 @@ struct SceneInputs {
   std::string organs, parts, image;  // paths of G, S and the image ("" when none)
 };
 
-// What a rig is built for: S (path, size, modification time), the rig settings and the pose's
-// separations, as JSON text (the scene's "built_for").
-std::string sceneRigKey(const std::string& partsPath, const Pose& pose,
+// What a rig is built for: S (path, size, modification time), the rig settings and the
+// separations it was cut with (the pose's own and the automatic ones), as JSON text (the
+// scene's "built_for").
+std::string sceneRigKey(const std::string& partsPath,
+                        const std::vector<LimbSeparation>& separations,
                         const RigSettings& settings);
 
 // Writes scene.json, cage.vtk, tm.vtu and <pose>.pose.json into `folder` (created), each

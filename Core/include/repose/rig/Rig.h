@@ -1,0 +1,45 @@
+// `repose rig`: from a user's organ map G alone to what posing needs — the body-part map S (the
+// phantom's part names: head, torso, upper_arm_left, forearm_left, hand_left, ... foot_right),
+// the skeleton (named joints with their anatomical axes, fitted to the bones' articular ends) and
+// the tissue table (names, densities, which labels are bone and which bone). Works from the bones
+// of G under a label convention (LabelConvention.h); a body part whose bones are missing (a scan
+// without arms) is left out and said so.
+#pragma once
+
+#include "repose/pose/Skeleton.h"
+#include "repose/rig/LabelConvention.h"
+#include "repose/util/Progress.h"
+#include "repose/volume/TissueTable.h"
+#include "repose/volume/Volume.h"
+
+#include <string>
+#include <vector>
+
+namespace repose {
+
+struct RigOptions {
+  std::string labels = "auto";  // phantom, icrp110, totalsegmentator, auto, or a CSV path
+  std::string source = "G";     // the file G came from, for messages
+  int threads = 0;
+  ProgressFn progress;
+};
+
+struct RigResult {
+  Volume parts;  // S on G's grid, uint8, with the part names
+  Skeleton skeleton;
+  TissueTable tissues;
+  LabelConvention convention;
+  std::vector<std::string> missing;   // joints not made, one line each, saying why
+  std::vector<std::string> warnings;  // orientation doubts, labels the convention did not know
+  std::string reportJson;             // rig.json: all of the above with the bones found
+};
+
+// Throws repose::Error "<source>: <problem>" for a G that is not a label map, whose convention
+// cannot be told, or whose bones give no limb to rig (no humerus and no femur).
+RigResult rigBody(const Volume& organs, const RigOptions& options = {});
+
+// Writes `folder`/S.nii.gz, skeleton.json, tissues.csv and rig.json (the folder is created; its
+// parent must exist), all four or none. `input` names G in the files.
+void writeRigFolder(const RigResult& rig, const std::string& folder, const std::string& input);
+
+}  // namespace repose

@@ -1,0 +1,112 @@
+#include "repose/pose/PoseJob.h"
+
+#include "repose/util/Error.h"
+#include "repose/volume/LabelStatistics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+namespace repose {
+namespace {
+
+std::vector<int> presentLabels(const Volume& organs) {
+  std::vector<int> out;
+  for (const LabelCount& c : countLabels(organs))
+    if (c.layer == 0 && c.value != 0 && c.voxels > 0) out.push_back(c.value);
+  return out;
+}
+
+}  // namespace
+
+std::vector<int> rigidLabelsOf(const TissueTable& table) {
+  std::vector<int> out;
+  for (const auto& [label, tissue] : table)
+    if (tissue.rigid) out.push_back(label);
+  return out;
+}
+
+TissueChoice chooseTissues(const Volume& organs, const std::string& explicitPath,
+                           const std::string& partsPath) {
+  TissueChoice out;
+  if (!explicitPath.empty()) {
+    out.table = readTissueTable(explicitPath);
+    out.name = explicitPath;
+    return out;
+  }
+  const std::vector<int> present = presentLabels(organs);
+  const std::string beside = findTissuesBeside(partsPath);
+  if (!beside.empty()) {
+    TissueTable t = readTissueTable(beside);
+    std::string missing;
+    int count = 0;
+    for (const int label : present)
+      if (!t.count(label) && count++ < 5) missing += (missing.empty() ? "" : ", ") + std::to_string(label);
+    if (count == 0) {
+      out.table = std::move(t);
+      out.name = beside;
+      return out;
+    }
+    out.warning = beside + " lacks " + std::to_string(count) + " label(s) of G (" + missing +
+                  (count > 5 ? ", ..." : "") + "): not used (was it made for another G?)";
+  }
+  // The phantom's table only for the phantom's labels: every label present named as it names it.
+  TissueTable phantom = phantomTissueTable();
+  bool phantomLabels = !present.empty();
+  for (const int label : present) {
+    const Label* l = organs.labels().find(label);
+    const auto it = phantom.find(label);
+    phantomLabels = phantomLabels && l && it != phantom.end() && it->second.name == l->name;
+  }
+  if (phantomLabels) {
+    out.table = std::move(phantom);
+    out.name = "phantom default";
+  }
+  return out;
+}
+
+std::optional<Skeleton> skeletonFor(const std::string& partsPath, const std::string& explicitPath) {
+  if (!explicitPath.empty()) return readSkeleton(explicitPath);
+  const std::string beside = findSkeletonBeside(partsPath);
+  if (beside.empty()) return std::nullopt;
+  return readSkeleton(beside);
+}
+
+void resolveJointsWith(Pose& pose, const Skeleton* skeleton, const std::string& partsPath) {
+  if (!poseNamesJoints(pose)) return;
+  if (!skeleton) {
+    const std::string folder =
+        std::filesystem::path(partsPath).has_parent_path()
+            ? std::filesystem::path(partsPath).parent_path().string()
+            : std::string(".");
+    throw Error("pose " + pose.name + " names joints, but there is no skeleton.json beside " +
+                (partsPath.empty() ? std::string("S") : partsPath) + " (in " + folder +
+                "; `repose rig` writes one, or give --skeleton)");
+  }
+  resolvePoseJoints(pose, *skeleton);
+}
+
+PoseSeparations poseSeparations(const Pose& pose, const Volume& parts, const Skeleton* skeleton,
+                                bool automatic) {
+  PoseSeparations out;
+  out.all = resolveSeparations(pose, parts.labels());
+  out.automaticOn = automatic;
+  if (automatic) {
+    out.automatic = findContactSeparations(parts, pose, skeleton);
+    for (const LimbSeparation& s : out.automatic.separations()) out.all.push_back(s);
+  }
+  return out;
+}
+
+std::string PoseSeparations::reportJson() const {
+  nlohmann::json manual = nlohmann::json::array();
+  const std::size_t manualCount = all.size() - automatic.made.size() * (automaticOn ? 1 : 0);
+  for (std::size_t i = 0; i < manualCount; ++i)
+    manual.push_back({{"labels", {all[i].labelA, all[i].labelB}},
+                      {"region", nlohmann::json::parse(regionToJson(all[i].region))}});
+  nlohmann::json doc = {{"manual", manual}, {"automatic", automaticOn}};
+  if (automaticOn) doc.update(nlohmann::json::parse(automatic.json()));
+  return doc.dump();
+}
+
+}  // namespace repose

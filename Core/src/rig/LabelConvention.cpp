@@ -1,0 +1,399 @@
+// The rig's label conventions: the phantom (by name), ICRP 110 (by organ ID), TotalSegmentator v2
+// (by class name, from the file's label table), a user's CSV; and "auto", which tells them apart.
+#include "repose/rig/LabelConvention.h"
+
+#include "Icrp110Organs.h"
+#include "repose/util/Error.h"
+#include "repose/volume/LabelStatistics.h"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace repose {
+namespace {
+
+// Typical mass densities (kg/m^3) of the IT'IS Foundation tissue properties database, for the
+// soft tissues of conventions that carry no densities of their own (TotalSegmentator, a user's
+// CSV). A dosimetry study should give its own table (`repose pose --tissues`).
+struct Density {
+  const char* prefix;
+  double kgM3;
+};
+constexpr Density kTypicalDensities[] = {
+    {"skin", 1109},        {"subcutaneous_fat", 911}, {"torso_fat", 911},     {"fat", 911},
+    {"skeletal_muscle", 1090}, {"muscle", 1090},      {"gluteus", 1090},      {"iliopsoas", 1090},
+    {"autochthon", 1090},  {"brain", 1046},           {"spinal_cord", 1075},  {"lung", 394},
+    {"heart", 1081},       {"atrial_appendage", 1081}, {"liver", 1079},       {"spleen", 1089},
+    {"kidney", 1066},      {"stomach", 1088},         {"small_bowel", 1030},  {"duodenum", 1030},
+    {"colon", 1088},       {"urinary_bladder", 1086}, {"prostate", 1045},     {"pancreas", 1087},
+    {"gallbladder", 1071}, {"adrenal", 1028},         {"esophagus", 1040},    {"trachea", 1080},
+    {"thyroid", 1050},     {"aorta", 1102},           {"vena", 1050},         {"vein", 1050},
+    {"artery", 1050},      {"trunk", 1050},           {"intervertebral_disc", 1100},
+    {"costal_cartilage", 1100}, {"eye", 1050},        {"blood", 1050}};
+constexpr double kCorticalBoneKgM3 = 1908;  // IT'IS "Bone (Cortical)"
+constexpr double kMarrowKgM3 = 1178;        // IT'IS "Bone (Cancellous)"
+constexpr double kSoftTissueKgM3 = 1050;    // when nothing closer is known
+
+double typicalDensity(const std::string& name, bool* known) {
+  for (const Density& d : kTypicalDensities)
+    if (name.rfind(d.prefix, 0) == 0 || name.find(std::string("_") + d.prefix) != std::string::npos) {
+      if (known) *known = true;
+      return d.kgM3;
+    }
+  if (known) *known = false;
+  return kSoftTissueKgM3;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool endsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+const char* kBoneNames[] = {"none",    "skull",   "mandible", "teeth",   "spine",  "ribs",
+                            "sternum", "clavicle", "scapula", "pelvis",  "humerus", "radius_ulna",
+                            "hand",    "femur",   "patella",  "tibia_fibula", "foot"};
+
+BoneKind boneFromName(const std::string& n) {
+  for (int k = 0; k < int(sizeof(kBoneNames) / sizeof(*kBoneNames)); ++k)
+    if (n == kBoneNames[k]) return BoneKind(k);
+  return BoneKind::None;
+}
+
+std::vector<int> present(const Volume& organs) {
+  std::vector<int> out;
+  for (const LabelCount& c : countLabels(organs))
+    if (c.layer == 0 && c.value != 0 && c.voxels > 0) out.push_back(c.value);
+  return out;
+}
+
+std::string nameOf(const Volume& organs, int value) {
+  const Label* l = organs.labels().find(value);
+  return l ? l->name : std::string();
+}
+
+// ---- the generated phantom (Resources/Tissues/phantom.csv names) ----
+bool phantomRole(const std::string& name, LabelRole& r) {
+  static const std::map<std::string, BoneKind> bones = {
+      {"skull", BoneKind::Skull},       {"vertebrae", BoneKind::Spine},
+      {"ribs", BoneKind::Ribs},         {"sternum", BoneKind::Sternum},
+      {"pelvis", BoneKind::Pelvis},     {"humerus", BoneKind::Humerus},
+      {"radius_ulna", BoneKind::Forearm}, {"hand_bones", BoneKind::Hand},
+      {"femur", BoneKind::Femur},       {"tibia_fibula", BoneKind::Shank},
+      {"foot_bones", BoneKind::Foot}};
+  std::string bone = name;
+  const bool marrow = endsWith(name, "_marrow");
+  if (marrow) bone = name.substr(0, name.size() - 7);
+  const auto it = bones.find(bone);
+  if (it != bones.end()) {
+    r.bone = it->second;
+    r.rigid = true;
+    r.boneName = bone;
+    r.densityKgM3 = marrow ? kMarrowKgM3 : kCorticalBoneKgM3;
+    return true;
+  }
+  static const std::map<std::string, BodyRegion> regions = {
+      {"blood_vessels_trunk", BodyRegion::Trunk},
+      {"blood_vessels_arms", BodyRegion::Arms},
+      {"blood_vessels_legs", BodyRegion::Legs}};
+  if (regions.count(name)) r.region = regions.at(name);
+  static const std::set<std::string> soft = {
+      "skin", "subcutaneous_fat", "muscle", "brain", "eye", "lung_left", "lung_right", "heart",
+      "liver", "kidney_left", "kidney_right", "stomach", "spleen", "urinary_bladder",
+      "small_bowel", "spinal_cord", "blood_vessels_trunk", "blood_vessels_arms",
+      "blood_vessels_legs"};
+  if (!soft.count(name)) return false;
+  r.densityKgM3 = typicalDensity(name, nullptr);
+  return true;
+}
+
+// ---- ICRP 110 (organ IDs; regions from the structure names) ----
+BoneKind icrpBone(int id) {
+  if (id >= 13 && id <= 18) return BoneKind::Humerus;
+  if (id >= 19 && id <= 21) return BoneKind::Forearm;
+  if (id == 22 || id == 23) return BoneKind::Hand;
+  if (id == 24 || id == 25) return BoneKind::Clavicle;
+  if (id == 26 || id == 27) return BoneKind::Skull;
+  if (id >= 28 && id <= 33) return BoneKind::Femur;
+  if (id >= 34 && id <= 36) return BoneKind::Shank;  // tibiae, fibulae and patellae
+  if (id == 37 || id == 38) return BoneKind::Foot;
+  if (id == 39 || id == 40) return BoneKind::Mandible;
+  if (id == 41 || id == 42) return BoneKind::Pelvis;
+  if (id == 43 || id == 44) return BoneKind::Ribs;
+  if (id == 45 || id == 46) return BoneKind::Scapula;
+  if (id >= 47 && id <= 54) return BoneKind::Spine;
+  if (id == 55 || id == 56) return BoneKind::Sternum;
+  if (id == 128) return BoneKind::Teeth;
+  return BoneKind::None;
+}
+
+const char* icrpBoneName(int id) {
+  static const std::pair<int, const char*> first[] = {
+      {13, "humerus"}, {19, "radius_ulna"}, {22, "hand_bones"}, {24, "clavicles"},
+      {26, "cranium"}, {28, "femur"}, {34, "tibia_fibula_patella"}, {37, "foot_bones"},
+      {39, "mandible"}, {41, "pelvis"}, {43, "ribs"}, {45, "scapulae"}, {47, "cervical_spine"},
+      {49, "thoracic_spine"}, {51, "lumbar_spine"}, {53, "sacrum"}, {55, "sternum"},
+      {57, nullptr}};
+  if (id == 128) return "teeth";
+  const char* name = nullptr;
+  for (const auto& [from, n] : first)
+    if (id >= from) name = n;
+  return name ? name : "";
+}
+
+LabelConvention icrp110(const Volume& organs, const std::vector<int>& labels) {
+  // The female phantom has ovaries and a uterus, the male a prostate and testes.
+  const std::set<int> has(labels.begin(), labels.end());
+  const bool male = has.count(115) || has.count(129) || has.count(130);
+  const bool female = has.count(111) || has.count(112) || has.count(139);
+  LabelConvention c;
+  c.name = std::string("icrp110 (") + (male && !female ? "AM" : "AF") + ")";
+  if (!male && !female)
+    c.notes.push_back("no sex-specific organ found: the AF densities are used");
+  for (const int v : labels) {
+    const rig::IcrpOrgan* organ = nullptr;
+    for (const rig::IcrpOrgan& o : rig::kIcrp110Organs)
+      if (o.id == v) organ = &o;
+    if (!organ)
+      throw Error("label " + std::to_string(v) +
+                  " is not an ICRP 110 organ ID (1 to 140): G is not an ICRP 110 phantom");
+    LabelRole r;
+    r.name = organ->name;
+    r.densityKgM3 = male && !female ? organ->densityAm : organ->densityAf;
+    r.bone = icrpBone(v);
+    r.rigid = r.bone != BoneKind::None;
+    r.boneName = icrpBoneName(v);
+    r.cervical = v == 47 || v == 48;
+    const std::string n = lower(organ->name);
+    if (endsWith(n, ", head")) r.region = BodyRegion::Head;
+    if (endsWith(n, ", trunk")) r.region = BodyRegion::Trunk;
+    if (endsWith(n, ", arms")) r.region = BodyRegion::Arms;
+    if (endsWith(n, ", legs")) r.region = BodyRegion::Legs;
+    c.roles[v] = r;
+  }
+  (void)organs;
+  return c;
+}
+
+// ---- TotalSegmentator v2 (class names of its label table) ----
+bool totalSegmentatorRole(const std::string& name, LabelRole& r) {
+  int side = 0;
+  std::string base = name;
+  if (endsWith(name, "_left")) side = -1, base = name.substr(0, name.size() - 5);
+  if (endsWith(name, "_right")) side = +1, base = name.substr(0, name.size() - 6);
+  static const std::map<std::string, BoneKind> bones = {
+      {"skull", BoneKind::Skull},      {"sacrum", BoneKind::Spine},
+      {"vertebrae", BoneKind::Spine},  {"sternum", BoneKind::Sternum},
+      {"clavicula", BoneKind::Clavicle}, {"scapula", BoneKind::Scapula},
+      {"hip", BoneKind::Pelvis},       {"humerus", BoneKind::Humerus},
+      {"radius", BoneKind::Forearm},   {"ulna", BoneKind::Forearm},
+      {"carpal", BoneKind::Hand},      {"metacarpal", BoneKind::Hand},
+      {"phalanges_hand", BoneKind::Hand}, {"femur", BoneKind::Femur},
+      {"patella", BoneKind::Patella},  {"tibia", BoneKind::Shank},
+      {"fibula", BoneKind::Shank},     {"tarsal", BoneKind::Foot},
+      {"metatarsal", BoneKind::Foot},  {"phalanges_feet", BoneKind::Foot}};
+  BoneKind bone = BoneKind::None;
+  if (bones.count(base)) bone = bones.at(base);
+  if (base.rfind("vertebrae_", 0) == 0) bone = BoneKind::Spine;
+  if (base.rfind("rib_", 0) == 0 || base == "rib") bone = BoneKind::Ribs;
+  if (name.rfind("rib_left_", 0) == 0) side = -1;
+  if (name.rfind("rib_right_", 0) == 0) side = +1;
+  if (bone != BoneKind::None) {
+    r.bone = bone;
+    r.side = side;
+    r.rigid = true;
+    r.boneName = base.rfind("vertebrae_", 0) == 0 ? "spine" : (bone == BoneKind::Ribs ? "ribs" : base);
+    r.densityKgM3 = kCorticalBoneKgM3;
+    r.cervical = base.rfind("vertebrae_C", 0) == 0;
+    return true;
+  }
+  bool known = false;
+  r.densityKgM3 = typicalDensity(name, &known);
+  return known;
+}
+
+// ---- a user's CSV: label,bone[,side][,name][,density_kg_m3] ----
+LabelConvention fromCsv(const Volume& organs, const std::string& path,
+                        const std::vector<int>& labels) {
+  std::ifstream in(path);
+  if (!in) throw Error(path + ": cannot open");
+  LabelConvention c;
+  c.name = path;
+  std::vector<std::string> header;
+  std::string line;
+  int number = 0;
+  std::map<int, LabelRole> given;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> f;
+    std::stringstream row(line);
+    for (std::string x; std::getline(row, x, ',');) f.push_back(x);
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    if (header.empty()) {
+      header = f;
+      if (f.size() < 2 || f[0] != "label" || f[1] != "bone")
+        throw Error(where + "expected the header label,bone[,side][,name][,density_kg_m3]");
+      continue;
+    }
+    if (f.size() > header.size()) throw Error(where + "more fields than the header");
+    LabelRole r;
+    int value = 0;
+    try {
+      std::size_t used = 0;
+      value = std::stoi(f[0], &used);
+      if (used != f[0].size()) throw std::invalid_argument("label");
+    } catch (const std::exception&) {
+      throw Error(where + "label must be an integer");
+    }
+    const std::string bone = f.size() > 1 ? lower(f[1]) : "";
+    r.bone = boneFromName(bone.empty() ? "none" : bone);
+    if (!bone.empty() && bone != "none" && r.bone == BoneKind::None)
+      throw Error(where + "unknown bone \"" + f[1] +
+                  "\" (skull, mandible, teeth, spine, ribs, sternum, clavicle, scapula, pelvis, "
+                  "humerus, radius_ulna, hand, femur, patella, tibia_fibula, foot, none)");
+    r.rigid = r.bone != BoneKind::None;
+    r.boneName = r.rigid ? bone : "";
+    r.name = nameOf(organs, value);
+    for (std::size_t k = 2; k < f.size(); ++k) {
+      if (header[k] == "side") {
+        const std::string s = lower(f[k]);
+        if (s == "left") r.side = -1;
+        else if (s == "right") r.side = +1;
+        else if (!s.empty()) throw Error(where + "side must be left, right or empty");
+      } else if (header[k] == "name") {
+        if (!f[k].empty()) r.name = f[k];
+      } else if (header[k] == "density_kg_m3") {
+        try {
+          r.densityKgM3 = std::stod(f[k]);
+        } catch (const std::exception&) {
+          throw Error(where + "density_kg_m3 must be a number");
+        }
+        if (!(r.densityKgM3 > 0)) throw Error(where + "density_kg_m3 must be positive");
+      } else {
+        throw Error(where + "unknown column " + header[k]);
+      }
+    }
+    if (r.densityKgM3 == 1050 && !r.rigid) {
+      bool known = false;
+      const double d = typicalDensity(lower(r.name), &known);
+      if (known) r.densityKgM3 = d;
+    }
+    if (r.rigid && r.densityKgM3 == 1050) r.densityKgM3 = kCorticalBoneKgM3;
+    if (!given.emplace(value, r).second)
+      throw Error(where + "label " + std::to_string(value) + " given twice");
+  }
+  if (header.empty()) throw Error(path + ": empty");
+  for (const int v : labels) {
+    if (given.count(v)) {
+      c.roles[v] = given[v];
+    } else {
+      LabelRole r;
+      r.name = nameOf(organs, v);
+      bool known = false;
+      r.densityKgM3 = typicalDensity(lower(r.name), &known);
+      c.roles[v] = r;
+    }
+  }
+  return c;
+}
+
+int countMatches(const Volume& organs, const std::vector<int>& labels,
+                 bool (*role)(const std::string&, LabelRole&), int* bonesFound) {
+  int matched = 0, bones = 0;
+  for (const int v : labels) {
+    LabelRole r;
+    if (role(nameOf(organs, v), r)) ++matched, bones += r.bone != BoneKind::None;
+  }
+  if (bonesFound) *bonesFound = bones;
+  return matched;
+}
+
+LabelConvention byNames(const Volume& organs, const std::vector<int>& labels,
+                        const std::string& name,
+                        bool (*role)(const std::string&, LabelRole&)) {
+  LabelConvention c;
+  c.name = name;
+  std::vector<std::string> unknown;
+  for (const int v : labels) {
+    LabelRole r;
+    r.name = nameOf(organs, v);
+    if (!role(r.name, r)) {
+      unknown.push_back(std::to_string(v) + (r.name.empty() ? "" : " " + r.name));
+      r.densityKgM3 = kSoftTissueKgM3;
+    }
+    c.roles[v] = r;
+  }
+  if (!unknown.empty()) {
+    std::string list;
+    for (std::size_t i = 0; i < unknown.size() && i < 8; ++i) list += (i ? ", " : "") + unknown[i];
+    c.notes.push_back(std::to_string(unknown.size()) + " label(s) not in the " + name +
+                      " convention, taken as soft tissue of density " +
+                      std::to_string(int(kSoftTissueKgM3)) + " kg/m^3: " + list +
+                      (unknown.size() > 8 ? ", ..." : ""));
+  }
+  return c;
+}
+
+}  // namespace
+
+const char* boneKindName(BoneKind kind) {
+  return kBoneNames[int(kind)];
+}
+
+LabelConvention labelConvention(const Volume& organs, const std::string& requested,
+                                const std::string& source) {
+  if (!organs.isLabelMap()) throw Error(source + ": not a label map (float voxels)");
+  const std::vector<int> labels = present(organs);
+  if (labels.empty()) throw Error(source + ": no labelled voxel, nothing to rig");
+  LabelConvention c;
+  if (requested == "phantom") {
+    c = byNames(organs, labels, "phantom", phantomRole);
+    c.detection = "--labels phantom";
+  } else if (requested == "totalsegmentator") {
+    c = byNames(organs, labels, "totalsegmentator", totalSegmentatorRole);
+    c.detection = "--labels totalsegmentator";
+  } else if (requested == "icrp110") {
+    c = icrp110(organs, labels);
+    c.detection = "--labels icrp110";
+  } else if (requested == "auto") {
+    int phantomBones = 0, tsBones = 0;
+    const int phantomNames = countMatches(organs, labels, phantomRole, &phantomBones);
+    const int tsNames = countMatches(organs, labels, totalSegmentatorRole, &tsBones);
+    const bool icrpValues = labels.back() <= 140 && labels.size() >= 20 &&
+                            std::count_if(labels.begin(), labels.end(), [&](int v) {
+                              return nameOf(organs, v).empty();
+                            }) == std::ptrdiff_t(labels.size());
+    const std::set<int> has(labels.begin(), labels.end());
+    const bool icrpBones = has.count(13) + has.count(16) + has.count(28) + has.count(31) >= 2;
+    if (phantomBones >= 3 && phantomNames * 2 >= int(labels.size())) {
+      c = byNames(organs, labels, "phantom", phantomRole);
+      c.detection = "auto: G's label names are the phantom's";
+    } else if (tsBones >= 3 && tsNames * 2 >= int(labels.size())) {
+      c = byNames(organs, labels, "totalsegmentator", totalSegmentatorRole);
+      c.detection = "auto: G's label names are TotalSegmentator's";
+    } else if (icrpValues && icrpBones) {
+      c = icrp110(organs, labels);
+      c.detection = "auto: unnamed labels 1-140 with the ICRP 110 humerus and femur IDs";
+    } else {
+      throw Error(source + ": cannot tell the label convention (" + std::to_string(labels.size()) +
+                  " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs): "
+                  "give --labels phantom|icrp110|totalsegmentator|FILE.csv");
+    }
+  } else {
+    c = fromCsv(organs, requested, labels);
+    c.detection = "--labels " + requested;
+  }
+  for (auto& [v, r] : c.roles)
+    if (r.name.empty()) r.name = "label_" + std::to_string(v);
+  return c;
+}
+
+}  // namespace repose

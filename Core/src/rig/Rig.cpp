@@ -1,0 +1,156 @@
+// rigBody: bones, body frame, joints, parts, joint radii, tissue table and the report, in order.
+#include "repose/rig/Rig.h"
+
+#include "RigInternal.h"
+#include "repose/io/AtomicOutput.h"
+#include "repose/io/VolumeIO.h"
+#include "repose/util/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <Eigen/LU>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace repose {
+
+using rig::V;
+
+RigResult rigBody(const Volume& organs, const RigOptions& options) {
+  const std::string& source = options.source;
+  if (organs.layers() != 1)
+    throw Error(source + ": a segmentation with overlapping layers cannot be rigged (flatten it)");
+  organs.geometry().requireOrthogonalAxes(source);
+  RigResult out;
+  reportProgress(options.progress, 0.0, "rig: labels");
+  out.convention = labelConvention(organs, options.labels, source);
+  const rig::Grid grid(organs.geometry());
+  reportProgress(options.progress, 0.1, "rig: bones");
+  const rig::Bones bones = rig::findBones(organs, out.convention, grid);
+  if (bones.byKind.empty())
+    throw Error(source + ": no bones found under the " + out.convention.name +
+                " convention (give --labels, or a CSV naming the bone labels)");
+  bool limb = false;
+  for (const int side : {-1, 1})
+    limb = limb || bones.find(BoneKind::Humerus, side) || bones.find(BoneKind::Femur, side);
+  if (!limb)
+    throw Error(source + ": no humerus or femur found: nothing to rig beyond the torso");
+  out.warnings = bones.frame.warnings;
+  out.warnings.insert(out.warnings.end(), out.convention.notes.begin(),
+                      out.convention.notes.end());
+
+  reportProgress(options.progress, 0.3, "rig: joints");
+  const std::vector<rig::FittedJoint> joints = rig::fitJoints(bones, out.missing);
+  reportProgress(options.progress, 0.4, "rig: body parts");
+  rig::PartStats stats;
+  out.parts = rig::assignParts(organs, out.convention, bones, joints, grid, options.threads, stats);
+  if (stats.unreached > 0)
+    out.warnings.push_back(std::to_string(stats.unreached) +
+                           " body voxels are joined to no bone (a separate piece): put in the "
+                           "torso");
+  reportProgress(options.progress, 0.9, "rig: joints' reach");
+
+  const LabelTable names = rig::rigPartLabels();
+  auto partName = [&](int v) { return names.find(v) ? names.find(v)->name : std::string(); };
+  const V up = bones.frame.superior, ant = bones.frame.anterior;
+  for (const rig::FittedJoint& j : joints) {
+    SkeletonJoint s;
+    s.name = j.name;
+    s.parent = j.kind == JointKind::Elbow   ? "shoulder" + std::string(j.side < 0 ? "_left" : "_right")
+               : j.kind == JointKind::Wrist ? "elbow" + std::string(j.side < 0 ? "_left" : "_right")
+               : j.kind == JointKind::Knee  ? "hip" + std::string(j.side < 0 ? "_left" : "_right")
+               : j.kind == JointKind::Ankle ? "knee" + std::string(j.side < 0 ? "_left" : "_right")
+                                            : "";
+    if (!s.parent.empty() && !std::any_of(joints.begin(), joints.end(), [&](const auto& o) {
+          return o.name == s.parent;
+        }))
+      s.parent.clear();
+    s.centre = j.centre;
+    s.axes = jointAxes(j.kind, j.distal, ant, up, j.side, j.palmar);
+    if (j.flexion) s.axes[0].second = *j.flexion;  // the condyles' own line
+    s.parts = {partName(j.parts[0]), partName(j.parts[1])};
+    s.radiusMm = rig::jointRadius(out.parts, j, grid);
+    s.method = j.method;
+    s.fitRmsMm = j.rms;
+    out.skeleton.joints.push_back(s);
+  }
+
+  for (const auto& [value, r] : out.convention.roles) {
+    Tissue t;
+    t.name = r.name;
+    t.densityKgM3 = r.densityKgM3;
+    t.rigid = r.rigid;
+    t.bone = r.rigid ? r.boneName : "";
+    out.tissues[value] = t;
+  }
+
+  nlohmann::json bonesJson = nlohmann::json::array();
+  for (const auto& [key, b] : bones.byKind)
+    bonesJson.push_back({{"bone", boneKindName(b.kind)},
+                         {"side", b.side < 0 ? "left" : b.side > 0 ? "right" : "axial"},
+                         {"voxels", b.voxels.size()},
+                         {"length_mm", b.length}});
+  nlohmann::json partsJson = nlohmann::json::array();
+  {
+    std::vector<std::int64_t> count(15, 0);
+    const std::uint8_t* s = out.parts.data<std::uint8_t>();
+    for (std::int64_t i = 0; i < out.parts.numVoxels(); ++i) ++count[s[i] < 15 ? s[i] : 0];
+    const double ml = std::fabs(organs.geometry().ijkToRas.block<3, 3>(0, 0).determinant()) / 1000;
+    for (int v = 1; v < 15; ++v)
+      if (count[std::size_t(v)] > 0)
+        partsJson.push_back({{"part", partName(v)},
+                             {"voxels", count[std::size_t(v)]},
+                             {"volume_ml", double(count[std::size_t(v)]) * ml}});
+  }
+  nlohmann::json jointsJson = nlohmann::json::parse(skeletonToJson(out.skeleton))["joints"];
+  nlohmann::json report = {
+      {"input", source},
+      {"convention", out.convention.name},
+      {"detection", out.convention.detection},
+      {"body_frame",
+       {{"superior", {up.x(), up.y(), up.z()}},
+        {"anterior", {ant.x(), ant.y(), ant.z()}},
+        {"midline_x_mm", bones.frame.midlineX}}},
+      {"bones", bonesJson},
+      {"joints", jointsJson},
+      {"missing", out.missing},
+      {"warnings", out.warnings},
+      {"parts", partsJson},
+      {"unreached_voxels", stats.unreached}};
+  out.reportJson = report.dump();
+  out.skeleton.source = "";
+  reportProgress(options.progress, 1.0, "rig: done");
+  return out;
+}
+
+void writeRigFolder(const RigResult& rig, const std::string& folder, const std::string& input) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::absolute(folder);
+  if (!fs::exists(dir.parent_path())) throw Error(folder + ": its parent folder does not exist");
+  if (fs::exists(dir) && !fs::is_directory(dir)) throw Error(folder + ": exists and is not a folder");
+  fs::create_directories(dir);
+  for (const char* name : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
+    refuseOverwritingInput(input, (dir / name).string());
+  AtomicOutput parts((dir / "S.nii.gz").string()), skeleton((dir / "skeleton.json").string()),
+      tissues((dir / "tissues.csv").string()), report((dir / "rig.json").string());
+  writeVolume(rig.parts, parts.tempPath());
+  auto text = [](const std::string& path, const std::string& content) {
+    std::ofstream f(path, std::ios::binary);
+    f << content;
+    if (!f.flush()) throwFileError(path, "write failed (disk full?)");
+  };
+  const nlohmann::json made = {
+      {"made_by", "repose rig"}, {"input", input}, {"convention", rig.convention.name}};
+  text(skeleton.tempPath(), skeletonToJson(rig.skeleton, made.dump()));
+  text(tissues.tempPath(),
+       tissueTableCsv(rig.tissues, "Tissues of " + input + " (" + rig.convention.name +
+                                       " convention), made by repose rig.\nrigid = 1 for bone "
+                                       "(a pose moves it as a rigid copy); bone names the bone a "
+                                       "label is part of."));
+  text(report.tempPath(), nlohmann::json::parse(rig.reportJson).dump(2) + "\n");
+  commitTogether({&parts, &skeleton, &tissues, &report});
+}
+
+}  // namespace repose
