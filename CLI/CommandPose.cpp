@@ -159,6 +159,8 @@ int runPose(const Args& args) {
         std::to_string(c.contactVoxels) + " contact voxels" +
         (c.joint.empty() ? std::string() : ", outside the " + c.joint + " joint") + ")");
   const std::vector<LimbSeparation>& separations = cuts.all;
+  // Finer tets where the pose bends.
+  rs.refineJoints = jointRefinements(pose, parts, skeleton ? &*skeleton : nullptr);
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
   const std::string key = sceneRigKey(p.get("parts"), separations, rs);
   std::optional<RigGeometry> fromScene;
@@ -174,7 +176,8 @@ int runPose(const Args& args) {
                                 &organs);
   }
   say("embedding the mesh in the cage");
-  const PoseRig rig(std::move(geometry), pose, parts.labels(), threads, jointRings);
+  const PoseRig rig(std::move(geometry), pose, parts.labels(), threads, jointRings,
+                    bendJoints(skeleton ? &*skeleton : nullptr, parts.labels()));
   if (p.has("scene") && !reused)
     writeSceneFolder(p.get("scene"), rig, key,
                      {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""}, rs);

@@ -28,6 +28,23 @@ run_pose() {  # phantom-folder pose-name
 for pose in elbow90 arm_raise90 leg_step30 walk; do run_pose phantom "$pose"; done
 run_pose phantom_touching hand_from_hip
 
+# A user's own segmentation: only G of the arms-resting phantom (arms on the trunk, hands on the
+# thighs, thighs touching) goes in; `repose rig` makes S, the skeleton and the tissue table, and
+# the suite's named-joint poses run on that rig with automatic contact separation.
+echo
+echo "== your own segmentation: rig the arms-resting 2 mm phantom from G alone"
+"$REPOSE" phantom --voxel 2 --arms-resting --out "$DEMO_DIR/phantom_resting"
+"$REPOSE" rig --input "$DEMO_DIR/phantom_resting/G.nii.gz" --out "$DEMO_DIR/phantom_resting/rig"
+/usr/bin/python3 "$(dirname "$0")/plot-rig.py" "$DEMO_DIR/phantom_resting/G.nii.gz" \
+  "$DEMO_DIR/phantom_resting/rig" "$DEMO_DIR/rig_resting.png" | sed 's/^/  picture of S and the joints: /'
+for pose in arm_raise90 leg_step30; do
+  echo
+  echo "== pose $pose on the rigged arms-resting phantom"
+  "$REPOSE" pose --input "$DEMO_DIR/phantom_resting/G.nii.gz" \
+    --parts "$DEMO_DIR/phantom_resting/rig/S.nii.gz" --pose "$POSES/$pose.pose.json" \
+    --out "$DEMO_DIR/poses/resting_$pose"
+done
+
 echo
 echo "== plots"
 find "$DEMO_DIR/poses" -name report.json | sort | xargs /usr/bin/python3 "$(dirname "$0")/plot-report.py" | sed 's/^/  /'
@@ -62,7 +79,7 @@ import json, pathlib, sys
 rows = []
 for p in sorted(pathlib.Path(sys.argv[1]).rglob("report.json")):
     r = json.load(open(p)); q = r["quality"]
-    rows.append((f"{r['pose']}/{r['frame']}", r["body"]["volume_change_percent"],
+    rows.append((str(p.parent.relative_to(sys.argv[1])), r["body"]["volume_change_percent"],
                  q["labels_within_1_percent"]["worst_change_percent"],
                  q.get("bones_rigid", {}).get("min_dice", float("nan")),
                  q["no_new_holes"]["new_enclosed_voxels"], r["pockets"]["filled_voxels"],
@@ -73,4 +90,5 @@ for f, b, w, d, h, p, i, a in rows:
 PY
 echo
 echo "Demo outputs are in $DEMO_DIR: phantom*/ (G, S, CT, skeleton, scene/ with cage.vtk and tm.vtu),"
+echo "phantom_resting/rig/ (S, skeleton, tissues, rig.json from G alone) and rig_resting.png,"
 echo "poses/<pose>[/<frame>]/ (posed_G.nii.gz, posed_S.nii.gz, transform.nrrd, report.json, *.png)."

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <stdlib.h>
 #include <set>
@@ -42,6 +43,8 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   ro.threads = options.threads;
   ro.progress = options.progress;
   ro.outerFaces = &outer;
+  ro.restParts = &parts;
+  ro.pieceLabels = &organs;
   RasterReport raster;
   out.organs = rasterizeLabels(organs, mesh, frame.deformed, out.grid, ro, &raster);
   ro.progress = {};

@@ -5,7 +5,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 
 namespace repose {
 namespace {
@@ -94,6 +96,55 @@ PoseSeparations poseSeparations(const Pose& pose, const Volume& parts, const Ske
   if (automatic) {
     out.automatic = findContactSeparations(parts, pose, skeleton);
     for (const LimbSeparation& s : out.automatic.separations()) out.all.push_back(s);
+  }
+  return out;
+}
+
+std::vector<JointRefinement> jointRefinements(const Pose& pose, const Volume& parts,
+                                              const Skeleton* skeleton) {
+  std::vector<JointRefinement> out;
+  if (!skeleton) return out;
+  std::map<std::string, int> group;
+  for (const auto& [label, g] : groupOfParts(pose, parts))
+    if (const Label* l = parts.labels().find(label)) group[l->name] = g;
+  const double voxel = parts.geometry().spacing().maxCoeff();
+  for (const SkeletonJoint& j : skeleton->joints) {
+    const auto a = group.find(j.parts[0]), b = group.find(j.parts[1]);
+    if (a == group.end() || b == group.end() || a->second == b->second || !(j.radiusMm > 0))
+      continue;
+    if (pose.groups[std::size_t(a->second)].fixed && pose.groups[std::size_t(b->second)].fixed)
+      continue;
+    JointRefinement r;
+    r.centre = j.centre;
+    r.radiusMm = 1.5 * j.radiusMm;
+    r.sizeMm = std::max(2 * voxel, j.radiusMm / 3);
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& partLabels) {
+  std::vector<BendJoint> out;
+  if (!skeleton) return out;
+  auto label = [&](const std::string& name) {
+    for (const Label& l : partLabels.labels())
+      if (l.name == name) return l.value;
+    return 0;
+  };
+  for (const SkeletonJoint& j : skeleton->joints) {
+    const Eigen::Vector3d* distal = j.axis("rotation");
+    BendJoint b;
+    b.name = j.name;
+    b.centre = j.centre;
+    b.proximalPart = label(j.parts[0]);
+    b.distalPart = label(j.parts[1]);
+    b.radiusMm = j.radiusMm;
+    if (!distal || b.proximalPart == 0 || b.distalPart == 0 || !(b.radiusMm > 0)) continue;
+    b.distal = *distal;
+    // The trunk's side of a root joint bends only near the joint.
+    if (j.parts[0] == "torso")
+      b.proximalReach = 0.5;
+    out.push_back(b);
   }
   return out;
 }

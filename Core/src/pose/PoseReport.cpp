@@ -124,10 +124,17 @@ static json makePoseReport(const PoseReportInput& in) {
   int worstLabel = 0, lost = 0;
   for (const auto& [value, c] : counts) {
     const Label* l = in.organs->labels().find(value);
+    // G's own label table names the label; without one (an ICRP phantom's bare IDs), the tissue
+    // table does.
+    std::string name = l ? l->name : "";
+    if (name.empty() && in.tissues) {
+      const auto t = in.tissues->find(value);
+      if (t != in.tissues->end()) name = t->second.name;
+    }
     const double before = c.first.volumeMm3, after = c.second.volumeMm3;
     const double change = before > 0 ? 100 * (after / before - 1) : 0;
     json row = {{"value", value},
-                {"name", l ? l->name : ""},
+                {"name", name},
                 {"voxels_before", c.first.voxels},
                 {"voxels_after", c.second.voxels},
                 {"volume_before_ml", before / 1000},
@@ -253,8 +260,9 @@ static json makePoseReport(const PoseReportInput& in) {
                    {{"met", std::fabs(worstBeyond) <= 1.0},
                     {"worst_label", worstLabel},
                     {"worst_name", [&] {
-                       const Label* l = in.organs->labels().find(worstLabel);
-                       return l ? l->name : std::string();
+                       for (const json& row : labels)
+                         if (row["value"] == worstLabel) return row["name"].get<std::string>();
+                       return std::string();
                      }()},
                     {"worst_change_percent", worstChange},
                     {"worst_resampling_floor_percent", worstFloor},

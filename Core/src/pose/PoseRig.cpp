@@ -2,7 +2,12 @@
 
 #include "repose/util/Error.h"
 
+#include <Eigen/LU>
+#include <cstdio>
+#include <cstdlib>
+
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -15,16 +20,37 @@ std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
     throw Error("the label map is not on the grid of the body-part map");
   std::set<int> whole(settings.rigidLabels.begin(), settings.rigidLabels.end());
   if (settings.wholeOrgans) {
-    // Voxels of each label of G per body part of S.
+    // Voxels of each label of G per body part of S, and how many of them face another part.
     std::map<int, std::map<int, std::int64_t>> counts;
-    for (std::int64_t i = 0; i < organs.numVoxels(); ++i) {
-      const double label = organs.valueAsDouble(i), part = parts.valueAsDouble(i);
-      if (label > 0 && part > 0) ++counts[int(label)][int(part)];
-    }
+    std::map<int, std::int64_t> atBorder;
+    const auto& d = organs.dims();
+    const std::int64_t step[3] = {1, d[0], d[0] * d[1]};
+    for (std::int64_t k = 0; k < d[2]; ++k)
+      for (std::int64_t j = 0; j < d[1]; ++j)
+        for (std::int64_t i = 0; i < d[0]; ++i) {
+          const std::int64_t at = organs.index(i, j, k);
+          const double label = organs.valueAsDouble(at), part = parts.valueAsDouble(at);
+          if (!(label > 0 && part > 0)) continue;
+          ++counts[int(label)][int(part)];
+          const std::int64_t ijk[3] = {i, j, k};
+          bool border = false;
+          for (int a = 0; a < 3 && !border; ++a)
+            for (const int s : {-1, 1}) {
+              const std::int64_t n = ijk[a] + s;
+              if (n < 0 || n >= d[a]) continue;
+              const double other = parts.valueAsDouble(at + s * step[a]);
+              border = border || (other > 0 && other != part);
+            }
+          atBorder[int(label)] += border;
+        }
     for (const auto& [label, perPart] : counts) {
       std::int64_t total = 0, most = 0;
       for (const auto& [part, n] : perPart) total += n, most = std::max(most, n);
-      if (double(most) >= kWholeOrganShare * double(total)) whole.insert(label);
+      // An organ lies in one part and clear of its borders: a vessel of the trunk that runs on
+      // into a limb as the limb's vessels touches the joint and must bend there.
+      if (double(most) >= kWholeOrganShare * double(total) &&
+          double(atBorder[label]) <= kWholeOrganBorderShare * double(total))
+        whole.insert(label);
     }
   }
   std::vector<int> out;
@@ -100,6 +126,25 @@ Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSetting
   return pieces;
 }
 
+SizingField rigSizingField(const Volume& parts, const RigSettings& settings) {
+  SizingField field = initialSizingField(parts, settings.meshMm);
+  if (settings.refineJoints.empty()) return field;
+  const auto& d = field.grid.dims;
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    for (std::int64_t j = 0; j < d[1]; ++j)
+      for (std::int64_t i = 0; i < d[0]; ++i) {
+        const Eigen::Vector3d p = field.grid.voxelToRas(double(i), double(j), double(k));
+        float& size = field.sizeMm[std::size_t(i + d[0] * (j + d[1] * k))];
+        for (const JointRefinement& r : settings.refineJoints) {
+          if (!(r.radiusMm > 0) || !(r.sizeMm > 0)) continue;
+          // sizeMm inside the ball, growing linearly to the default at twice its radius.
+          const double t = std::clamp(((p - r.centre).norm() - r.radiusMm) / r.radiusMm, 0.0, 1.0);
+          size = std::min(size, float(r.sizeMm + t * (double(size) - r.sizeMm)));
+        }
+      }
+  return field;
+}
+
 RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparation>& separations,
                              const RigSettings& settings, const ProgressFn& progress,
                              const Volume* organs) {
@@ -119,6 +164,8 @@ RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparati
   TransferMeshOptions to;
   to.sizeMm = settings.meshMm;
   to.progress = scaled(0.5, 1);
+  const SizingField sizing = rigSizingField(parts, settings);
+  if (!settings.refineJoints.empty()) to.sizing = &sizing;
   std::optional<Volume> pieces;
   if (organs) {
     pieces = wholePieceMap(*organs, parts, settings);
@@ -160,12 +207,13 @@ TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
 }
 
 PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads,
-                 int jointRings)
+                 int jointRings, const std::vector<BendJoint>& bends)
     : geometry_(std::move(geometry)), pose_(pose) {
   deformation_ = std::make_unique<CageDeformation>(geometry_.mesh, geometry_.cage, threads);
   handles_ = resolveHandles(pose_, geometry_.cage, geometry_.mesh, partLabels);
   influence_ = computeHandleInfluence(geometry_.mesh, geometry_.cage, handles_, threads,
                                       jointRings >= 0 ? jointRings : pose_.jointRings);
+  bends_ = JointBends(geometry_.mesh, handles_, bends);
   frames_ = pose_.frames();
 }
 
@@ -198,6 +246,34 @@ PoseRig::Frame PoseRig::solveFrame(const std::string& name,
   setMotions(f.handles, motions);
   f.cage = poseCage(geometry_.cage, f.handles);
   f.deformed = deformation_->deform(f.cage, influence_, f.handles, &f.tetMaps, precision);
+  // Tissue a group carries alone moves with it exactly, also where the cage misses it (the crotch
+  // beside a cut between the thighs): the rigidity solver would drag it along with its moving
+  // neighbours otherwise.
+  int carriedOutside = 0;
+  {
+    const TransferMesh& m = geometry_.mesh;
+    const std::vector<char>& inside = deformation_->embedding().inside;
+    for (Eigen::Index v = 0; v < m.vertices.rows(); ++v) {
+      if (inside[std::size_t(v)] || influence_.weight[std::size_t(v)] < 1) continue;
+      f.deformed.row(v) = (blendMotions(influence_.membership.row(v).transpose(), f.handles) *
+                           Eigen::Vector3d(m.vertices.row(v)))
+                              .transpose();
+      ++carriedOutside;
+    }
+  }
+  const JointBendReport bent = bends_.apply(geometry_.mesh, f.handles, f.deformed);
+  // The bends and the carried vertices moved vertices after the solver: their tets' maps follow.
+  if (bent.vertices > 0 || carriedOutside > 0) {
+    const TransferMesh& m = geometry_.mesh;
+    for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
+      Eigen::Matrix3d D, E;
+      for (int c = 0; c < 3; ++c) {
+        D.col(c) = (m.vertices.row(m.tets(t, c + 1)) - m.vertices.row(m.tets(t, 0))).transpose();
+        E.col(c) = (f.deformed.row(m.tets(t, c + 1)) - f.deformed.row(m.tets(t, 0))).transpose();
+      }
+      f.tetMaps[std::size_t(t)] = E * D.inverse();
+    }
+  }
   return f;
 }
 

@@ -30,6 +30,13 @@ std::string sceneRigKey(const std::string& partsPath,
                     {"mesh_size_mm", settings.meshMm},
                     {"rigid_labels", settings.rigidLabels},
                     {"whole_organs", settings.wholeOrgans},
+                    {"refine_joints", [&] {
+                       json balls = json::array();
+                       for (const JointRefinement& r : settings.refineJoints)
+                         balls.push_back({r.centre.x(), r.centre.y(), r.centre.z(), r.radiusMm,
+                                          r.sizeMm});
+                       return balls;
+                     }()},
                     {"separations", separations}};
   return key.dump();
 }

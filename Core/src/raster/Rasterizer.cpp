@@ -12,6 +12,7 @@
 #include <map>
 #include <unordered_map>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <sstream>
@@ -46,22 +47,125 @@ void countBadTets(const ScanInput& in, double frameSign, RasterReport& r) {
 }
 
 // How the shell around the outer faces is scanned (RasterOptions::shellMm).
+// Index of the input voxel nearest to the rest position p (input IJK), or -1 beyond the grid.
+inline std::int64_t nearestVoxel(const Eigen::Vector3d& p, const std::array<std::int64_t, 3>& d) {
+  const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
+                     y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
+                     z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
+  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]) return -1;
+  return x + d[0] * (y + d[1] * z);
+}
+
 struct Shell {
   std::vector<std::uint8_t> outer;  // empty: no shell
   double mm = 0;
   Eigen::Matrix3d normalToMm = Eigen::Matrix3d::Identity();
   std::array<double, 3> boxGrowth{0, 0, 0};
+  // The pieces' rims (RasterOptions::pieceLabels): per piece tet, its faces on tissue that is
+  // not the same piece, grown by pieceMm and written after the soft tissue where the rest
+  // position holds the piece's own label.
+  std::vector<std::uint8_t> pieceFaces;
+  const Volume* pieceLabels = nullptr;
+  double pieceMm = 0;
+  std::array<double, 3> pieceGrowth{0, 0, 0};
+  std::vector<char> boneLabel;  // per label value: some tet is a piece of it
+  const Volume* rimParts = nullptr;  // RasterOptions::restParts, for the rims
+  // A rim voxel is taken when its rest label is bone of the tet's own body part: a thin cortex
+  // that Mesh_3 merged into its marrow's tets still moves with the bone.
+  bool rimTakes(std::int32_t t, const Eigen::Vector3d& p, const Eigen::VectorXi& tetParts) const {
+    const std::int64_t at = nearestVoxel(p, pieceLabels->dims());
+    if (at < 0) return false;
+    const double v = pieceLabels->valueAsDouble(at);
+    if (!(v >= 0 && v < double(boneLabel.size())) || !boneLabel[std::size_t(v)]) return false;
+    return !rimParts || rimParts->valueAsDouble(at) == tetParts[t];
+  }
+  const Volume* restParts = nullptr;  // RasterOptions::restParts
+  const Eigen::VectorXi* tetParts = nullptr;
+  std::vector<std::uint8_t> restCovered;  // per input voxel: a rest tet covers its centre
+  // Whether tet t's shell writes the voxel whose rest position is p (input IJK): not where p is
+  // another part's tissue that a rest tet already carries (wherever that tissue is now): a limb
+  // that moved away from the trunk it rested on must not copy the trunk's side into the gap.
+  bool takes(std::int32_t t, const Eigen::Vector3d& p) const {
+    if (!restParts) return true;
+    const std::int64_t at = nearestVoxel(p, restParts->dims());
+    if (at < 0) return true;
+    const double part = restParts->valueAsDouble(at);
+    return part == 0 || part == (*tetParts)[t] || !restCovered[std::size_t(at)];
+  }
 };
+
+// Per piece tet, bit f for face f (opposite vertex f) when the tet across it is not a tet of the
+// same piece label (soft tissue, another piece, or nothing).
+std::vector<std::uint8_t> pieceRimFaces(const TransferMesh& mesh) {
+  const Eigen::Index nt = mesh.tets.rows();
+  std::vector<std::uint8_t> out(std::size_t(nt), 0);
+  if (mesh.rigid.empty()) return out;
+  std::map<std::array<int, 3>, std::vector<std::int32_t>> faces;
+  auto key = [&](Eigen::Index t, int f) {
+    std::array<int, 3> k;
+    for (int c = 0, n = 0; c < 4; ++c)
+      if (c != f) k[std::size_t(n++)] = mesh.tets(t, c);
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (mesh.rigid[std::size_t(t)])
+      for (int f = 0; f < 4; ++f) faces[key(t, f)].push_back(std::int32_t(t));
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (!mesh.rigid[std::size_t(t)])
+      for (int f = 0; f < 4; ++f) {
+        const auto it = faces.find(key(t, f));
+        if (it != faces.end()) it->second.push_back(std::int32_t(t));
+      }
+  for (const auto& [k, tets] : faces)
+    for (const std::int32_t t : tets) {
+      if (!mesh.rigid[std::size_t(t)]) continue;
+      bool samePiece = false;
+      for (const std::int32_t u : tets)
+        samePiece = samePiece || (u != t && mesh.rigid[std::size_t(u)] == mesh.rigid[std::size_t(t)]);
+      if (samePiece) continue;
+      for (int f = 0; f < 4; ++f)
+        if (key(t, f) == k) out[std::size_t(t)] |= std::uint8_t(1u << f);
+    }
+  return out;
+}
 
 Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const VolumeGeometry& output,
                 const RasterOptions& options) {
   Shell sh;
+  if (options.pieceLabels && !mesh.rigid.empty()) {
+    if (options.pieceLabels->dims() != input.dims)
+      throw Error("rasterizer: the label map of the pieces is not on the input's grid");
+    sh.pieceLabels = options.pieceLabels;
+    sh.pieceFaces = pieceRimFaces(mesh);
+    sh.tetParts = &mesh.labels;
+    if (options.restParts && options.restParts->dims() == input.dims) sh.rimParts = options.restParts;
+    for (const int v : mesh.rigid)
+      if (v > 0) {
+        if (std::size_t(v) >= sh.boneLabel.size()) sh.boneLabel.resize(std::size_t(v) + 1, 0);
+        sh.boneLabel[std::size_t(v)] = 1;
+      }
+    sh.pieceMm = std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm);
+    const Eigen::Matrix3d Minv = output.ijkToRas.block<3, 3>(0, 0).inverse();
+    for (int c = 0; c < 3; ++c) sh.pieceGrowth[c] = sh.pieceMm * Minv.row(c).norm();
+    sh.normalToMm = output.ijkToRas.block<3, 3>(0, 0).inverse().transpose();
+  }
   sh.mm = options.shellMm < 0 ? 2 * std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm)
                               : options.shellMm;
   if (sh.mm <= 0) return sh;
   sh.outer = options.outerFaces ? *options.outerFaces : outerFaces(mesh);
   if (sh.outer.size() != static_cast<std::size_t>(mesh.tets.rows()))
     throw Error("rasterizer: outer-face flags do not match the mesh");
+  if (options.restParts) {
+    if (options.restParts->dims() != input.dims)
+      throw Error("rasterizer: the body-part map is not on the input's grid");
+    sh.restParts = options.restParts;
+    sh.tetParts = &mesh.labels;
+    RasterOptions coverage;
+    coverage.threads = options.threads;
+    const Volume c = rasterizeCoverage(mesh, mesh.vertices, input, coverage);
+    sh.restCovered.assign(c.data<std::uint8_t>(), c.data<std::uint8_t>() + c.numVoxels());
+  }
   const Eigen::Matrix3d M = output.ijkToRas.block<3, 3>(0, 0);
   sh.normalToMm = M.inverse().transpose();
   const Eigen::Matrix3d Minv = M.inverse();
@@ -85,6 +189,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // outside a work item. Only tets whose box meets the grid are kept: for a live slice, the few
   // crossing it, found with plain comparisons first since every tet is looked at.
   const bool withShell = !shell.outer.empty();
+  const bool withRims = !shell.pieceFaces.empty();
   // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
   struct Candidates {
     std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;
@@ -98,18 +203,18 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           Candidates& c = parts[static_cast<std::size_t>(part)];
           for (Eigen::Index t = nt * part / selectThreads; t < nt * (part + 1) / selectThreads;
                ++t) {
-            const double growth = withShell && shell.outer[t] ? 1.0 : 0.0;
+            double gy = 0, gz = 0;  // box growth for the shell and the piece's rim
+            if (withShell && shell.outer[t])
+              gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
+            if (withRims && shell.pieceFaces[std::size_t(t)])
+              gy = std::max(gy, shell.pieceGrowth[1]), gz = std::max(gz, shell.pieceGrowth[2]);
             const Eigen::Vector3d &p0 = in.out[T(t, 0)], &p1 = in.out[T(t, 1)],
                                   &p2 = in.out[T(t, 2)], &p3 = in.out[T(t, 3)];
-            const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) -
-                               growth * shell.boxGrowth[2];
-            const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) +
-                               growth * shell.boxGrowth[2];
+            const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - gz;
+            const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + gz;
             if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
-            const double ylo = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) -
-                               growth * shell.boxGrowth[1];
-            const double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) +
-                               growth * shell.boxGrowth[1];
+            const double ylo = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - gy;
+            const double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + gy;
             if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
             c.tet.push_back(static_cast<std::int32_t>(t));
             c.kmin.push_back(static_cast<std::int32_t>(std::max(double(kBegin), std::ceil(zlo))));
@@ -158,7 +263,8 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           const std::int64_t j0 = bands ? s0 : 0, j1 = bands ? s1 : in.dims[1];
           // Voxels of this work item already written, row by row (rows j0..j1 of slices k0..k1).
           const std::int64_t rows = j1 - j0;
-          if (!shell.outer.empty())
+          // 1: written by soft tissue, 2: by a whole piece (its tets or its rim).
+          if (withShell || withRims)
             covered.assign(static_cast<std::size_t>(nx * rows * (k1 - k0)), 0);
           ScanTet s;
           for (std::size_t c = 0; c < candidates.size(); ++c) {
@@ -166,6 +272,8 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             if (kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
                 !raster::prepareTet(in, t, s))
               continue;
+            const std::uint8_t mark =
+                withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
             raster::scanTet(s, k0, k1, j0, j1,
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
@@ -173,11 +281,33 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                               if (!covered.empty())
                                 std::fill_n(
                                     covered.begin() + (((k - k0) * rows + (j - j0)) * nx + i0),
-                                    i1 - i0 + 1, std::uint8_t(1));
-                              write(k, j, i0, i1, rest0, step);
+                                    i1 - i0 + 1, mark);
+                              write(k, j, i0, i1, rest0, step, t);
                             });
           }
-          for (std::size_t c = 0; c < candidates.size() && !shell.outer.empty(); ++c) {
+          // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
+          // follows its surface to within a voxel) move with the piece, over the soft tissue
+          // that covered them.
+          for (std::size_t c = 0; c < candidates.size() && withRims; ++c) {
+            const std::int32_t t = candidates[c];
+            const unsigned rim = shell.pieceFaces[std::size_t(t)];
+            if (!rim || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
+                !raster::prepareShell(in, t, rim, shell.pieceMm, shell.normalToMm,
+                                      shell.pieceGrowth, s))
+              continue;
+            raster::scanTet(s, k0, k1, j0, j1,
+                            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                                const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
+                              std::uint8_t* cv = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
+                              for (std::int64_t a = i0; a <= i1; ++a) {
+                                const Eigen::Vector3d p = rest0 + double(a - i0) * step;
+                                if (cv[a] == 2 || !shell.rimTakes(t, p, *shell.tetParts)) continue;
+                                cv[a] = 2;
+                                write(k, j, a, a, p, step, t);
+                              }
+                            });
+          }
+          for (std::size_t c = 0; c < candidates.size() && withShell; ++c) {
             const std::int32_t t = candidates[c];
             if (!shell.outer[t] || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
                 !raster::prepareShell(in, t, shell.outer[t], shell.mm, shell.normalToMm,
@@ -187,17 +317,21 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
                               std::uint8_t* c = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
+                              auto free = [&](std::int64_t x) {
+                                return !c[x] &&
+                                       shell.takes(t, rest0 + double(x - i0) * step);
+                              };
                               for (std::int64_t a = i0; a <= i1;) {
-                                if (c[a]) {
+                                if (!free(a)) {
                                   ++a;
                                   continue;
                                 }
                                 std::int64_t b = a;
-                                while (b + 1 <= i1 && !c[b + 1]) ++b;
+                                while (b + 1 <= i1 && free(b + 1)) ++b;
                                 std::fill(c + a, c + b + 1, std::uint8_t(1));
                                 localShell += b - a + 1;
                                 write(k, j, a, b, Eigen::Vector3d(rest0 + double(a - i0) * step),
-                                      step);
+                                      step, t);
                                 a = b + 1;
                               }
                             });
@@ -227,15 +361,6 @@ double frameSign(const VolumeGeometry& output) {
   return output.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0;
 }
 
-// Index of the input voxel nearest to the rest position p (input IJK), or -1 beyond the grid.
-inline std::int64_t nearestVoxel(const Eigen::Vector3d& p, const std::array<std::int64_t, 3>& d) {
-  const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
-                     y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
-                     z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
-  if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]) return -1;
-  return x + d[0] * (y + d[1] * z);
-}
-
 template <class T>
 T fromDouble(double v) {
   if constexpr (std::is_integral_v<T>) {
@@ -248,6 +373,29 @@ T fromDouble(double v) {
 }
 
 }  // namespace
+
+// Per voxel of `input`: the tet of a whole piece that writes it at rest (its tets and rims),
+// or -1.
+static std::vector<std::int32_t> pieceOwnerTets(const TransferMesh& mesh,
+                                                const VolumeGeometry& input,
+                                                const RasterOptions& options) {
+  std::vector<std::int32_t> owner(std::size_t(input.numVoxels()), -1);
+  if (mesh.rigid.empty() || !options.pieceLabels) return owner;
+  RasterOptions rest;
+  rest.threads = options.threads;
+  rest.shellMm = 0;  // only the pieces' rims
+  rest.pieceLabels = options.pieceLabels;
+  const ScanInput in = raster::makeScanInput(mesh, mesh.vertices, input, input);
+  const std::int64_t nx = input.dims[0], plane = nx * input.dims[1];
+  runScan(in, makeShell(mesh, input, input, rest), rest, "pieces at rest", nullptr,
+          frameSign(input),
+          [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+              const Eigen::Vector3d&, const Eigen::Vector3d&, std::int32_t tet) {
+            if (mesh.rigid[std::size_t(tet)])
+              std::fill_n(owner.begin() + (k * plane + j * nx + i0), i1 - i0 + 1, tet);
+          });
+  return owner;
+}
 
 std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh) {
   using Key = std::array<int, 3>;
@@ -365,19 +513,80 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
   out.labels() = labels.labels();
   const auto d = labels.dims();
   const std::int64_t nx = output.dims[0], ny = output.dims[1], plane = nx * ny;
+  const Shell shell = makeShell(mesh, labels.geometry(), output, options);
+  // The voxels the pieces carry (this map holds the pieces' labels). Soft tissue that samples
+  // one of them (a piece's rim lying in a soft tet) where it has moved away from that piece
+  // (a bend beside the piece) would copy the piece beside the place the piece itself puts it,
+  // so it takes the tissue around instead; where it moves with the piece it keeps it.
+  const std::vector<std::int32_t> owner =
+      options.pieceLabels == &labels ? pieceOwnerTets(mesh, labels.geometry(), options)
+                                     : std::vector<std::int32_t>();
+  // Each piece tet's map from rest (input IJK) to output IJK.
+  std::vector<Eigen::Matrix<double, 3, 4>> pieceMap;
+  if (!owner.empty()) {
+    pieceMap.resize(std::size_t(mesh.tets.rows()));
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      if (!mesh.rigid[std::size_t(t)]) continue;
+      Eigen::Matrix3d R, O;
+      for (int c = 0; c < 3; ++c) {
+        R.col(c) = in.rest[std::size_t(mesh.tets(t, c + 1))] - in.rest[std::size_t(mesh.tets(t, 0))];
+        O.col(c) = in.out[std::size_t(mesh.tets(t, c + 1))] - in.out[std::size_t(mesh.tets(t, 0))];
+      }
+      const Eigen::Matrix3d A = O * R.inverse();
+      pieceMap[std::size_t(t)].leftCols<3>() = A;
+      pieceMap[std::size_t(t)].col(3) =
+          in.out[std::size_t(mesh.tets(t, 0))] - A * in.rest[std::size_t(mesh.tets(t, 0))];
+    }
+  }
+  auto movedAway = [&](std::int64_t at, std::int64_t i, std::int64_t j, std::int64_t k) {
+    const std::int32_t p = owner[std::size_t(at)];
+    if (p < 0) return false;
+    const Eigen::Vector3d x(double(at % d[0]), double((at / d[0]) % d[1]),
+                            double(at / (d[0] * d[1])));
+    const Eigen::Vector3d y = pieceMap[std::size_t(p)].leftCols<3>() * x +
+                              pieceMap[std::size_t(p)].col(3);
+    return (y - Eigen::Vector3d(double(i), double(j), double(k))).squaredNorm() > 1.0;
+  };
   dispatchScalar(labels.scalarType(), [&](auto* tag) {
     using T = std::remove_pointer_t<decltype(tag)>;
     const int layers = labels.layers();
     std::vector<const T*> src(layers);
     std::vector<T*> dst(layers);
     for (int l = 0; l < layers; ++l) src[l] = labels.data<T>(l), dst[l] = out.data<T>(l);
-    runScan(in, makeShell(mesh, labels.geometry(), output, options), options, "rasterize labels",
-            report, frameSign(output),
+    // The most common value around `at` that no piece owns (`at` itself if there is none),
+    // looking one voxel around first, then two.
+    auto aroundPiece = [&](std::int64_t at) {
+      const std::int64_t x = at % d[0], y = (at / d[0]) % d[1], z = at / (d[0] * d[1]);
+      for (int r = 1; r <= 2; ++r) {
+        std::map<double, int> votes;
+        std::map<double, std::int64_t> where;
+        for (int c = -r; c <= r; ++c)
+          for (int b = -r; b <= r; ++b)
+            for (int a = -r; a <= r; ++a) {
+              const std::int64_t u = x + a, v = y + b, w = z + c;
+              if (u < 0 || v < 0 || w < 0 || u >= d[0] || v >= d[1] || w >= d[2]) continue;
+              const std::int64_t n = u + d[0] * (v + d[1] * w);
+              if (owner[std::size_t(n)] >= 0) continue;
+              const double value = double(src[0][n]);
+              if (++votes[value] == 1) where[value] = n;
+            }
+        std::int64_t best = -1;
+        int most = 0;
+        for (const auto& [value, n] : votes)
+          if (n > most) most = n, best = where[value];
+        if (best >= 0) return best;
+      }
+      return at;
+    };
+    runScan(in, shell, options, "rasterize labels", report, frameSign(output),
             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
-                const Eigen::Vector3d& step) {
+                const Eigen::Vector3d& step, std::int32_t tet) {
               const std::int64_t row = k * plane + j * nx;
               for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-                const std::int64_t at = nearestVoxel(p, d);
+                std::int64_t at = nearestVoxel(p, d);
+                if (at >= 0 && !owner.empty() && !mesh.rigid[std::size_t(tet)] &&
+                    movedAway(at, i, j, k))
+                  at = aroundPiece(at);
                 for (int l = 0; l < layers; ++l) dst[l][row + i] = at >= 0 ? src[l][at] : T(0);
               }
             });
@@ -416,7 +625,7 @@ void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
       runScan(
           in, shell, one, "rasterize labels (out of core)", &part, frameSign(output),
           [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
-              const Eigen::Vector3d& step) {
+              const Eigen::Vector3d& step, std::int32_t) {
             T* row = buffer.data() + (k - k0) * plane + j * nx;
             for (std::int64_t i = i0; i <= i1; ++i, p += step) {
               const std::int64_t at = nearestVoxel(p, d), inPlane = d[0] * d[1];
@@ -457,7 +666,7 @@ Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
     runScan(in, makeShell(mesh, image.geometry(), output, options), options, "rasterize image",
             report, frameSign(output),
             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
-                const Eigen::Vector3d& step) {
+                const Eigen::Vector3d& step, std::int32_t) {
               const std::int64_t row = k * plane + j * nx;
               for (std::int64_t i = i0; i <= i1; ++i, p += step) {
                 // Trilinear over the 8 voxel centres around p, clamped at the grid's edge;
@@ -523,7 +732,7 @@ std::vector<float> rasterizeDisplacement(const TransferMesh& mesh, const Eigen::
   runScan(in, makeShell(mesh, input, output, options), options, "displacement field", nullptr,
           frameSign(output),
           [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
-              const Eigen::Vector3d& step) {
+              const Eigen::Vector3d& step, std::int32_t) {
             for (std::int64_t i = i0; i <= i1; ++i, p += step) {
               const Eigen::Vector3d d =
                   (I * p + io) - (O * Eigen::Vector3d(double(i), double(j), double(k)) + oo);
@@ -544,7 +753,7 @@ Volume rasterizeCoverage(const TransferMesh& mesh, const Eigen::MatrixX3d& defor
   const std::int64_t nx = output.dims[0], plane = nx * output.dims[1];
   runScan(in, Shell(), options, "coverage", nullptr, frameSign(output),
           [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
-              const Eigen::Vector3d&, const Eigen::Vector3d&) {
+              const Eigen::Vector3d&, const Eigen::Vector3d&, std::int32_t) {
             std::uint8_t* row = dst + k * plane + j * nx;
             for (std::int64_t i = i0; i <= i1; ++i)
               if (row[i] < 255) ++row[i];

@@ -2,6 +2,7 @@
 // maps, the transform and a report whose checks hold where they should; re-running through the
 // saved scene is bit-identical; keyframes give one folder per frame; a bad pose file fails with
 // one line naming the field and writes nothing.
+#include "CliTestFiles.h"
 #include "CommandRunner.h"
 #include "TestPaths.h"
 
@@ -16,18 +17,6 @@
 using namespace repose;
 using namespace repose::test;
 
-namespace {
-
-std::string suite(const std::string& name) {
-  return std::string(REPOSE_SOURCE_DIR) + "/bench/poses/" + name + ".pose.json";
-}
-
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream f(path);
-  return nlohmann::json::parse(f);
-}
-
-}  // namespace
 
 TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   ScratchDir dir("pose");
@@ -40,11 +29,11 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   // check, so the test demands their rigid copy itself (the suite's one-ring elbow is the image
   // run below).
   const CommandResult first =
-      runCommand("repose", common + " --pose " + shellQuote(suite("elbow90")) +
+      runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) +
                                " --joint-rings 0 --out " + shellQuote(dir.file("a")) + " --json");
   ASSERT_EQ(first.exitCode, 0) << first.err;
   const nlohmann::json report = nlohmann::json::parse(first.out);
-  EXPECT_EQ(report, readJson(dir.file("a/report.json")));
+  EXPECT_EQ(report, readJsonFile(dir.file("a/report.json")));
   for (const char* f : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd"})
     EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("a/") + f))) << f;
   EXPECT_FALSE(report["scene_reused"].get<bool>());
@@ -68,7 +57,7 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
 
   // Through the saved scene: the same posed map, bit for bit.
   const CommandResult second =
-      runCommand("repose", common + " --pose " + shellQuote(suite("elbow90")) +
+      runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) +
                                " --joint-rings 0 --out " + shellQuote(dir.file("b")) + " --json");
   ASSERT_EQ(second.exitCode, 0) << second.err;
   EXPECT_TRUE(nlohmann::json::parse(second.out)["scene_reused"].get<bool>());
@@ -89,7 +78,7 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
           ct.data<float>()[ct.index(i, j, k)] = 1000.0f + float(i);
     writeVolume(ct, dir.file("ct.nii.gz"));
     const CommandResult withImage =
-        runCommand("repose", common + " --pose " + shellQuote(suite("elbow90")) + " --image " +
+        runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) + " --image " +
                                  shellQuote(dir.file("ct.nii.gz")) + " --background -1000 --out " +
                                  shellQuote(dir.file("img")) + " --json");
     ASSERT_EQ(withImage.exitCode, 0) << withImage.err;
@@ -112,7 +101,7 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
 
   // Keyframes: one folder and one report per frame.
   const CommandResult walk =
-      runCommand("repose", common + " --pose " + shellQuote(suite("walk")) + " --out " +
+      runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("walk")) + " --out " +
                                shellQuote(dir.file("walk")) + " --json");
   ASSERT_EQ(walk.exitCode, 0) << walk.err;
   EXPECT_EQ(nlohmann::json::parse(walk.out)["frames"].size(), 7u);

@@ -7,6 +7,7 @@
 #include "repose/cage/CageBuilder.h"
 #include "repose/pose/ContactSeparation.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseRig.h"
 #include "repose/pose/Skeleton.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
@@ -46,5 +47,15 @@ struct PoseSeparations {
 };
 PoseSeparations poseSeparations(const Pose& pose, const Volume& parts, const Skeleton* skeleton,
                                 bool automatic);
+
+// The joints whose two body parts the pose moves with different groups (not both fixed): the
+// balls where the rig's transfer mesh is made finer (RigSettings::refineJoints), tets of a third
+// of the joint's radius_mm (at least two voxels) within 1.5 radii of its centre.
+std::vector<JointRefinement> jointRefinements(const Pose& pose, const Volume& parts,
+                                              const Skeleton* skeleton);
+
+// The skeleton's joints as PoseRig bends them: each joint with its two parts (labels of S by
+// name), its centre, its distal direction (its "rotation" axis) and its radius.
+std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& partLabels);
 
 }  // namespace repose

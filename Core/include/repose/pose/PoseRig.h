@@ -5,6 +5,7 @@
 #pragma once
 
 #include "repose/cage/CageBuilder.h"
+#include "repose/mesh/JointBend.h"
 #include "repose/mesh/Refinement.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
@@ -14,6 +15,15 @@
 #include <memory>
 
 namespace repose {
+
+// A ball of finer tets around a joint a pose bends: the bend happens in the soft tissue there,
+// and tets as large as the default (5% of the body's diagonal) cannot bulge as that tissue must
+// to keep its volume.
+struct JointRefinement {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radiusMm = 0;  // tets of sizeMm within this distance, growing to the default at twice it
+  double sizeMm = 0;
+};
 
 struct RigSettings {
   int cageVertices = 300;
@@ -26,13 +36,22 @@ struct RigSettings {
   // Also mesh as whole pieces the labels of G that lie in one body part of S (organs: the
   // bladder beside the hip moves with the pelvis instead of bending with the thigh).
   bool wholeOrgans = true;
+  // Finer tets around the joints the pose bends (PoseJob.h: jointRefinements).
+  std::vector<JointRefinement> refineJoints;
 };
 
-// The share of a label's voxels in one body part above which it is an organ of that part.
+// The sizing field of buildRigGeometry: the default size (meshMm, or 5% of S's diagonal), finer
+// in the balls of settings.refineJoints. Uniform when there are none.
+SizingField rigSizingField(const Volume& parts, const RigSettings& settings);
+
+// The share of a label's voxels in one body part above which it is an organ of that part, and
+// the share of them at most that may face another part (a label reaching a joint bends there).
 constexpr double kWholeOrganShare = 0.99;
+constexpr double kWholeOrganBorderShare = 0.002;
 
 // The labels of G that buildRigGeometry meshes as whole pieces: settings.rigidLabels, and with
-// settings.wholeOrgans every label with kWholeOrganShare of its voxels in one part of S.
+// settings.wholeOrgans every label with kWholeOrganShare of its voxels in one part of S and at
+// most kWholeOrganBorderShare of them facing another part.
 std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
                                    const RigSettings& settings);
 
@@ -72,8 +91,10 @@ class PoseRig {
  public:
   // Embeds the mesh in the cage and resolves the pose's groups (part names through partLabels).
   // jointRings: the widening of the joints (computeHandleInfluence); -1 takes the pose's own.
+  // bends: the body's joints (Skeleton), where a turn about the joint bends the soft tissue
+  // without overlap or loss of volume (JointBend.h) instead of blending the two motions.
   PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads = 0,
-          int jointRings = -1);
+          int jointRings = -1, const std::vector<BendJoint>& bends = {});
   ~PoseRig();
 
   struct Frame {
@@ -107,6 +128,7 @@ class PoseRig {
   std::unique_ptr<CageDeformation> deformation_;
   std::vector<RigidHandle> handles_;
   HandleInfluence influence_;
+  JointBends bends_;
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames_;
 };
 

@@ -49,6 +49,17 @@ struct RasterOptions {
   // is further from the labels); 0: off (only voxels inside tets are written).
   double shellMm = -1;
   const std::vector<std::uint8_t>* outerFaces = nullptr;  // outerFaces(mesh), computed if null
+  // The body-part map S the mesh was built from (its tets' labels), on the input's grid. With
+  // it a tet's shell does not write a voxel whose rest position is another part's tissue that a
+  // rest tet already carries: a limb moved away from the trunk does not extrapolate its
+  // boundary tets into the trunk's tissue it rested against (thick slices make the shell wide:
+  // 9.6 mm on 4.8 mm slices). Costs one coverage scan of the rest mesh on the input's grid.
+  const Volume* restParts = nullptr;
+  // The label map G the mesh's whole pieces come from (TransferMesh::rigid holds their labels),
+  // on the input's grid. With it each piece also writes its rim: the voxels of its own label
+  // within a voxel beyond its tets (Mesh_3 puts a piece's surface only that close), over the
+  // soft tissue around it, so a bone or organ beside a bending joint keeps all its voxels.
+  const Volume* pieceLabels = nullptr;
 };
 
 struct RasterReport {

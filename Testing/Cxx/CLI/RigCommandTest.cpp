@@ -1,0 +1,103 @@
+// `repose rig` and `repose pose` end to end, as a user brings a segmentation: the rig folder's
+// four files, a pose by named joints with automatic contact separation (each cut in the report)
+// and with separations drawn by hand (--no-auto-separate), and one-line errors for a
+// segmentation with no limb bones (TotalSegmentator's CT example: a chest, no humerus or femur).
+#include "CliTestFiles.h"
+#include "CommandRunner.h"
+#include "TestPaths.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace repose::test;
+
+
+TEST(RigCommand, RigsTheArmsRestingPhantomAndPosesItByNamedJointsWithAutomaticCuts) {
+  ScratchDir dir;
+  const std::string d = shellQuote(dir.path().string());
+  ASSERT_EQ(runCommand("repose", "phantom --voxel 3 --arms-resting --out " + d).exitCode, 0);
+  // Only G goes in: the phantom's own S and skeleton are moved away.
+  std::filesystem::rename(dir.file("S.nii.gz"), dir.file("truth_S.nii.gz"));
+  std::filesystem::rename(dir.file("skeleton.json"), dir.file("truth_skeleton.json"));
+  const CommandResult rig = runCommand(
+      "repose", "rig --input " + shellQuote(dir.file("G.nii.gz")) + " --out " +
+                    shellQuote(dir.file("rig")) + " --json");
+  ASSERT_EQ(rig.exitCode, 0) << rig.err;
+  for (const char* f : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("rig/") + f))) << f;
+  const nlohmann::json rigReport = nlohmann::json::parse(rig.out);
+  EXPECT_EQ(rigReport, readJsonFile(dir.file("rig/rig.json")));
+  EXPECT_EQ(rigReport["convention"], "phantom");
+  const nlohmann::json skeleton = readJsonFile(dir.file("rig/skeleton.json"));
+  EXPECT_GE(skeleton["joints"].size(), 13u);
+
+  // The suite's arm raise names shoulder_left and its abduction axis; the skeleton beside S
+  // resolves them.
+  auto raise = [&](const std::string& out, const std::string& extra) {
+    return runCommand("repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                                    shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
+                                    shellQuote(suitePoseFile("arm_raise90")) + " --out " +
+                                    shellQuote(dir.file(out)) + " --json" + extra);
+  };
+  const CommandResult pose = raise("raised", "");
+  ASSERT_EQ(pose.exitCode, 0) << pose.err;
+  const nlohmann::json report = nlohmann::json::parse(pose.out);
+  EXPECT_TRUE(report["separations"]["automatic"].get<bool>());
+  bool armFromTrunk = false;
+  for (const auto& s : report["separations"]["made"]) {
+    EXPECT_GT(s["contact_voxels"].get<int>(), 0);
+    armFromTrunk = armFromTrunk || (s["parts"][0] == "torso" && s["parts"][1] == "upper_arm_left");
+  }
+  EXPECT_TRUE(armFromTrunk) << report["separations"].dump();
+  EXPECT_LT(std::fabs(report["body"]["volume_change_percent"].get<double>()), 0.5);
+  EXPECT_TRUE(report["quality"]["bones_rigid"]["met"].get<bool>());
+  EXPECT_EQ(report["labels_lost"], 0);
+
+  // Without the automatic cut the arm drags the trunk's side along: the body grows.
+  const CommandResult uncut = raise("uncut", " --no-auto-separate");
+  ASSERT_EQ(uncut.exitCode, 0) << uncut.err;
+  const nlohmann::json u = nlohmann::json::parse(uncut.out);
+  EXPECT_FALSE(u["separations"]["automatic"].get<bool>());
+  EXPECT_GT(std::fabs(u["body"]["volume_change_percent"].get<double>()),
+            2 * std::fabs(report["body"]["volume_change_percent"].get<double>()));
+}
+
+TEST(RigCommand, SeparationsDrawnByHandPoseTheArmsTouchingPhantom) {
+  ScratchDir dir;
+  const std::string d = shellQuote(dir.path().string());
+  ASSERT_EQ(runCommand("repose", "phantom --voxel 3 --arms-touching --out " + d).exitCode, 0);
+  ASSERT_EQ(runCommand("repose", "rig --input " + shellQuote(dir.file("G.nii.gz")) + " --out " +
+                                     shellQuote(dir.file("rig")))
+                .exitCode,
+            0);
+  const CommandResult pose = runCommand(
+      "repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                    shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
+                    shellQuote(suitePoseFile("hand_from_hip")) + " --out " + shellQuote(dir.file("out")) +
+                    " --json --no-auto-separate");
+  ASSERT_EQ(pose.exitCode, 0) << pose.err;
+  const nlohmann::json report = nlohmann::json::parse(pose.out);
+  EXPECT_FALSE(report["separations"]["automatic"].get<bool>());
+  EXPECT_EQ(report["separations"]["manual"].size(), 4u);
+  EXPECT_LT(std::fabs(report["body"]["volume_change_percent"].get<double>()), 0.5);
+  EXPECT_TRUE(report["quality"]["bones_rigid"]["met"].get<bool>());
+  EXPECT_EQ(report["labels_lost"], 0);
+}
+
+TEST(RigCommand, ASegmentationWithoutLimbBonesIsAOneLineErrorAndWritesNothing) {
+  const std::string seg =
+      std::string(REPOSE_DATA_DIR) + "/totalsegmentator/example_seg.nii.gz";
+  if (!std::filesystem::exists(seg)) GTEST_SKIP() << seg << " not found";
+  ScratchDir dir;
+  const CommandResult r = runCommand(
+      "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("rig")));
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("example_seg.nii.gz"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("humerus"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("femur"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("rig")));
+}

@@ -1,0 +1,177 @@
+// `repose rig` from the organ map alone (rig/Rig.h), checked against the generated phantom's own
+// truth: its body-part map S on >= 95 % of body voxels and its joint centres within 5 mm, on the
+// free-armed phantom, the arms-resting one (arms on the trunk, hands on the thighs, thighs
+// touching) at 2 mm, its thick-slice variant (1.8 x 1.8 x 4.8 mm) and its ICRP 110 labelling (no
+// sides in the bone labels); a CSV convention gives the phantom's rig; a body without arms is
+// rigged for its legs and says which joints it could not make.
+#include "repose/phantom/Phantom.h"
+#include "repose/rig/Rig.h"
+#include "repose/util/Error.h"
+
+#include "TestPaths.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <string>
+
+using namespace repose;
+
+namespace {
+
+struct Variant {
+  const char* name;
+  Eigen::Vector3d spacing;
+  bool armsResting;
+  PhantomLabelling labels;
+};
+
+void PrintTo(const Variant& v, std::ostream* os) { *os << v.name; }
+
+class RigPhantom : public ::testing::TestWithParam<Variant> {};
+
+double agreement(const Volume& truth, const Volume& rigged) {
+  std::int64_t body = 0, same = 0;
+  for (std::int64_t i = 0; i < truth.numVoxels(); ++i) {
+    const double t = truth.valueAsDouble(i);
+    if (t <= 0) continue;
+    ++body;
+    same += rigged.valueAsDouble(i) == t;
+  }
+  return double(same) / double(std::max<std::int64_t>(1, body));
+}
+
+}  // namespace
+
+TEST_P(RigPhantom, ReproducesThePhantomsPartsAndJoints) {
+  const Variant& v = GetParam();
+  PhantomOptions o;
+  o.spacingMm = v.spacing;
+  o.armsResting = v.armsResting;
+  o.labels = v.labels;
+  const Phantom phantom(o);
+  const auto [G, S] = phantom.makeVolumes();
+  RigOptions ro;
+  ro.source = v.name;
+  const RigResult rig = rigBody(G, ro);
+  EXPECT_TRUE(rig.missing.empty()) << rig.missing.front();
+  EXPECT_GE(agreement(S, rig.parts), 0.95);
+  // The parts keep the phantom's names and numbers, so pose files written for it pose this rig.
+  for (const Label& l : S.labels().labels())
+    if (l.value > 0) EXPECT_EQ(rig.parts.labels().find(l.value)->name, l.name);
+  const Skeleton truth = phantom.skeleton();
+  int compared = 0;
+  for (const SkeletonJoint& j : truth.joints) {
+    if (j.parts[0].empty()) continue;  // the phantom's root ("pelvis") joins no two parts
+    const SkeletonJoint* found = rig.skeleton.find(j.name);
+    ASSERT_NE(found, nullptr) << j.name;
+    EXPECT_LT((found->centre - j.centre).norm(), 5.0) << j.name;
+    EXPECT_EQ(found->parts, j.parts) << j.name;
+    ASSERT_NE(found->axis("flexion"), nullptr) << j.name;
+    // The flexion axes agree in direction (within 25 degrees: a hinge fitted to the condyles).
+    if (j.axis("flexion"))
+      EXPECT_GT(found->axis("flexion")->dot(*j.axis("flexion")), std::cos(25 * M_PI / 180))
+          << j.name;
+    ++compared;
+  }
+  EXPECT_GE(compared, 13);
+  // The tissue table marks the bones rigid and names which bone each is.
+  int bones = 0;
+  for (const auto& [value, t] : rig.tissues) bones += t.rigid;
+  EXPECT_GE(bones, 10);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Variants, RigPhantom,
+    ::testing::Values(
+        Variant{"free_arms_2mm", Eigen::Vector3d(2, 2, 2), false, PhantomLabelling::Phantom},
+        Variant{"arms_resting_2mm", Eigen::Vector3d(2, 2, 2), true, PhantomLabelling::Phantom},
+        Variant{"arms_resting_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true,
+                PhantomLabelling::Phantom},
+        Variant{"icrp110_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true,
+                PhantomLabelling::Icrp110}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(Rig, ACsvConventionGivesThePhantomsRig) {
+  PhantomOptions o;
+  o.voxelMm = 3;
+  o.armsResting = true;
+  const Phantom phantom(o);
+  auto [G, S] = phantom.makeVolumes();
+  const RigResult builtIn = rigBody(G);
+  // The user's table: label, bone (and a side where the label has one).
+  test::ScratchDir dir;
+  std::ofstream csv(dir.file("bones.csv"));
+  csv << "label,bone,side,name\n";
+  for (const auto& [value, role] : builtIn.convention.roles)
+    if (role.bone != BoneKind::None)
+      csv << value << "," << boneKindName(role.bone) << ","
+          << (role.side < 0 ? "left" : role.side > 0 ? "right" : "") << "," << role.name << "\n";
+  csv.close();
+  RigOptions ro;
+  ro.labels = dir.file("bones.csv");
+  const RigResult fromCsv = rigBody(G, ro);
+  EXPECT_GE(agreement(builtIn.parts, fromCsv.parts), 0.99);
+  for (const SkeletonJoint& j : builtIn.skeleton.joints) {
+    const SkeletonJoint* found = fromCsv.skeleton.find(j.name);
+    ASSERT_NE(found, nullptr) << j.name;
+    EXPECT_LT((found->centre - j.centre).norm(), 1.0) << j.name;
+  }
+}
+
+TEST(Rig, ABodyWithoutArmsIsRiggedForItsLegsAndSaysSo) {
+  PhantomOptions o;
+  o.voxelMm = 3;
+  const Phantom phantom(o);
+  auto [G, S] = phantom.makeVolumes();
+  ASSERT_EQ(G.scalarType(), ScalarType::UInt8);
+  // The arms' bones become muscle: a scan whose arms were cropped or not segmented.
+  const RigResult full = rigBody(G);
+  int muscle = 0;
+  for (const Label& l : G.labels().labels())
+    if (l.name == "muscle") muscle = l.value;
+  ASSERT_GT(muscle, 0);
+  std::map<int, bool> armBone;
+  for (const auto& [value, role] : full.convention.roles)
+    armBone[value] = role.bone == BoneKind::Humerus || role.bone == BoneKind::Forearm ||
+                     role.bone == BoneKind::Hand;
+  for (std::int64_t i = 0; i < G.numVoxels(); ++i)
+    if (armBone[int(G.valueAsDouble(i))]) G.data<std::uint8_t>()[i] = std::uint8_t(muscle);
+  const RigResult legs = rigBody(G);
+  for (const char* j : {"hip_left", "knee_right", "ankle_left"})
+    EXPECT_NE(legs.skeleton.find(j), nullptr) << j;
+  EXPECT_EQ(legs.skeleton.find("elbow_left"), nullptr);
+  bool said = false;
+  for (const std::string& m : legs.missing)
+    said = said || m.find("humerus") != std::string::npos;
+  EXPECT_TRUE(said) << "no line names the missing humerus";
+}
+
+TEST(Rig, NoLimbBonesIsAOneLineErrorNamingThem) {
+  PhantomOptions o;
+  o.voxelMm = 4;
+  auto [G, S] = Phantom(o).makeVolumes();
+  int muscle = 0;
+  for (const Label& l : G.labels().labels())
+    if (l.name == "muscle") muscle = l.value;
+  const RigResult full = rigBody(G);
+  for (std::int64_t i = 0; i < G.numVoxels(); ++i) {
+    const auto it = full.convention.roles.find(int(G.valueAsDouble(i)));
+    if (it != full.convention.roles.end() &&
+        (it->second.bone == BoneKind::Humerus || it->second.bone == BoneKind::Femur))
+      G.data<std::uint8_t>()[i] = std::uint8_t(muscle);
+  }
+  RigOptions ro;
+  ro.source = "trunk.nii.gz";
+  try {
+    rigBody(G, ro);
+    FAIL() << "rigged a body without humeri and femora";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos);
+    EXPECT_NE(m.find("trunk.nii.gz"), std::string::npos) << m;
+    EXPECT_NE(m.find("humerus"), std::string::npos) << m;
+    EXPECT_NE(m.find("femur"), std::string::npos) << m;
+  }
+}

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""The standard pose suite on a generated phantom, rigged by `repose rig` and posed by `repose pose`
+alone (named joints, automatic contact separation), checked against docs/QUALITY.md's targets
+from each frame's report.json:
+
+  body volume within +-0.5 %; every label of >= 1000 voxels within +-1 % beyond its resampling
+  floor; each bone (all its labels) Dice >= 0.95; no new holes; no label lost.
+
+usage: pose_suite_quality.py BIN_DIR POSES_DIR WORK_DIR [phantom options...]
+       [--label-bound PERCENT]  the per-label bound beyond the floor (default 1, the target)
+
+Exits 1 naming every frame and target that fails.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+SUITE = ["elbow90", "arm_raise90", "leg_step30", "walk"]
+
+
+def run(args):
+    r = subprocess.run(args, capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"{' '.join(args)}: exit {r.returncode}: {r.stderr.strip()}")
+    return r.stdout
+
+
+def main():
+    argv = sys.argv[1:]
+    bound = 1.0
+    if "--label-bound" in argv:
+        i = argv.index("--label-bound")
+        bound = float(argv[i + 1])
+        del argv[i:i + 2]
+    bin_dir, poses, work = argv[:3]
+    phantom_args = argv[3:]
+    repose = os.path.join(bin_dir, "repose")
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    run([repose, "phantom", "--out", work] + phantom_args)
+    g = os.path.join(work, "G.nii.gz")
+    rig = os.path.join(work, "rig")
+    run([repose, "rig", "--input", g, "--out", rig])
+    failures, frames = [], 0
+    for name in SUITE:
+        out = os.path.join(work, name)
+        report = json.loads(run([repose, "pose", "--input", g, "--parts",
+                                 os.path.join(rig, "S.nii.gz"), "--pose",
+                                 os.path.join(poses, name + ".pose.json"), "--out", out,
+                                 "--json"]))
+        for f in report.get("frames", [report]):
+            frames += 1
+            q, where = f["quality"], f"{f['pose']}/{f['frame']}"
+            body = f["body"]["volume_change_percent"]
+            worst = q["labels_within_1_percent"]
+            beyond = worst["worst_change_beyond_floor_percent"]
+            print(f"{where}: body {body:+.3f} %, worst label {worst['worst_name']} "
+                  f"{worst['worst_change_percent']:+.2f} % (floor "
+                  f"{worst['worst_resampling_floor_percent']:+.2f} %), bones min Dice "
+                  f"{q['bones_rigid']['min_dice']:.3f}, new holes "
+                  f"{q['no_new_holes']['new_enclosed_voxels']}, lost "
+                  f"{q['no_label_lost']['labels_lost']}")
+            if abs(body) > 0.5:
+                failures.append(f"{where}: body volume {body:+.3f} % (target +-0.5 %)")
+            if abs(beyond) > bound:
+                failures.append(f"{where}: {worst['worst_name']} {beyond:+.2f} % beyond its "
+                                f"resampling floor (bound +-{bound} %)")
+            if not q["bones_rigid"]["met"]:
+                failures.append(f"{where}: bone {q['bones_rigid']['min_dice_bone']} Dice "
+                                f"{q['bones_rigid']['min_dice']:.3f} (target >= 0.95)")
+            if not q["no_new_holes"]["met"]:
+                failures.append(f"{where}: {q['no_new_holes']['new_enclosed_voxels']} new "
+                                "enclosed voxels")
+            if not q["no_label_lost"]["met"]:
+                failures.append(f"{where}: {q['no_label_lost']['labels_lost']} labels lost")
+            seps = f["separations"]
+            if not seps.get("automatic") or not seps.get("made"):
+                failures.append(f"{where}: no automatic contact separation was made")
+    if frames < 10:
+        failures.append(f"only {frames} frames posed")
+    for line in failures:
+        print("FAILED", line)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
