@@ -160,24 +160,24 @@ int runPhantom(const Args& args) {
 
   if (json) {
     const Eigen::Vector3d o = g.origin();
-    nlohmann::json doc = {{"files",
-                           {{"organs", files.organs},
-                            {"parts", files.parts},
-                            {"skeleton", files.skeleton},
-                            {"image", files.image}}},
-                          {"dims", g.dims},
-                          {"voxelMm", options.spacing().maxCoeff()},
-                          {"spacingMm",
-                           {options.spacing().x(), options.spacing().y(), options.spacing().z()}},
-                          {"armsResting", options.armsResting},
-                          {"labels", labels},
-                          {"originRas", {o.x(), o.y(), o.z()}},
-                          {"numVoxels", g.numVoxels()},
-                          {"armsTouching", options.armsTouching},
-                          {"bytesWritten", written},
-                          {"seconds", seconds},
-                          {"organLabels", labelsJson(phantom.organLabels())},
-                          {"partLabels", labelsJson(phantom.partLabels())}};
+    nlohmann::json doc = {
+        {"files",
+         {{"organs", files.organs},
+          {"parts", files.parts},
+          {"skeleton", files.skeleton},
+          {"image", files.image}}},
+        {"dims", g.dims},
+        {"voxelMm", options.spacing().maxCoeff()},
+        {"spacingMm", {options.spacing().x(), options.spacing().y(), options.spacing().z()}},
+        {"armsResting", options.armsResting},
+        {"labels", labels},
+        {"originRas", {o.x(), o.y(), o.z()}},
+        {"numVoxels", g.numVoxels()},
+        {"armsTouching", options.armsTouching},
+        {"bytesWritten", written},
+        {"seconds", seconds},
+        {"organLabels", labelsJson(phantom.organLabels())},
+        {"partLabels", labelsJson(phantom.partLabels())}};
     std::cout << doc.dump(2) << "\n";
   } else {
     std::cout << "wrote " << files.organs << "\n      " << files.parts << "\n      "

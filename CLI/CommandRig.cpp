@@ -79,8 +79,8 @@ int runRig(const Args& args) {
     std::cout << "  " << j.name << " at (" << std::lround(j.centre.x()) << ", "
               << std::lround(j.centre.y()) << ", " << std::lround(j.centre.z())
               << ") mm: " << j.method << "\n";
-  std::cout << "wrote " << (dir / "S.nii.gz").string() << ", skeleton.json, tissues.csv, rig.json in "
-            << int(seconds) << " s\n";
+  std::cout << "wrote " << (dir / "S.nii.gz").string()
+            << ", skeleton.json, tissues.csv, rig.json in " << int(seconds) << " s\n";
   return 0;
 }
 

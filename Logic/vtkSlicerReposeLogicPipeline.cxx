@@ -167,8 +167,8 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {
       for (auto it = segs.rbegin(); it != segs.rend(); ++it)
         if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(*it);
             seg && !seg->GetSkeletonJSON().empty()) {
-          repose::resolvePoseJoints(pose, repose::parseSkeleton(seg->GetSkeletonJSON(),
-                                                                seg->GetName() + " skeleton"));
+          repose::resolvePoseJoints(
+              pose, repose::parseSkeleton(seg->GetSkeletonJSON(), seg->GetName() + " skeleton"));
           break;
         }
     }
@@ -386,12 +386,16 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
       });
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
+    // The joints bend as `repose pose` bends them (the skeleton beside S).
+    const std::optional<repose::Skeleton> skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
+    const std::vector<repose::BendJoint> bends =
+        repose::bendJoints(skeleton ? &*skeleton : nullptr, S->labels());
     this->Job->Start(
         "pose",
         [=, geometry = std::move(geometry)](
             const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
           repose::reportProgress(progress, 0, "embedding");
-          const repose::PoseRig rig(std::move(geometry), pose, S->labels());
+          const repose::PoseRig rig(std::move(geometry), pose, S->labels(), 0, -1, bends);
           // The frame as `repose pose` poses it (one implementation: repose::poseFrame).
           repose::PoseFrameOptions fo;
           fo.image = I.get();
@@ -552,8 +556,7 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
             vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg))));
         if (!seg->GetBodyPartMapFileName().empty()) {
           const std::string parts = (dir / seg->GetBodyPartMapFileName()).string();
-          seg->SetBodyPartMap(
-              Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(parts)));
+          seg->SetBodyPartMap(Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(parts)));
           // A scene the command line wrote names S where it is; its skeleton is beside it.
           if (seg->GetSkeletonJSON().empty())
             if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())

@@ -235,9 +235,8 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
       .def(py::init([](const Volume& organs, const Volume& parts, const Pose& named,
                        int cageVertices, double dilateMm, double meshMm,
                        const std::string& tissuesPath, bool tissuesIfCovering,
-                       const std::string& tissuesCsv, bool wholeOrgans, int jointRings,
-                       int threads, const py::object& skeleton, bool autoSeparate,
-                       const py::object& progress) {
+                       const std::string& tissuesCsv, bool wholeOrgans, int jointRings, int threads,
+                       const py::object& skeleton, bool autoSeparate, const py::object& progress) {
              if (parts.dims() != organs.dims() ||
                  !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
                throw Error("the body-part map is not on the organ map's grid");
@@ -263,7 +262,7 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
                const auto separations = poseSeparations(pose, parts, body, autoSeparate).all;
                RigGeometry g = buildRigGeometry(parts, separations, r->settings, fn, &organs);
                r->rig = std::make_unique<PoseRig>(std::move(g), pose, parts.labels(), threads,
-                                                  jointRings);
+                                                  jointRings, bendJoints(body, parts.labels()));
                return 0;
              });
              return r;
@@ -272,9 +271,8 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
            py::arg("cage_vertices") = 300, py::arg("dilate_mm") = 10.0, py::arg("mesh_mm") = 0.0,
            py::arg("_tissues_path") = "", py::arg("_tissues_if_covering") = false,
            py::arg("_tissues_csv") = "", py::arg("whole_organs") = true,
-           py::arg("joint_rings") = -1, py::arg("threads") = 0,
-           py::arg("skeleton") = py::none(), py::arg("auto_separate") = true,
-           py::arg("progress") = py::none())
+           py::arg("joint_rings") = -1, py::arg("threads") = 0, py::arg("skeleton") = py::none(),
+           py::arg("auto_separate") = true, py::arg("progress") = py::none())
       .def_property_readonly("frame_count", [](const Rig& r) { return r.rig->frameCount(); })
       .def_property_readonly("frame_names",
                              [](const Rig& r) {
@@ -365,9 +363,8 @@ slabs), so label maps larger than memory can be posed.)doc")
           [](const Rig& r, const std::string& folder, const std::string& organsPath,
              const std::string& partsPath, const std::string& imagePath) {
             const Volume parts = readVolume(partsPath);
-            const std::string key =
-                sceneRigKey(partsPath, resolveSeparations(r.rig->pose(), parts.labels()),
-                            r.settings);
+            const std::string key = sceneRigKey(
+                partsPath, resolveSeparations(r.rig->pose(), parts.labels()), r.settings);
             writeSceneFolder(folder, *r.rig, key, {organsPath, partsPath, imagePath}, r.settings);
           },
           py::arg("folder"), py::arg("organs_path"), py::arg("parts_path"),

@@ -71,8 +71,8 @@ does.)doc")
 
   m.def(
       "rig_body",
-      [](const Volume& organs, const std::string& labels, const std::string& source,
-         int threads, const py::object& progress) {
+      [](const Volume& organs, const std::string& labels, const std::string& source, int threads,
+         const py::object& progress) {
         RigOptions o;
         o.labels = labels;
         o.source = source;

@@ -21,8 +21,8 @@ double smoothstepSlope(double t) {
 }  // namespace
 
 Eigen::Vector3d bendPoint(const Eigen::Vector3d& p, const Eigen::Vector3d& centre,
-                          const Eigen::Vector3d& axis, const Eigen::Vector3d& distal,
-                          double angle, double* share) {
+                          const Eigen::Vector3d& axis, const Eigen::Vector3d& distal, double angle,
+                          double* share) {
   const Eigen::Vector3d a = axis.normalized();
   Eigen::Vector3d d = distal - distal.dot(a) * a;
   if (d.norm() < 1e-9) d = a.unitOrthogonal();
@@ -47,8 +47,8 @@ Eigen::Vector3d bendPoint(const Eigen::Vector3d& p, const Eigen::Vector3d& centr
   const double ramp = std::clamp(t, 0.0, 1.0), rampSlope = t <= 0 || t >= 1 ? 0.0 : 1.0;
   const double s = 1 - ((1 - linear) * smoothstep(t) + linear * ramp);
   if (share) *share = s;
-  const double slope = -((1 - linear) * smoothstepSlope(t) + linear * rampSlope) / width *
-                       (phi < 0 ? -1.0 : 1.0);
+  const double slope =
+      -((1 - linear) * smoothstepSlope(t) + linear * rampSlope) / width * (phi < 0 ? -1.0 : 1.0);
   const double stretch = std::max(0.05, 1 + angle * slope);  // dphi'/dphi
   const double phi2 = phi + angle * s;
   const double rho2 = rho / std::sqrt(stretch);  // the plane's areas kept
@@ -92,8 +92,7 @@ JointBends::JointBends(const TransferMesh& mesh, const std::vector<RigidHandle>&
         for (int k = 0; k < 4; ++k) mixedOk[std::size_t(mesh.tets(t, k))] = 0;
     const double reach = j.radiusMm * std::max(j.proximalReach, j.distalReach);
     for (Eigen::Index v = 0; v < nv; ++v) {
-      if (piece[std::size_t(v)] || !mixedOk[std::size_t(v)] || part[std::size_t(v)] == -2)
-        continue;
+      if (piece[std::size_t(v)] || !mixedOk[std::size_t(v)] || part[std::size_t(v)] == -2) continue;
       if ((Eigen::Vector3d(mesh.vertices.row(v)) - j.centre).norm() <= reach)
         out.vertices.push_back(int(v));
     }
@@ -118,9 +117,8 @@ JointBendReport JointBends::apply(const TransferMesh& mesh, const std::vector<Ri
       double s = 0;
       const Eigen::Vector3d bent =
           proximal * bendPoint(rest, c, turn.axis(), j.joint.distal, turn.angle(), &s);
-      const double reach =
-          j.joint.radiusMm *
-          (j.joint.proximalReach + s * (j.joint.distalReach - j.joint.proximalReach));
+      const double reach = j.joint.radiusMm * (j.joint.proximalReach +
+                                               s * (j.joint.distalReach - j.joint.proximalReach));
       // Into the blended frame over the outer 30% of the joint's reach; on the trunk's side of
       // a root joint also outside the limb's cross-section (the pelvis beside a hip, the chest
       // beside a shoulder), faded by the share so the two sides agree at the joint plane.

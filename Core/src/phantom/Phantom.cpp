@@ -286,8 +286,8 @@ Skeleton Phantom::skeleton() const {
     s.method = "phantom";
     for (const auto& [name, info] : impl_->model.jointInfo) {
       if (name != j.name) continue;
-      s.axes = jointAxes(info.kind, info.distal, Eigen::Vector3d::UnitY(),
-                         Eigen::Vector3d::UnitZ(), info.side, info.palmar);
+      s.axes = jointAxes(info.kind, info.distal, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
+                         info.side, info.palmar);
       s.parts = {partName(info.proximal), partName(info.distalPart)};
       s.radiusMm = info.radiusMm;
     }
@@ -299,12 +299,11 @@ Skeleton Phantom::skeleton() const {
 std::string Phantom::skeletonJson() const {
   const PhantomOptions& o = impl_->options;
   const Eigen::Vector3d sp = o.spacing();
-  nlohmann::json made = {
-      {"made_by", "repose phantom"},
-      {"armsTouching", o.armsTouching},
-      {"armsResting", o.armsResting},
-      {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
-      {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
+  nlohmann::json made = {{"made_by", "repose phantom"},
+                         {"armsTouching", o.armsTouching},
+                         {"armsResting", o.armsResting},
+                         {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
+                         {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
   return skeletonToJson(skeleton(), made.dump());
 }
 

@@ -385,9 +385,13 @@ void addVessels(Builder& b, const SideJoints& j) {
     const V h = P(j.hip), k = P(j.knee), a = P(j.ankle);
     const V ut = (k - h).normalized(), us = (a - k).normalized();
     const V medT = across(ut, P(V(-1, 0, 0))), antT = across(ut, V::UnitY());
-    b.vessel({{0, -22, 765}, P({40, 10, 725}), h + 22 * antT + 14 * medT - 10 * ut,
-              h + 150 * ut + 25 * medT + 12 * antT, k - 70 * ut + 22 * medT - 5 * antT,
-              k - 20 * V::UnitY() + 5 * medT, k + 80 * us - 18 * V::UnitY(),
+    b.vessel({{0, -22, 765},
+              P({40, 10, 725}),
+              h + 22 * antT + 14 * medT - 10 * ut,
+              h + 150 * ut + 25 * medT + 12 * antT,
+              k - 70 * ut + 22 * medT - 5 * antT,
+              k - 20 * V::UnitY() + 5 * medT,
+              k + 80 * us - 18 * V::UnitY(),
               a - 30 * us - 14 * V::UnitY() + 8 * medT},
              5, 2.5);
   }

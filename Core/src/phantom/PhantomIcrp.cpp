@@ -9,7 +9,7 @@ namespace {
 
 // ICRP 110 organ IDs (ICRP Publication 110, Annex A; ../shared/labels/icrp110_organs.csv).
 namespace id {
-constexpr std::uint8_t kVessels[4] = {9, 10, 11, 12};    // head, trunk, arms, legs
+constexpr std::uint8_t kVessels[4] = {9, 10, 11, 12};  // head, trunk, arms, legs
 constexpr std::uint8_t kMuscle[4] = {106, 107, 108, 109};
 constexpr std::uint8_t kAdipose[4] = {116, 117, 118, 119};  // "residual tissue"
 constexpr std::uint8_t kSkin[4] = {122, 123, 124, 125};
@@ -112,7 +112,7 @@ std::uint8_t IcrpLabeller::label(std::uint8_t organ, std::uint8_t part,
     case kSternum:
       return id::kSternum;
     case kVertebrae:  // levels by height on the phantom's spine (T1 at z = 1000 mm)
-      return p.z() >= 1000 ? id::kCervical
+      return p.z() >= 1000  ? id::kCervical
              : p.z() >= 860 ? id::kThoracic
              : p.z() >= 725 ? id::kLumbar
                             : id::kSacrum;

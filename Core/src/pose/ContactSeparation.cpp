@@ -18,9 +18,12 @@ bool standardJointPair(const std::string& a, const std::string& b) {
     std::set<std::pair<std::string, std::string>> out{{"head", "torso"}};
     for (const char* side : {"_left", "_right"}) {
       const std::string s = side;
-      for (const auto& [p, q] :
-           {std::pair{"torso", "upper_arm"}, {"upper_arm", "forearm"}, {"forearm", "hand"},
-            {"torso", "thigh"}, {"thigh", "shank"}, {"shank", "foot"}}) {
+      for (const auto& [p, q] : {std::pair{"torso", "upper_arm"},
+                                 {"upper_arm", "forearm"},
+                                 {"forearm", "hand"},
+                                 {"torso", "thigh"},
+                                 {"thigh", "shank"},
+                                 {"shank", "foot"}}) {
         const std::string x = std::string(p) == "torso" ? "torso" : p + s, y = q + s;
         out.insert({std::min(x, y), std::max(x, y)});
       }
@@ -64,7 +67,8 @@ std::vector<std::pair<int, int>> groupOfParts(const Pose& pose, const Volume& pa
     std::vector<char> seen(65536, 0);
     for (std::int64_t i = 0; i < parts.numVoxels(); ++i) {
       const double v = double(s[i]);
-      if (v > 0 && v < 65536 && !seen[std::size_t(v)]) seen[std::size_t(v)] = 1, present.insert(int(v));
+      if (v > 0 && v < 65536 && !seen[std::size_t(v)])
+        seen[std::size_t(v)] = 1, present.insert(int(v));
     }
   });
   std::map<int, int> owner;
@@ -108,9 +112,7 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
       std::vector<int> groupOf(65536, -1);
       for (const auto& [p, g] : group)
         if (p > 0 && p < 65536) groupOf[std::size_t(p)] = g;
-      auto gOf = [&](T v) {
-        return v > 0 && double(v) < 65536 ? groupOf[std::size_t(v)] : -1;
-      };
+      auto gOf = [&](T v) { return v > 0 && double(v) < 65536 ? groupOf[std::size_t(v)] : -1; };
       const std::int64_t step[3] = {1, d[0], d[0] * d[1]};
       for (std::int64_t k = 0; k < d[2]; ++k)
         for (std::int64_t j = 0; j < d[1]; ++j)
@@ -171,10 +173,9 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
     for (const auto& [va, vb] : list) {
       const std::int64_t i0 = va % d[0], j0 = (va / d[0]) % d[1], k0 = va / (d[0] * d[1]);
       const std::int64_t i1 = vb % d[0], j1 = (vb / d[0]) % d[1], k1 = vb / (d[0] * d[1]);
-      const Eigen::Vector3d mid = 0.5 * (parts.geometry().voxelToRas(double(i0), double(j0),
-                                                                      double(k0)) +
-                                         parts.geometry().voxelToRas(double(i1), double(j1),
-                                                                      double(k1)));
+      const Eigen::Vector3d mid =
+          0.5 * (parts.geometry().voxelToRas(double(i0), double(j0), double(k0)) +
+                 parts.geometry().voxelToRas(double(i1), double(j1), double(k1)));
       if (!c.separation.region.contains(mid)) continue;
       voxels.insert(va);
       voxels.insert(vb);

@@ -43,7 +43,8 @@ struct Reader : JsonFields {
   Region region(const json& j, const std::string& field) const {
     object(j, field);
     onlyKeys(j, field, {"box", "sphere", "outside_sphere", "everywhere"});
-    if (j.size() != 1) fail(field, "expected exactly one of box, sphere, outside_sphere, everywhere");
+    if (j.size() != 1)
+      fail(field, "expected exactly one of box, sphere, outside_sphere, everywhere");
     Region r;
     if (j.contains("everywhere")) {
       if (!j["everywhere"].is_boolean() || !j["everywhere"].get<bool>())
@@ -111,10 +112,10 @@ struct Reader : JsonFields {
   std::string jointName(const json& j, const std::string& field, bool axis) const {
     const std::string name = string(j, field);
     const auto dot = name.find('.');
-    const bool valid = !name.empty() && (axis ? dot != std::string::npos && dot > 0 &&
-                                                    dot + 1 < name.size() &&
-                                                    name.find('.', dot + 1) == std::string::npos
-                                              : dot == std::string::npos);
+    const bool valid =
+        !name.empty() && (axis ? dot != std::string::npos && dot > 0 && dot + 1 < name.size() &&
+                                     name.find('.', dot + 1) == std::string::npos
+                               : dot == std::string::npos);
     if (!valid)
       fail(field, axis ? "expected [x, y, z] or a joint's axis such as \"elbow_left.flexion\""
                        : "expected [x, y, z] or a joint such as \"elbow_left\"");
@@ -204,9 +205,8 @@ Eigen::Isometry3d PoseTransform::isometry() const {
 
 bool poseNamesJoints(const Pose& pose) {
   bool names = false;
-  forEachTransform(pose, [&](const PoseTransform& t, const std::string&) {
-    names = names || t.namesJoints();
-  });
+  forEachTransform(
+      pose, [&](const PoseTransform& t, const std::string&) { names = names || t.namesJoints(); });
   return names;
 }
 

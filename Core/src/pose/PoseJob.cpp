@@ -43,7 +43,8 @@ TissueChoice chooseTissues(const Volume& organs, const std::string& explicitPath
     std::string missing;
     int count = 0;
     for (const int label : present)
-      if (!t.count(label) && count++ < 5) missing += (missing.empty() ? "" : ", ") + std::to_string(label);
+      if (!t.count(label) && count++ < 5)
+        missing += (missing.empty() ? "" : ", ") + std::to_string(label);
     if (count == 0) {
       out.table = std::move(t);
       out.name = beside;
@@ -77,10 +78,9 @@ std::optional<Skeleton> skeletonFor(const std::string& partsPath, const std::str
 void resolveJointsWith(Pose& pose, const Skeleton* skeleton, const std::string& partsPath) {
   if (!poseNamesJoints(pose)) return;
   if (!skeleton) {
-    const std::string folder =
-        std::filesystem::path(partsPath).has_parent_path()
-            ? std::filesystem::path(partsPath).parent_path().string()
-            : std::string(".");
+    const std::string folder = std::filesystem::path(partsPath).has_parent_path()
+                                   ? std::filesystem::path(partsPath).parent_path().string()
+                                   : std::string(".");
     throw Error("pose " + pose.name + " names joints, but there is no skeleton.json beside " +
                 (partsPath.empty() ? std::string("S") : partsPath) + " (in " + folder +
                 "; `repose rig` writes one, or give --skeleton)");
@@ -142,8 +142,7 @@ std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& pa
     if (!distal || b.proximalPart == 0 || b.distalPart == 0 || !(b.radiusMm > 0)) continue;
     b.distal = *distal;
     // The trunk's side of a root joint bends only near the joint.
-    if (j.parts[0] == "torso")
-      b.proximalReach = 0.5;
+    if (j.parts[0] == "torso") b.proximalReach = 0.5;
     out.push_back(b);
   }
   return out;

@@ -109,8 +109,8 @@ static json makePoseReport(const PoseReportInput& in) {
       groupCounts.push_back(h.parts.empty() ? DiceCounts{} : diceCounts(in, h));
   const std::map<int, std::int64_t> floors =
       in.handles ? floorCounts(in, groupCounts) : std::map<int, std::int64_t>{};
-  const double outVoxelMm3 = std::fabs(in.posedOrgans->geometry().ijkToRas.block<3, 3>(0, 0)
-                                           .determinant());
+  const double outVoxelMm3 =
+      std::fabs(in.posedOrgans->geometry().ijkToRas.block<3, 3>(0, 0).determinant());
   // Per label: volume, and mass where the tissue table knows the label.
   std::map<int, std::pair<LabelCount, LabelCount>> counts;
   for (const LabelCount& c : countLabels(*in.organs))
@@ -259,7 +259,8 @@ static json makePoseReport(const PoseReportInput& in) {
   json quality = {{"labels_within_1_percent",
                    {{"met", std::fabs(worstBeyond) <= 1.0},
                     {"worst_label", worstLabel},
-                    {"worst_name", [&] {
+                    {"worst_name",
+                     [&] {
                        for (const json& row : labels)
                          if (row["value"] == worstLabel) return row["name"].get<std::string>();
                        return std::string();

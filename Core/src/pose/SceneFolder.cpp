@@ -16,28 +16,29 @@ namespace repose {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-std::string sceneRigKey(const std::string& partsPath,
-                        const std::vector<LimbSeparation>& cuts, const RigSettings& settings) {
+std::string sceneRigKey(const std::string& partsPath, const std::vector<LimbSeparation>& cuts,
+                        const RigSettings& settings) {
   json separations = json::array();
   for (const LimbSeparation& s : cuts)
     separations.push_back(
         {{"labels", {s.labelA, s.labelB}}, {"region", json::parse(regionToJson(s.region))}});
-  const json key = {{"parts", fs::absolute(partsPath).string()},
-                    {"parts_bytes", fs::file_size(partsPath)},
-                    {"parts_mtime", fs::last_write_time(partsPath).time_since_epoch().count()},
-                    {"cage_vertices", settings.cageVertices},
-                    {"dilate_mm", settings.dilateMm},
-                    {"mesh_size_mm", settings.meshMm},
-                    {"rigid_labels", settings.rigidLabels},
-                    {"whole_organs", settings.wholeOrgans},
-                    {"refine_joints", [&] {
-                       json balls = json::array();
-                       for (const JointRefinement& r : settings.refineJoints)
-                         balls.push_back({r.centre.x(), r.centre.y(), r.centre.z(), r.radiusMm,
-                                          r.sizeMm});
-                       return balls;
-                     }()},
-                    {"separations", separations}};
+  const json key = {
+      {"parts", fs::absolute(partsPath).string()},
+      {"parts_bytes", fs::file_size(partsPath)},
+      {"parts_mtime", fs::last_write_time(partsPath).time_since_epoch().count()},
+      {"cage_vertices", settings.cageVertices},
+      {"dilate_mm", settings.dilateMm},
+      {"mesh_size_mm", settings.meshMm},
+      {"rigid_labels", settings.rigidLabels},
+      {"whole_organs", settings.wholeOrgans},
+      {"refine_joints",
+       [&] {
+         json balls = json::array();
+         for (const JointRefinement& r : settings.refineJoints)
+           balls.push_back({r.centre.x(), r.centre.y(), r.centre.z(), r.radiusMm, r.sizeMm});
+         return balls;
+       }()},
+      {"separations", separations}};
   return key.dump();
 }
 

@@ -68,7 +68,7 @@ struct Shell {
   const Volume* pieceLabels = nullptr;
   double pieceMm = 0;
   std::array<double, 3> pieceGrowth{0, 0, 0};
-  std::vector<char> boneLabel;  // per label value: some tet is a piece of it
+  std::vector<char> boneLabel;       // per label value: some tet is a piece of it
   const Volume* rimParts = nullptr;  // RasterOptions::restParts, for the rims
   // A rim voxel is taken when its rest label is bone of the tet's own body part: a thin cortex
   // that Mesh_3 merged into its marrow's tets still moves with the bone.
@@ -122,7 +122,8 @@ std::vector<std::uint8_t> pieceRimFaces(const TransferMesh& mesh) {
       if (!mesh.rigid[std::size_t(t)]) continue;
       bool samePiece = false;
       for (const std::int32_t u : tets)
-        samePiece = samePiece || (u != t && mesh.rigid[std::size_t(u)] == mesh.rigid[std::size_t(t)]);
+        samePiece =
+            samePiece || (u != t && mesh.rigid[std::size_t(u)] == mesh.rigid[std::size_t(t)]);
       if (samePiece) continue;
       for (int f = 0; f < 4; ++f)
         if (key(t, f) == k) out[std::size_t(t)] |= std::uint8_t(1u << f);
@@ -139,7 +140,8 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
     sh.pieceLabels = options.pieceLabels;
     sh.pieceFaces = pieceRimFaces(mesh);
     sh.tetParts = &mesh.labels;
-    if (options.restParts && options.restParts->dims() == input.dims) sh.rimParts = options.restParts;
+    if (options.restParts && options.restParts->dims() == input.dims)
+      sh.rimParts = options.restParts;
     for (const int v : mesh.rigid)
       if (v > 0) {
         if (std::size_t(v) >= sh.boneLabel.size()) sh.boneLabel.resize(std::size_t(v) + 1, 0);
@@ -204,8 +206,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           for (Eigen::Index t = nt * part / selectThreads; t < nt * (part + 1) / selectThreads;
                ++t) {
             double gy = 0, gz = 0;  // box growth for the shell and the piece's rim
-            if (withShell && shell.outer[t])
-              gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
+            if (withShell && shell.outer[t]) gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
             if (withRims && shell.pieceFaces[std::size_t(t)])
               gy = std::max(gy, shell.pieceGrowth[1]), gz = std::max(gz, shell.pieceGrowth[2]);
             const Eigen::Vector3d &p0 = in.out[T(t, 0)], &p1 = in.out[T(t, 1)],
@@ -272,8 +273,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             if (kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
                 !raster::prepareTet(in, t, s))
               continue;
-            const std::uint8_t mark =
-                withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
+            const std::uint8_t mark = withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
             raster::scanTet(s, k0, k1, j0, j1,
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
@@ -318,8 +318,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
                               std::uint8_t* c = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
                               auto free = [&](std::int64_t x) {
-                                return !c[x] &&
-                                       shell.takes(t, rest0 + double(x - i0) * step);
+                                return !c[x] && shell.takes(t, rest0 + double(x - i0) * step);
                               };
                               for (std::int64_t a = i0; a <= i1;) {
                                 if (!free(a)) {
@@ -518,9 +517,9 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
   // one of them (a piece's rim lying in a soft tet) where it has moved away from that piece
   // (a bend beside the piece) would copy the piece beside the place the piece itself puts it,
   // so it takes the tissue around instead; where it moves with the piece it keeps it.
-  const std::vector<std::int32_t> owner =
-      options.pieceLabels == &labels ? pieceOwnerTets(mesh, labels.geometry(), options)
-                                     : std::vector<std::int32_t>();
+  const std::vector<std::int32_t> owner = options.pieceLabels == &labels
+                                              ? pieceOwnerTets(mesh, labels.geometry(), options)
+                                              : std::vector<std::int32_t>();
   // Each piece tet's map from rest (input IJK) to output IJK.
   std::vector<Eigen::Matrix<double, 3, 4>> pieceMap;
   if (!owner.empty()) {
@@ -529,7 +528,8 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
       if (!mesh.rigid[std::size_t(t)]) continue;
       Eigen::Matrix3d R, O;
       for (int c = 0; c < 3; ++c) {
-        R.col(c) = in.rest[std::size_t(mesh.tets(t, c + 1))] - in.rest[std::size_t(mesh.tets(t, 0))];
+        R.col(c) =
+            in.rest[std::size_t(mesh.tets(t, c + 1))] - in.rest[std::size_t(mesh.tets(t, 0))];
         O.col(c) = in.out[std::size_t(mesh.tets(t, c + 1))] - in.out[std::size_t(mesh.tets(t, 0))];
       }
       const Eigen::Matrix3d A = O * R.inverse();
@@ -543,8 +543,8 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
     if (p < 0) return false;
     const Eigen::Vector3d x(double(at % d[0]), double((at / d[0]) % d[1]),
                             double(at / (d[0] * d[1])));
-    const Eigen::Vector3d y = pieceMap[std::size_t(p)].leftCols<3>() * x +
-                              pieceMap[std::size_t(p)].col(3);
+    const Eigen::Vector3d y =
+        pieceMap[std::size_t(p)].leftCols<3>() * x + pieceMap[std::size_t(p)].col(3);
     return (y - Eigen::Vector3d(double(i), double(j), double(k))).squaredNorm() > 1.0;
   };
   dispatchScalar(labels.scalarType(), [&](auto* tag) {

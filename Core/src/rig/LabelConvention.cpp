@@ -22,24 +22,52 @@ struct Density {
   const char* prefix;
   double kgM3;
 };
-constexpr Density kTypicalDensities[] = {
-    {"skin", 1109},        {"subcutaneous_fat", 911}, {"torso_fat", 911},     {"fat", 911},
-    {"skeletal_muscle", 1090}, {"muscle", 1090},      {"gluteus", 1090},      {"iliopsoas", 1090},
-    {"autochthon", 1090},  {"brain", 1046},           {"spinal_cord", 1075},  {"lung", 394},
-    {"heart", 1081},       {"atrial_appendage", 1081}, {"liver", 1079},       {"spleen", 1089},
-    {"kidney", 1066},      {"stomach", 1088},         {"small_bowel", 1030},  {"duodenum", 1030},
-    {"colon", 1088},       {"urinary_bladder", 1086}, {"prostate", 1045},     {"pancreas", 1087},
-    {"gallbladder", 1071}, {"adrenal", 1028},         {"esophagus", 1040},    {"trachea", 1080},
-    {"thyroid", 1050},     {"aorta", 1102},           {"vena", 1050},         {"vein", 1050},
-    {"artery", 1050},      {"trunk", 1050},           {"intervertebral_disc", 1100},
-    {"costal_cartilage", 1100}, {"eye", 1050},        {"blood", 1050}};
+constexpr Density kTypicalDensities[] = {{"skin", 1109},
+                                         {"subcutaneous_fat", 911},
+                                         {"torso_fat", 911},
+                                         {"fat", 911},
+                                         {"skeletal_muscle", 1090},
+                                         {"muscle", 1090},
+                                         {"gluteus", 1090},
+                                         {"iliopsoas", 1090},
+                                         {"autochthon", 1090},
+                                         {"brain", 1046},
+                                         {"spinal_cord", 1075},
+                                         {"lung", 394},
+                                         {"heart", 1081},
+                                         {"atrial_appendage", 1081},
+                                         {"liver", 1079},
+                                         {"spleen", 1089},
+                                         {"kidney", 1066},
+                                         {"stomach", 1088},
+                                         {"small_bowel", 1030},
+                                         {"duodenum", 1030},
+                                         {"colon", 1088},
+                                         {"urinary_bladder", 1086},
+                                         {"prostate", 1045},
+                                         {"pancreas", 1087},
+                                         {"gallbladder", 1071},
+                                         {"adrenal", 1028},
+                                         {"esophagus", 1040},
+                                         {"trachea", 1080},
+                                         {"thyroid", 1050},
+                                         {"aorta", 1102},
+                                         {"vena", 1050},
+                                         {"vein", 1050},
+                                         {"artery", 1050},
+                                         {"trunk", 1050},
+                                         {"intervertebral_disc", 1100},
+                                         {"costal_cartilage", 1100},
+                                         {"eye", 1050},
+                                         {"blood", 1050}};
 constexpr double kCorticalBoneKgM3 = 1908;  // IT'IS "Bone (Cortical)"
 constexpr double kMarrowKgM3 = 1178;        // IT'IS "Bone (Cancellous)"
 constexpr double kSoftTissueKgM3 = 1050;    // when nothing closer is known
 
 double typicalDensity(const std::string& name, bool* known) {
   for (const Density& d : kTypicalDensities)
-    if (name.rfind(d.prefix, 0) == 0 || name.find(std::string("_") + d.prefix) != std::string::npos) {
+    if (name.rfind(d.prefix, 0) == 0 ||
+        name.find(std::string("_") + d.prefix) != std::string::npos) {
       if (known) *known = true;
       return d.kgM3;
     }
@@ -56,9 +84,10 @@ bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-const char* kBoneNames[] = {"none",    "skull",   "mandible", "teeth",   "spine",  "ribs",
-                            "sternum", "clavicle", "scapula", "pelvis",  "humerus", "radius_ulna",
-                            "hand",    "femur",   "patella",  "tibia_fibula", "foot"};
+const char* kBoneNames[] = {"none",         "skull",       "mandible", "teeth",   "spine",
+                            "ribs",         "sternum",     "clavicle", "scapula", "pelvis",
+                            "humerus",      "radius_ulna", "hand",     "femur",   "patella",
+                            "tibia_fibula", "foot"};
 
 BoneKind boneFromName(const std::string& n) {
   for (int k = 0; k < int(sizeof(kBoneNames) / sizeof(*kBoneNames)); ++k)
@@ -81,11 +110,11 @@ std::string nameOf(const Volume& organs, int value) {
 // ---- the generated phantom (Resources/Tissues/phantom.csv names) ----
 bool phantomRole(const std::string& name, LabelRole& r) {
   static const std::map<std::string, BoneKind> bones = {
-      {"skull", BoneKind::Skull},       {"vertebrae", BoneKind::Spine},
-      {"ribs", BoneKind::Ribs},         {"sternum", BoneKind::Sternum},
-      {"pelvis", BoneKind::Pelvis},     {"humerus", BoneKind::Humerus},
+      {"skull", BoneKind::Skull},         {"vertebrae", BoneKind::Spine},
+      {"ribs", BoneKind::Ribs},           {"sternum", BoneKind::Sternum},
+      {"pelvis", BoneKind::Pelvis},       {"humerus", BoneKind::Humerus},
       {"radius_ulna", BoneKind::Forearm}, {"hand_bones", BoneKind::Hand},
-      {"femur", BoneKind::Femur},       {"tibia_fibula", BoneKind::Shank},
+      {"femur", BoneKind::Femur},         {"tibia_fibula", BoneKind::Shank},
       {"foot_bones", BoneKind::Foot}};
   std::string bone = name;
   const bool marrow = endsWith(name, "_marrow");
@@ -103,11 +132,25 @@ bool phantomRole(const std::string& name, LabelRole& r) {
       {"blood_vessels_arms", BodyRegion::Arms},
       {"blood_vessels_legs", BodyRegion::Legs}};
   if (regions.count(name)) r.region = regions.at(name);
-  static const std::set<std::string> soft = {
-      "skin", "subcutaneous_fat", "muscle", "brain", "eye", "lung_left", "lung_right", "heart",
-      "liver", "kidney_left", "kidney_right", "stomach", "spleen", "urinary_bladder",
-      "small_bowel", "spinal_cord", "blood_vessels_trunk", "blood_vessels_arms",
-      "blood_vessels_legs"};
+  static const std::set<std::string> soft = {"skin",
+                                             "subcutaneous_fat",
+                                             "muscle",
+                                             "brain",
+                                             "eye",
+                                             "lung_left",
+                                             "lung_right",
+                                             "heart",
+                                             "liver",
+                                             "kidney_left",
+                                             "kidney_right",
+                                             "stomach",
+                                             "spleen",
+                                             "urinary_bladder",
+                                             "small_bowel",
+                                             "spinal_cord",
+                                             "blood_vessels_trunk",
+                                             "blood_vessels_arms",
+                                             "blood_vessels_legs"};
   if (!soft.count(name)) return false;
   r.densityKgM3 = typicalDensity(name, nullptr);
   return true;
@@ -134,12 +177,24 @@ BoneKind icrpBone(int id) {
 }
 
 const char* icrpBoneName(int id) {
-  static const std::pair<int, const char*> first[] = {
-      {13, "humerus"}, {19, "radius_ulna"}, {22, "hand_bones"}, {24, "clavicles"},
-      {26, "cranium"}, {28, "femur"}, {34, "tibia_fibula_patella"}, {37, "foot_bones"},
-      {39, "mandible"}, {41, "pelvis"}, {43, "ribs"}, {45, "scapulae"}, {47, "cervical_spine"},
-      {49, "thoracic_spine"}, {51, "lumbar_spine"}, {53, "sacrum"}, {55, "sternum"},
-      {57, nullptr}};
+  static const std::pair<int, const char*> first[] = {{13, "humerus"},
+                                                      {19, "radius_ulna"},
+                                                      {22, "hand_bones"},
+                                                      {24, "clavicles"},
+                                                      {26, "cranium"},
+                                                      {28, "femur"},
+                                                      {34, "tibia_fibula_patella"},
+                                                      {37, "foot_bones"},
+                                                      {39, "mandible"},
+                                                      {41, "pelvis"},
+                                                      {43, "ribs"},
+                                                      {45, "scapulae"},
+                                                      {47, "cervical_spine"},
+                                                      {49, "thoracic_spine"},
+                                                      {51, "lumbar_spine"},
+                                                      {53, "sacrum"},
+                                                      {55, "sternum"},
+                                                      {57, nullptr}};
   if (id == 128) return "teeth";
   const char* name = nullptr;
   for (const auto& [from, n] : first)
@@ -154,8 +209,7 @@ LabelConvention icrp110(const Volume& organs, const std::vector<int>& labels) {
   const bool female = has.count(111) || has.count(112) || has.count(139);
   LabelConvention c;
   c.name = std::string("icrp110 (") + (male && !female ? "AM" : "AF") + ")";
-  if (!male && !female)
-    c.notes.push_back("no sex-specific organ found: the AF densities are used");
+  if (!male && !female) c.notes.push_back("no sex-specific organ found: the AF densities are used");
   for (const int v : labels) {
     const rig::IcrpOrgan* organ = nullptr;
     for (const rig::IcrpOrgan& o : rig::kIcrp110Organs)
@@ -188,16 +242,16 @@ bool totalSegmentatorRole(const std::string& name, LabelRole& r) {
   if (endsWith(name, "_left")) side = -1, base = name.substr(0, name.size() - 5);
   if (endsWith(name, "_right")) side = +1, base = name.substr(0, name.size() - 6);
   static const std::map<std::string, BoneKind> bones = {
-      {"skull", BoneKind::Skull},      {"sacrum", BoneKind::Spine},
-      {"vertebrae", BoneKind::Spine},  {"sternum", BoneKind::Sternum},
-      {"clavicula", BoneKind::Clavicle}, {"scapula", BoneKind::Scapula},
-      {"hip", BoneKind::Pelvis},       {"humerus", BoneKind::Humerus},
-      {"radius", BoneKind::Forearm},   {"ulna", BoneKind::Forearm},
-      {"carpal", BoneKind::Hand},      {"metacarpal", BoneKind::Hand},
+      {"skull", BoneKind::Skull},         {"sacrum", BoneKind::Spine},
+      {"vertebrae", BoneKind::Spine},     {"sternum", BoneKind::Sternum},
+      {"clavicula", BoneKind::Clavicle},  {"scapula", BoneKind::Scapula},
+      {"hip", BoneKind::Pelvis},          {"humerus", BoneKind::Humerus},
+      {"radius", BoneKind::Forearm},      {"ulna", BoneKind::Forearm},
+      {"carpal", BoneKind::Hand},         {"metacarpal", BoneKind::Hand},
       {"phalanges_hand", BoneKind::Hand}, {"femur", BoneKind::Femur},
-      {"patella", BoneKind::Patella},  {"tibia", BoneKind::Shank},
-      {"fibula", BoneKind::Shank},     {"tarsal", BoneKind::Foot},
-      {"metatarsal", BoneKind::Foot},  {"phalanges_feet", BoneKind::Foot}};
+      {"patella", BoneKind::Patella},     {"tibia", BoneKind::Shank},
+      {"fibula", BoneKind::Shank},        {"tarsal", BoneKind::Foot},
+      {"metatarsal", BoneKind::Foot},     {"phalanges_feet", BoneKind::Foot}};
   BoneKind bone = BoneKind::None;
   if (bones.count(base)) bone = bones.at(base);
   if (base.rfind("vertebrae_", 0) == 0) bone = BoneKind::Spine;
@@ -208,7 +262,8 @@ bool totalSegmentatorRole(const std::string& name, LabelRole& r) {
     r.bone = bone;
     r.side = side;
     r.rigid = true;
-    r.boneName = base.rfind("vertebrae_", 0) == 0 ? "spine" : (bone == BoneKind::Ribs ? "ribs" : base);
+    r.boneName =
+        base.rfind("vertebrae_", 0) == 0 ? "spine" : (bone == BoneKind::Ribs ? "ribs" : base);
     r.densityKgM3 = kCorticalBoneKgM3;
     r.cervical = base.rfind("vertebrae_C", 0) == 0;
     return true;
@@ -265,9 +320,12 @@ LabelConvention fromCsv(const Volume& organs, const std::string& path,
     for (std::size_t k = 2; k < f.size(); ++k) {
       if (header[k] == "side") {
         const std::string s = lower(f[k]);
-        if (s == "left") r.side = -1;
-        else if (s == "right") r.side = +1;
-        else if (!s.empty()) throw Error(where + "side must be left, right or empty");
+        if (s == "left")
+          r.side = -1;
+        else if (s == "right")
+          r.side = +1;
+        else if (!s.empty())
+          throw Error(where + "side must be left, right or empty");
       } else if (header[k] == "name") {
         if (!f[k].empty()) r.name = f[k];
       } else if (header[k] == "density_kg_m3") {
@@ -317,8 +375,7 @@ int countMatches(const Volume& organs, const std::vector<int>& labels,
 }
 
 LabelConvention byNames(const Volume& organs, const std::vector<int>& labels,
-                        const std::string& name,
-                        bool (*role)(const std::string&, LabelRole&)) {
+                        const std::string& name, bool (*role)(const std::string&, LabelRole&)) {
   LabelConvention c;
   c.name = name;
   std::vector<std::string> unknown;

@@ -35,11 +35,9 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   bool limb = false;
   for (const int side : {-1, 1})
     limb = limb || bones.find(BoneKind::Humerus, side) || bones.find(BoneKind::Femur, side);
-  if (!limb)
-    throw Error(source + ": no humerus or femur found: nothing to rig beyond the torso");
+  if (!limb) throw Error(source + ": no humerus or femur found: nothing to rig beyond the torso");
   out.warnings = bones.frame.warnings;
-  out.warnings.insert(out.warnings.end(), out.convention.notes.begin(),
-                      out.convention.notes.end());
+  out.warnings.insert(out.warnings.end(), out.convention.notes.begin(), out.convention.notes.end());
 
   reportProgress(options.progress, 0.3, "rig: joints");
   const std::vector<rig::FittedJoint> joints = rig::fitJoints(bones, out.missing);
@@ -58,14 +56,14 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   for (const rig::FittedJoint& j : joints) {
     SkeletonJoint s;
     s.name = j.name;
-    s.parent = j.kind == JointKind::Elbow   ? "shoulder" + std::string(j.side < 0 ? "_left" : "_right")
+    s.parent = j.kind == JointKind::Elbow
+                   ? "shoulder" + std::string(j.side < 0 ? "_left" : "_right")
                : j.kind == JointKind::Wrist ? "elbow" + std::string(j.side < 0 ? "_left" : "_right")
                : j.kind == JointKind::Knee  ? "hip" + std::string(j.side < 0 ? "_left" : "_right")
                : j.kind == JointKind::Ankle ? "knee" + std::string(j.side < 0 ? "_left" : "_right")
                                             : "";
-    if (!s.parent.empty() && !std::any_of(joints.begin(), joints.end(), [&](const auto& o) {
-          return o.name == s.parent;
-        }))
+    if (!s.parent.empty() && !std::any_of(joints.begin(), joints.end(),
+                                          [&](const auto& o) { return o.name == s.parent; }))
       s.parent.clear();
     s.centre = j.centre;
     s.axes = jointAxes(j.kind, j.distal, ant, up, j.side, j.palmar);
@@ -89,7 +87,9 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   nlohmann::json bonesJson = nlohmann::json::array();
   for (const auto& [key, b] : bones.byKind)
     bonesJson.push_back({{"bone", boneKindName(b.kind)},
-                         {"side", b.side < 0 ? "left" : b.side > 0 ? "right" : "axial"},
+                         {"side", b.side < 0   ? "left"
+                                  : b.side > 0 ? "right"
+                                               : "axial"},
                          {"voxels", b.voxels.size()},
                          {"length_mm", b.length}});
   nlohmann::json partsJson = nlohmann::json::array();
@@ -105,20 +105,19 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
                              {"volume_ml", double(count[std::size_t(v)]) * ml}});
   }
   nlohmann::json jointsJson = nlohmann::json::parse(skeletonToJson(out.skeleton))["joints"];
-  nlohmann::json report = {
-      {"input", source},
-      {"convention", out.convention.name},
-      {"detection", out.convention.detection},
-      {"body_frame",
-       {{"superior", {up.x(), up.y(), up.z()}},
-        {"anterior", {ant.x(), ant.y(), ant.z()}},
-        {"midline_x_mm", bones.frame.midlineX}}},
-      {"bones", bonesJson},
-      {"joints", jointsJson},
-      {"missing", out.missing},
-      {"warnings", out.warnings},
-      {"parts", partsJson},
-      {"unreached_voxels", stats.unreached}};
+  nlohmann::json report = {{"input", source},
+                           {"convention", out.convention.name},
+                           {"detection", out.convention.detection},
+                           {"body_frame",
+                            {{"superior", {up.x(), up.y(), up.z()}},
+                             {"anterior", {ant.x(), ant.y(), ant.z()}},
+                             {"midline_x_mm", bones.frame.midlineX}}},
+                           {"bones", bonesJson},
+                           {"joints", jointsJson},
+                           {"missing", out.missing},
+                           {"warnings", out.warnings},
+                           {"parts", partsJson},
+                           {"unreached_voxels", stats.unreached}};
   out.reportJson = report.dump();
   out.skeleton.source = "";
   reportProgress(options.progress, 1.0, "rig: done");
@@ -129,7 +128,8 @@ void writeRigFolder(const RigResult& rig, const std::string& folder, const std::
   namespace fs = std::filesystem;
   const fs::path dir = fs::absolute(folder);
   if (!fs::exists(dir.parent_path())) throw Error(folder + ": its parent folder does not exist");
-  if (fs::exists(dir) && !fs::is_directory(dir)) throw Error(folder + ": exists and is not a folder");
+  if (fs::exists(dir) && !fs::is_directory(dir))
+    throw Error(folder + ": exists and is not a folder");
   fs::create_directories(dir);
   for (const char* name : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
     refuseOverwritingInput(input, (dir / name).string());

@@ -126,8 +126,8 @@ Bones findBones(const Volume& organs, const LabelConvention& convention, const G
   std::int64_t axialCount = 0;
   for (const BoneKind k : {BoneKind::Spine, BoneKind::Sternum})
     for (const std::int64_t v : raw[{k, 0}]) axialX += grid.ras(v).x(), ++axialCount;
-  out.frame.midlineX = axialCount ? axialX / double(axialCount)
-                                  : (bodyCount ? bodyX / double(bodyCount) : 0);
+  out.frame.midlineX =
+      axialCount ? axialX / double(axialCount) : (bodyCount ? bodyX / double(bodyCount) : 0);
 
   // Bones whose labels do not tell the side: each 26-connected piece by its side of the midline.
   std::vector<char> seen(std::size_t(grid.count()), 0);
@@ -191,16 +191,18 @@ Bones findBones(const Volume& organs, const LabelConvention& convention, const G
   if (skull && low && (skull->centroid - low->centroid).norm() > 1) {
     f.superior = (skull->centroid - low->centroid).normalized();
     if (f.superior.z() < 0.5)
-      f.warnings.push_back("the skull lies below the pelvis in the file's RAS frame: check its "
-                           "orientation (the joints' left and right follow it)");
+      f.warnings.push_back(
+          "the skull lies below the pelvis in the file's RAS frame: check its "
+          "orientation (the joints' left and right follow it)");
     if (f.superior.z() < 0) f.superior = V::UnitZ();
   }
   f.anterior = (V::UnitY() - V::UnitY().dot(f.superior) * f.superior).normalized();
   if (sternum && spine) {
     const V forward = sternum->centroid - spine->centroid;
     if (forward.dot(f.anterior) < 0)
-      f.warnings.push_back("the sternum lies behind the spine in the file's RAS frame: check its "
-                           "orientation (left and right may be swapped)");
+      f.warnings.push_back(
+          "the sternum lies behind the spine in the file's RAS frame: check its "
+          "orientation (left and right may be swapped)");
   }
   return out;
 }

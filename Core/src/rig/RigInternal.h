@@ -35,9 +35,9 @@ struct Bone {
   int side = 0;
   std::vector<std::int64_t> voxels;
   V centroid = V::Zero();
-  V axis = V::UnitZ();        // principal direction (unit), sign arbitrary until oriented
-  double length = 0;          // extent along the axis (mm)
-  std::vector<V> boundary;    // centres of the bone's outer voxel faces: its surface
+  V axis = V::UnitZ();           // principal direction (unit), sign arbitrary until oriented
+  double length = 0;             // extent along the axis (mm)
+  std::vector<V> boundary;       // centres of the bone's outer voxel faces: its surface
   std::vector<double> faceSize;  // per boundary point: the voxel's size along the face's normal
   V extreme(const V& towards) const;  // the boundary point furthest along `towards`
 };
@@ -65,7 +65,7 @@ struct FittedJoint {
   JointKind kind = JointKind::Neck;
   int side = 0;
   V centre = V::Zero();
-  V distal = V::UnitZ();  // direction of the distal segment, away from the joint
+  V distal = V::UnitZ();       // direction of the distal segment, away from the joint
   V planeNormal = V::UnitZ();  // the cut between the two parts, towards the distal part
   std::optional<V> flexion;    // from the condyles, when they say it
   V palmar = V::Zero();

@@ -93,7 +93,8 @@ EndFit fitEnd(const Bone& bone, const V& tip, const V& inward, double reach, con
   EndFit f;
   std::vector<Surface> pts;
   for (std::size_t i = 0; i < bone.boundary.size(); ++i)
-    if ((bone.boundary[i] - tip).norm() <= reach) pts.push_back({bone.boundary[i], bone.faceSize[i]});
+    if ((bone.boundary[i] - tip).norm() <= reach)
+      pts.push_back({bone.boundary[i], bone.faceSize[i]});
   auto distance = [&](const V& p) {
     if (!axis) return (p - f.centre).norm();
     const V d = p - f.centre;
@@ -167,10 +168,10 @@ V orientedAway(const V& axis, const V& from, const V& to) {
 
 // A hinge (the elbow, the knee): the proximal bone's condyles roll about their line at the
 // joint; the line from the condyles when they say it, else the body's left-right line.
-FittedJoint fitHinge(const Bone& proximal, const V& along, const Bone& distal,
-                     const V& distalAxis, JointKind kind, const V& anterior, const V& superior,
-                     int side, double voxel, double minReach, const std::string& condyleName,
-                     const std::string& boneName, const std::string& partnerName) {
+FittedJoint fitHinge(const Bone& proximal, const V& along, const Bone& distal, const V& distalAxis,
+                     JointKind kind, const V& anterior, const V& superior, int side, double voxel,
+                     double minReach, const std::string& condyleName, const std::string& boneName,
+                     const std::string& partnerName) {
   FittedJoint j;
   const V tip = proximal.extreme(along);
   const double reach = std::max(0.15 * proximal.length, minReach);
@@ -179,14 +180,12 @@ FittedJoint fitHinge(const Bone& proximal, const V& along, const Bone& distal,
   V axis = condyles ? *condyles : flexion;
   if (axis.dot(flexion) < 0) axis = -axis;
   const EndFit e = fitEnd(proximal, tip, -along, reach, &axis, voxel);
-  j.centre = e.ok ? e.centre
-                  : V(0.5 * (proximal.extreme(along) + distal.extreme(-along)));
+  j.centre = e.ok ? e.centre : V(0.5 * (proximal.extreme(along) + distal.extreme(-along)));
   std::ostringstream method;
   if (e.ok)
     method << (condyles ? "roll of the " + condyleName + " about their line"
                         : "roll of the distal " + boneName + " about the body's left-right line")
-           << " (radius " << std::lround(e.radius * 10) / 10.0 << " mm, " << e.points
-           << " points)";
+           << " (radius " << std::lround(e.radius * 10) / 10.0 << " mm, " << e.points << " points)";
   else
     method << "middle of the gap between " << boneName << " and " << partnerName;
   j.method = method.str();
@@ -234,7 +233,8 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
   const Bone* pelvis = bones.find(BoneKind::Pelvis, 0);
   // Where the shoulders hang from: the top of the spine (or the body's top).
   const V spineTop = spine ? spine->extreme(up) : V(f.midlineX, 0, 1e4);
-  const V hipsFrom = pelvis ? pelvis->centroid : (spine ? spine->extreme(-up) : V(f.midlineX, 0, -1e4));
+  const V hipsFrom =
+      pelvis ? pelvis->centroid : (spine ? spine->extreme(-up) : V(f.midlineX, 0, -1e4));
 
   auto add = [&](FittedJoint j, JointKind kind, const std::string& name, int side, int proximal,
                  int distal) {
@@ -307,8 +307,8 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
     }
     if (H && F) {
       uf = orientedAway(F->axis, H->centroid, F->centroid);
-      add(fitHinge(*H, uh, *F, uf, JointKind::Elbow, ant, up, side, voxel, 20.0,
-                   "humeral condyles", "humerus", "forearm bones"),
+      add(fitHinge(*H, uh, *F, uf, JointKind::Elbow, ant, up, side, voxel, 20.0, "humeral condyles",
+                   "humerus", "forearm bones"),
           JointKind::Elbow, "elbow" + sfx, side, partOf(BoneKind::Humerus, side),
           partOf(BoneKind::Forearm, side));
     } else if (H) {
@@ -381,8 +381,7 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
         if ((p - bottom).norm() < best) best = (p - bottom).norm(), tip = p;
       V axis = right;  // the talar dome rolls about the line between the malleoli
       // Only the dome itself: the foot's other bones leave the talus below its centre.
-      const EndFit e =
-          fitEnd(*Ft, tip, ut, std::max(0.1 * T->length, 20.0), &axis, voxel, 0.0);
+      const EndFit e = fitEnd(*Ft, tip, ut, std::max(0.1 * T->length, 20.0), &axis, voxel, 0.0);
       j.centre = e.ok ? e.centre : V(0.5 * (bottom + tip));
       j.method = e.ok ? describeFit("roll of the talar dome about the left-right line", e)
                       : "middle of the gap between tibia and foot bones";
@@ -400,10 +399,21 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
 }
 
 LabelTable rigPartLabels() {
-  static const char* names[] = {"",           "head",         "torso",       "upper_arm_left",
-                                "forearm_left", "hand_left",  "upper_arm_right",
-                                "forearm_right", "hand_right", "thigh_left",  "shank_left",
-                                "foot_left",    "thigh_right", "shank_right", "foot_right"};
+  static const char* names[] = {"",
+                                "head",
+                                "torso",
+                                "upper_arm_left",
+                                "forearm_left",
+                                "hand_left",
+                                "upper_arm_right",
+                                "forearm_right",
+                                "hand_right",
+                                "thigh_left",
+                                "shank_left",
+                                "foot_left",
+                                "thigh_right",
+                                "shank_right",
+                                "foot_right"};
   LabelTable t;
   for (int v = 1; v < 15; ++v) {
     Label l;

@@ -78,7 +78,8 @@ Volume assignParts(const Volume& organs, const LabelConvention& convention, cons
       if constexpr (std::is_integral_v<T>) {
         const T* g = organs.data<T>();
         for (std::int64_t i = 0; i < n; ++i)
-          if (g[i] > 0 && double(g[i]) < 65536) allowed[std::size_t(i)] = byLabel[std::size_t(g[i])];
+          if (g[i] > 0 && double(g[i]) < 65536)
+            allowed[std::size_t(i)] = byLabel[std::size_t(g[i])];
       }
     });
   }

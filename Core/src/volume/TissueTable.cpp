@@ -71,8 +71,8 @@ std::string tissueTableCsv(const TissueTable& table, const std::string& comment)
     for (std::string* s : {&name, &bone})
       for (char& c : *s)
         if (c == ',' || c == '\n' || c == '\r') c = ';';
-    out << label << "," << name << "," << t.densityKgM3 << "," << (t.rigid ? 1 : 0) << ","
-        << bone << "\n";
+    out << label << "," << name << "," << t.densityKgM3 << "," << (t.rigid ? 1 : 0) << "," << bone
+        << "\n";
   }
   return out.str();
 }

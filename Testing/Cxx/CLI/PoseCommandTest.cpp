@@ -17,7 +17,6 @@
 using namespace repose;
 using namespace repose::test;
 
-
 TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   ScratchDir dir("pose");
   const std::string d = shellQuote(dir.path().string());
@@ -77,10 +76,10 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
         for (std::int64_t i = 0; i < G.dims()[0]; ++i)
           ct.data<float>()[ct.index(i, j, k)] = 1000.0f + float(i);
     writeVolume(ct, dir.file("ct.nii.gz"));
-    const CommandResult withImage =
-        runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) + " --image " +
-                                 shellQuote(dir.file("ct.nii.gz")) + " --background -1000 --out " +
-                                 shellQuote(dir.file("img")) + " --json");
+    const CommandResult withImage = runCommand(
+        "repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) + " --image " +
+                      shellQuote(dir.file("ct.nii.gz")) + " --background -1000 --out " +
+                      shellQuote(dir.file("img")) + " --json");
     ASSERT_EQ(withImage.exitCode, 0) << withImage.err;
     const Volume posedCt = readVolume(dir.file("img/posed_image.nii.gz"));
     const Volume posedG = readVolume(dir.file("img/posed_G.nii.gz"));

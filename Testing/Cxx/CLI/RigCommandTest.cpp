@@ -14,7 +14,6 @@
 
 using namespace repose::test;
 
-
 TEST(RigCommand, RigsTheArmsRestingPhantomAndPosesItByNamedJointsWithAutomaticCuts) {
   ScratchDir dir;
   const std::string d = shellQuote(dir.path().string());
@@ -22,9 +21,9 @@ TEST(RigCommand, RigsTheArmsRestingPhantomAndPosesItByNamedJointsWithAutomaticCu
   // Only G goes in: the phantom's own S and skeleton are moved away.
   std::filesystem::rename(dir.file("S.nii.gz"), dir.file("truth_S.nii.gz"));
   std::filesystem::rename(dir.file("skeleton.json"), dir.file("truth_skeleton.json"));
-  const CommandResult rig = runCommand(
-      "repose", "rig --input " + shellQuote(dir.file("G.nii.gz")) + " --out " +
-                    shellQuote(dir.file("rig")) + " --json");
+  const CommandResult rig =
+      runCommand("repose", "rig --input " + shellQuote(dir.file("G.nii.gz")) + " --out " +
+                               shellQuote(dir.file("rig")) + " --json");
   ASSERT_EQ(rig.exitCode, 0) << rig.err;
   for (const char* f : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
     EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("rig/") + f))) << f;
@@ -73,11 +72,11 @@ TEST(RigCommand, SeparationsDrawnByHandPoseTheArmsTouchingPhantom) {
                                      shellQuote(dir.file("rig")))
                 .exitCode,
             0);
-  const CommandResult pose = runCommand(
-      "repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
-                    shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
-                    shellQuote(suitePoseFile("hand_from_hip")) + " --out " + shellQuote(dir.file("out")) +
-                    " --json --no-auto-separate");
+  const CommandResult pose =
+      runCommand("repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                               shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
+                               shellQuote(suitePoseFile("hand_from_hip")) + " --out " +
+                               shellQuote(dir.file("out")) + " --json --no-auto-separate");
   ASSERT_EQ(pose.exitCode, 0) << pose.err;
   const nlohmann::json report = nlohmann::json::parse(pose.out);
   EXPECT_FALSE(report["separations"]["automatic"].get<bool>());
@@ -88,8 +87,7 @@ TEST(RigCommand, SeparationsDrawnByHandPoseTheArmsTouchingPhantom) {
 }
 
 TEST(RigCommand, ASegmentationWithoutLimbBonesIsAOneLineErrorAndWritesNothing) {
-  const std::string seg =
-      std::string(REPOSE_DATA_DIR) + "/totalsegmentator/example_seg.nii.gz";
+  const std::string seg = std::string(REPOSE_DATA_DIR) + "/totalsegmentator/example_seg.nii.gz";
   if (!std::filesystem::exists(seg)) GTEST_SKIP() << seg << " not found";
   ScratchDir dir;
   const CommandResult r = runCommand(

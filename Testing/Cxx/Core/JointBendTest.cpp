@@ -22,8 +22,9 @@ Eigen::Matrix3d jacobian(const Eigen::Vector3d& p, const Eigen::Vector3d& c,
   const double h = 1e-5;
   for (int k = 0; k < 3; ++k) {
     const Eigen::Vector3d dp = Eigen::Vector3d::Unit(k) * h;
-    J.col(k) = (bendPoint(p + dp, c, axis, distal, angle) - bendPoint(p - dp, c, axis, distal, angle)) /
-               (2 * h);
+    J.col(k) =
+        (bendPoint(p + dp, c, axis, distal, angle) - bendPoint(p - dp, c, axis, distal, angle)) /
+        (2 * h);
   }
   return J;
 }

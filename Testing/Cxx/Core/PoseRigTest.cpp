@@ -54,7 +54,9 @@ TEST(PoseRig, BonesAndOrgansOfOnePartMoveWholeButNotTheTissuesThatCrossJoints) {
   const std::vector<int> whole = labelsMovingWhole(r.organs, r.parts, r.settings);
   const std::set<int> set(whole.begin(), whole.end());
   for (const int bone : r.settings.rigidLabels) EXPECT_TRUE(set.count(bone)) << bone;
-  for (const char* organ : {"brain", "urinary_bladder", "liver", "lung_left", "heart"})
+  // Organs clear of the parts' borders. (At 4 mm the brain's base lies on the neck's cut, the
+  // head/torso plane: like a vessel running from the trunk into a limb it bends there.)
+  for (const char* organ : {"urinary_bladder", "liver", "lung_left", "heart"})
     EXPECT_TRUE(set.count(labelNamed(r.organs, organ))) << organ;
   for (const char* crossing : {"skin", "subcutaneous_fat", "muscle"})
     EXPECT_FALSE(set.count(labelNamed(r.organs, crossing))) << crossing;
@@ -90,8 +92,8 @@ TEST(PoseRig, BonesAndOrgansOfOnePartMoveWholeButNotTheTissuesThatCrossJoints) {
     }
   // The phantom's joints are congruent with a cartilage gap, so its bones need no seam; where
   // bones of two parts do touch (a segmentation without the gap), one is cut on each side.
-  VolumeGeometry tiny = VolumeGeometry::make({6, 3, 3}, Eigen::Vector3d::Ones(),
-                                             Eigen::Vector3d::Zero());
+  VolumeGeometry tiny =
+      VolumeGeometry::make({6, 3, 3}, Eigen::Vector3d::Ones(), Eigen::Vector3d::Zero());
   Volume g(tiny, ScalarType::UInt8), s(tiny, ScalarType::UInt8);
   for (std::int64_t i = 0; i < 6; ++i)
     for (std::int64_t j = 0; j < 3; ++j)

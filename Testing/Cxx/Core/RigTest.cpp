@@ -27,7 +27,9 @@ struct Variant {
   PhantomLabelling labels;
 };
 
-void PrintTo(const Variant& v, std::ostream* os) { *os << v.name; }
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.name;
+}
 
 class RigPhantom : public ::testing::TestWithParam<Variant> {};
 
@@ -89,8 +91,7 @@ INSTANTIATE_TEST_SUITE_P(
         Variant{"arms_resting_2mm", Eigen::Vector3d(2, 2, 2), true, PhantomLabelling::Phantom},
         Variant{"arms_resting_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true,
                 PhantomLabelling::Phantom},
-        Variant{"icrp110_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true,
-                PhantomLabelling::Icrp110}),
+        Variant{"icrp110_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true, PhantomLabelling::Icrp110}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(Rig, ACsvConventionGivesThePhantomsRig) {
@@ -107,7 +108,10 @@ TEST(Rig, ACsvConventionGivesThePhantomsRig) {
   for (const auto& [value, role] : builtIn.convention.roles)
     if (role.bone != BoneKind::None)
       csv << value << "," << boneKindName(role.bone) << ","
-          << (role.side < 0 ? "left" : role.side > 0 ? "right" : "") << "," << role.name << "\n";
+          << (role.side < 0   ? "left"
+              : role.side > 0 ? "right"
+                              : "")
+          << "," << role.name << "\n";
   csv.close();
   RigOptions ro;
   ro.labels = dir.file("bones.csv");
@@ -143,8 +147,7 @@ TEST(Rig, ABodyWithoutArmsIsRiggedForItsLegsAndSaysSo) {
     EXPECT_NE(legs.skeleton.find(j), nullptr) << j;
   EXPECT_EQ(legs.skeleton.find("elbow_left"), nullptr);
   bool said = false;
-  for (const std::string& m : legs.missing)
-    said = said || m.find("humerus") != std::string::npos;
+  for (const std::string& m : legs.missing) said = said || m.find("humerus") != std::string::npos;
   EXPECT_TRUE(said) << "no line names the missing humerus";
 }
 

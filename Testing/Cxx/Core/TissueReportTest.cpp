@@ -29,15 +29,17 @@ TEST(TissueTable, ThePhantomTableNamesEveryPhantomLabelWithBonesRigid) {
 }
 
 TEST(TissueTable, TheBoneColumnIsOptionalAndRoundTrips) {
-  const TissueTable four = parseTissueTable("label,name,density_kg_m3,rigid\n4,skull,1908,1\n", "a");
+  const TissueTable four =
+      parseTissueTable("label,name,density_kg_m3,rigid\n4,skull,1908,1\n", "a");
   EXPECT_EQ(four.at(4).boneName(), "skull");
-  const TissueTable five =
-      parseTissueTable("label,name,density_kg_m3,rigid,bone\n13,cortex,1920,1,humerus\n"
-                       "14,spongiosa,1185,1,humerus\n2,fat,911,0,\n",
-                       "b");
+  const TissueTable five = parseTissueTable(
+      "label,name,density_kg_m3,rigid,bone\n13,cortex,1920,1,humerus\n"
+      "14,spongiosa,1185,1,humerus\n2,fat,911,0,\n",
+      "b");
   EXPECT_EQ(five.at(14).boneName(), "humerus");
   EXPECT_EQ(five.at(2).bone, "");
-  const TissueTable again = parseTissueTable(tissueTableCsv(five, "a comment\nover two lines"), "c");
+  const TissueTable again =
+      parseTissueTable(tissueTableCsv(five, "a comment\nover two lines"), "c");
   EXPECT_EQ(tissueTableCsv(again), tissueTableCsv(five));
   EXPECT_THROW(parseTissueTable("label,name,density_kg_m3,rigid,b\n", "d"), Error);
 }

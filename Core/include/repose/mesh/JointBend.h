@@ -74,7 +74,7 @@ class JointBends {
 // `distal`. Public for tests.
 // `share` (optional) receives the point's share of the turn, s(phi).
 Eigen::Vector3d bendPoint(const Eigen::Vector3d& p, const Eigen::Vector3d& centre,
-                          const Eigen::Vector3d& axis, const Eigen::Vector3d& distal,
-                          double angle, double* share = nullptr);
+                          const Eigen::Vector3d& axis, const Eigen::Vector3d& distal, double angle,
+                          double* share = nullptr);
 
 }  // namespace repose

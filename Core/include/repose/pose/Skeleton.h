@@ -15,8 +15,8 @@
 namespace repose {
 
 struct SkeletonJoint {
-  std::string name;    // e.g. "elbow_left"
-  std::string parent;  // "" for the root
+  std::string name;                                  // e.g. "elbow_left"
+  std::string parent;                                // "" for the root
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // RAS mm
   // Unit vectors in RAS, right-handed: a positive angle about "flexion" flexes the joint (the
   // elbow bends the forearm forward, the knee the shank backward, the hip the thigh forward);
@@ -29,7 +29,7 @@ struct SkeletonJoint {
   // contact between them is a contact (an arm resting on the trunk), which automatic separation
   // cuts. 0 when not known.
   double radiusMm = 0;
-  std::string method;  // how the centre was found ("phantom", "sphere fit: humeral head", ...)
+  std::string method;    // how the centre was found ("phantom", "sphere fit: humeral head", ...)
   double fitRmsMm = -1;  // residual of the fit, -1 when none
 
   const Eigen::Vector3d* axis(const std::string& axisName) const;
@@ -54,7 +54,8 @@ Skeleton parseSkeleton(const std::string& jsonText, const std::string& source);
 Skeleton readSkeleton(const std::string& path);
 // `extra` (a JSON object's text, or "") adds top-level fields (what made the skeleton).
 std::string skeletonToJson(const Skeleton& skeleton, const std::string& extra = "");
-void writeSkeleton(const Skeleton& skeleton, const std::string& path, const std::string& extra = "");
+void writeSkeleton(const Skeleton& skeleton, const std::string& path,
+                   const std::string& extra = "");
 
 // The skeleton that belongs to a body-part map: "skeleton.json" in S's folder, or
 // "<prefix>skeleton.json" for S named "<prefix>S.<ext>" (as `repose phantom --prefix` writes).

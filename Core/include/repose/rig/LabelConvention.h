@@ -16,22 +16,22 @@ namespace repose {
 // The bones the rig knows. Each moves with one body part.
 enum class BoneKind {
   None,
-  Skull,     // cranium; with the mandible and teeth: the head
+  Skull,  // cranium; with the mandible and teeth: the head
   Mandible,
   Teeth,
-  Spine,     // cervical to sacrum: the torso
+  Spine,  // cervical to sacrum: the torso
   Ribs,
   Sternum,
   Clavicle,
   Scapula,
   Pelvis,
-  Humerus,   // upper arm
-  Forearm,   // radius and ulna
-  Hand,      // carpals, metacarpals, phalanges
-  Femur,     // thigh
-  Patella,   // with the tibia: the shank (ICRP puts patellae with the tibiae)
-  Shank,     // tibia and fibula
-  Foot       // tarsals, metatarsals, phalanges
+  Humerus,  // upper arm
+  Forearm,  // radius and ulna
+  Hand,     // carpals, metacarpals, phalanges
+  Femur,    // thigh
+  Patella,  // with the tibia: the shank (ICRP puts patellae with the tibiae)
+  Shank,    // tibia and fibula
+  Foot      // tarsals, metatarsals, phalanges
 };
 const char* boneKindName(BoneKind kind);
 
@@ -44,13 +44,13 @@ struct LabelRole {
   BodyRegion region = BodyRegion::Unknown;  // for region-split soft tissue
   bool rigid = false;                       // bone tissue: moves as a rigid copy
   double densityKgM3 = 1050;
-  std::string boneName;  // the bone this label is part of ("humerus"), for the tissue table
+  std::string boneName;   // the bone this label is part of ("humerus"), for the tissue table
   bool cervical = false;  // spine labels of the neck (the neck joint is at their top)
 };
 
 struct LabelConvention {
-  std::string name;       // "phantom", "icrp110 (AF)", "totalsegmentator", "FILE.csv"
-  std::string detection;  // how it was chosen (for the report)
+  std::string name;                // "phantom", "icrp110 (AF)", "totalsegmentator", "FILE.csv"
+  std::string detection;           // how it was chosen (for the report)
   std::map<int, LabelRole> roles;  // per label value present in G
   std::vector<std::string> notes;  // labels it did not know, density sources
 };
