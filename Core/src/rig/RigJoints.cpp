@@ -284,6 +284,21 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
     const Bone* T = bones.find(BoneKind::Shank, side);
     const Bone* Ft = bones.find(BoneKind::Foot, side);
 
+    // A ball joint at a long bone's proximal end (shoulder, hip): a sphere fit of its head over
+    // `reach` of its length, else a point just inside the end.
+    auto ballJoint = [&](const Bone& b, const V& u, double reach, const std::string& head,
+                         const std::string& bone) {
+      FittedJoint j;
+      const V tip = b.extreme(-u);
+      const EndFit e = fitEnd(b, tip, u, reach * b.length, nullptr, voxel);
+      j.centre = e.ok ? e.centre : V(tip + 0.05 * b.length * u);
+      j.method = e.ok ? describeFit(("sphere fit of the " + head).c_str(), e)
+                      : "the " + bone + "'s proximal end (the head could not be fitted)";
+      j.rms = e.ok ? e.rms : -1;
+      j.distal = u;
+      return j;
+    };
+
     // ---- the arm ----
     V uh = V::Zero(), uf = V::Zero();
     if (H) {
@@ -291,14 +306,7 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
       uh = F ? orientedAway(H->axis, H->centroid, F->centroid)
              : orientedAway(H->axis, spineTop, H->centroid);
       if (!F && (H->extreme(uh) - spineTop).norm() < (H->extreme(-uh) - spineTop).norm()) uh = -uh;
-      FittedJoint j;
-      const V tip = H->extreme(-uh);
-      const EndFit e = fitEnd(*H, tip, uh, 0.25 * H->length, nullptr, voxel);
-      j.centre = e.ok ? e.centre : V(tip + 0.05 * H->length * uh);
-      j.method = e.ok ? describeFit("sphere fit of the humeral head", e)
-                      : "the humerus's proximal end (the head could not be fitted)";
-      j.rms = e.ok ? e.rms : -1;
-      j.distal = uh;
+      FittedJoint j = ballJoint(*H, uh, 0.25, "humeral head", "humerus");
       j.planeNormal = uh;
       add(j, JointKind::Shoulder, "shoulder" + sfx, side, 2, partOf(BoneKind::Humerus, side));
     } else {
@@ -345,14 +353,7 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
     if (Fe) {
       ufe = T ? orientedAway(Fe->axis, Fe->centroid, T->centroid)
               : orientedAway(Fe->axis, hipsFrom, Fe->centroid);
-      FittedJoint j;
-      const V tip = Fe->extreme(-ufe);
-      const EndFit e = fitEnd(*Fe, tip, ufe, 0.2 * Fe->length, nullptr, voxel);
-      j.centre = e.ok ? e.centre : V(tip + 0.05 * Fe->length * ufe);
-      j.method = e.ok ? describeFit("sphere fit of the femoral head", e)
-                      : "the femur's proximal end (the head could not be fitted)";
-      j.rms = e.ok ? e.rms : -1;
-      j.distal = ufe;
+      FittedJoint j = ballJoint(*Fe, ufe, 0.2, "femoral head", "femur");
       // The groin runs obliquely, 30 degrees lower towards the crotch than at the hip's side.
       const V inward = (medial - medial.dot(ufe) * ufe).normalized();
       j.planeNormal = (std::cos(kPi / 6) * ufe - std::sin(kPi / 6) * inward).normalized();
