@@ -5,6 +5,12 @@
 #include "repose/util/Error.h"
 
 #include <CGAL/Complex_2_in_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Delaunay_triangulation_cell_base_with_circumcenter_3.h>
+#include <CGAL/Robust_circumcenter_traits_3.h>
+#include <CGAL/Surface_mesh_cell_base_3.h>
+#include <CGAL/Surface_mesh_vertex_base_3.h>
+#include <CGAL/Triangulation_data_structure_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
 #include <CGAL/Implicit_surface_3.h>
@@ -13,7 +19,6 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_default_criteria_3.h>
-#include <CGAL/Surface_mesh_default_triangulation_3.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_filter.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Bounded_normal_change_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Count_stop_predicate.h>
@@ -68,9 +73,38 @@ TriangleMesh fromCgal(const Mesh& m) {
   return out;
 }
 
+// Time stamps on the triangulation's vertices and cells. Without them CGAL orders its handles
+// (the mesher's queue of bad facets, the complex's edge map) by memory address, so the same field
+// gave different cages whenever the allocator placed blocks differently (AddressSanitizer's
+// allocator with address-space randomization does): with them handles compare by creation order
+// and the cage depends on the input alone.
+template <class Base>
+class Stamped : public Base {
+ public:
+  using Has_timestamp = CGAL::Tag_true;
+  template <class Tds>
+  struct Rebind_TDS {
+    using Other = Stamped<typename Base::template Rebind_TDS<Tds>::Other>;
+  };
+  using Base::Base;
+  std::size_t time_stamp() const { return stamp_; }
+  void set_time_stamp(const std::size_t& stamp) { stamp_ = stamp; }
+
+ private:
+  std::size_t stamp_ = std::size_t(-1);
+};
+
+// CGAL's Surface_mesh_default_triangulation_3 with stamped vertices and cells.
+using MesherTraits = CGAL::Robust_circumcenter_traits_3<Kernel>;
+using MesherTds = CGAL::Triangulation_data_structure_3<
+    Stamped<CGAL::Surface_mesh_vertex_base_3<MesherTraits>>,
+    Stamped<CGAL::Delaunay_triangulation_cell_base_with_circumcenter_3<
+        MesherTraits, CGAL::Surface_mesh_cell_base_3<MesherTraits>>>>;
+using MesherTriangulation = CGAL::Delaunay_triangulation_3<MesherTraits, MesherTds>;
+
 // Field value at a point of the mesher's space, which is the grid's millimetre frame.
 struct FieldFunction {
-  using GT = CGAL::Surface_mesh_default_triangulation_3::Geom_traits;
+  using GT = MesherTriangulation::Geom_traits;
   const CageField* field;
   GT::FT operator()(const GT::Point_3& p) const {
     return field->at(Eigen::Vector3d(p.x(), p.y(), p.z()));
@@ -81,7 +115,7 @@ struct FieldFunction {
 
 TriangleMesh meshZeroLevelSet(const CageField& field, double facetRadiusMm,
                               double approximationMm) {
-  using Tr = CGAL::Surface_mesh_default_triangulation_3;
+  using Tr = MesherTriangulation;
   using C2t3 = CGAL::Complex_2_in_triangulation_3<Tr>;
   using GT = Tr::Geom_traits;
   using Surface = CGAL::Implicit_surface_3<GT, FieldFunction>;
