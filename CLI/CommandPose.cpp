@@ -98,12 +98,17 @@ int runPose(const Args& args) {
 
   // Everything that can be refused is checked before the work.
   Pose pose = readPoseFile(p.get("pose"));
-  const std::optional<Skeleton> skeleton = skeletonFor(p.get("parts"), p.get("skeleton"));
+  PoseJobRequest request;
+  request.organsName = p.get("input");
+  request.partsPath = p.get("parts");
+  if (p.has("image")) request.imageName = p.get("image");
+  request.tissuesPath = p.has("tissues") ? p.get("tissues") : "";
+  // Read first, so a bad skeleton file is refused before the volumes are read.
+  request.skeleton = skeletonFor(p.get("parts"), p.get("skeleton"));
+  request.jointRings = static_cast<int>(p.getInt("joint-rings"));
+  request.autoSeparate = !p.has("no-auto-separate");
   const double spacingMm = p.getDouble("spacing-mm");
   if (!(spacingMm >= 0)) throw UsageError{"--spacing-mm must be >= 0"};
-  const int jointRings = static_cast<int>(p.getInt("joint-rings")) >= 0
-                             ? static_cast<int>(p.getInt("joint-rings"))
-                             : pose.jointRings;
   const std::string outDir = p.get("out");
   for (const char* in : {"input", "parts", "image", "pose"})
     if (p.has(in) && fs::exists(p.get(in)) && fs::exists(outDir) &&
@@ -113,7 +118,7 @@ int runPose(const Args& args) {
     throw Error(outDir + ": its parent folder does not exist");
   const double budget = parseMemoryBudget(p.get("memory"));
   const int threads = static_cast<int>(p.getInt("threads"));
-  RigSettings rs;
+  RigSettings& rs = request.settings;
   rs.cageVertices = static_cast<int>(p.getInt("cage-vertices"));
   rs.dilateMm = p.getDouble("dilate-mm");
   rs.meshMm = p.getDouble("mesh-mm");
@@ -131,38 +136,18 @@ int runPose(const Args& args) {
   requirePoseableLabels(parts, p.get("parts"));
   warnUnnamedLabels(organs, p.get("input"), "pose");
   warnUnnamedLabels(parts, p.get("parts"), "pose");
-  if (parts.dims() != organs.dims() ||
-      !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
-    throw Error(p.get("parts") + ": not on the grid of " + p.get("input"));
-  // The joints a pose names are those of this body's skeleton.
-  resolveJointsWith(pose, skeleton ? &*skeleton : nullptr, p.get("parts"));
   std::optional<Volume> image;
-  if (p.has("image")) {
-    image = readVolume(p.get("image"), readOptionsWithin(budget, !quiet));
-    if (image->dims() != organs.dims())
-      throw Error(p.get("image") + ": not on the grid of " + p.get("input"));
-  }
-  const TissueChoice tissueChoice =
-      chooseTissues(organs, p.has("tissues") ? p.get("tissues") : "", p.get("parts"));
-  if (!tissueChoice.warning.empty())
-    std::cerr << "repose pose: warning: " << tissueChoice.warning << "\n";
-  const std::optional<TissueTable>& tissues = tissueChoice.table;
-  // Bones are meshed as rigid pieces when the tissue table says which labels they are.
-  if (tissues) rs.rigidLabels = rigidLabelsOf(*tissues);
-  // The pose's separations and, unless turned off, the contacts between parts that move apart.
-  const PoseSeparations cuts =
-      poseSeparations(pose, parts, skeleton ? &*skeleton : nullptr, !p.has("no-auto-separate"));
-  for (const std::string& why : cuts.automatic.skipped)
-    std::cerr << "repose pose: warning: not separated: " << why << "\n";
-  for (const ContactSeparation& c : cuts.automatic.made)
+  if (p.has("image")) image = readVolume(p.get("image"), readOptionsWithin(budget, !quiet));
+  // The job's policy (Core): tissues, skeleton and joints, separations, how the rig is built.
+  const PoseJob job(std::move(pose), organs, parts, std::move(request), image ? &*image : nullptr);
+  for (const std::string& line : job.warnings())
+    std::cerr << "repose pose: warning: " << line << "\n";
+  for (const ContactSeparation& c : job.separations().automatic.made)
     say("separating " + c.names[0] + " from " + c.names[1] + " where they touch (" +
         std::to_string(c.contactVoxels) + " contact voxels" +
         (c.joint.empty() ? std::string() : ", outside the " + c.joint + " joint") + ")");
-  const std::vector<LimbSeparation>& separations = cuts.all;
-  // Finer tets where the pose bends.
-  rs.refineJoints = jointRefinements(pose, parts, skeleton ? &*skeleton : nullptr);
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
-  const std::string key = sceneRigKey(p.get("parts"), separations, rs);
+  const std::string key = job.sceneKey();
   std::optional<RigGeometry> fromScene;
   if (p.has("scene")) fromScene = readSceneRig(p.get("scene"), key);
   const bool reused = fromScene.has_value();
@@ -172,25 +157,22 @@ int runPose(const Args& args) {
     say("reusing the cage and transfer mesh of " + p.get("scene"));
   } else {
     say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
-    geometry = buildRigGeometry(parts, separations, rs, quiet ? ProgressFn{} : terminalProgress(),
-                                &organs);
+    geometry = job.buildGeometry(quiet ? ProgressFn{} : terminalProgress());
   }
   say("embedding the mesh in the cage");
-  const PoseRig rig(std::move(geometry), pose, parts.labels(), threads, jointRings,
-                    bendJoints(skeleton ? &*skeleton : nullptr, parts.labels()));
+  const std::unique_ptr<PoseRig> rigHolder = job.makeRig(std::move(geometry), threads);
+  const PoseRig& rig = *rigHolder;
   if (p.has("scene") && !reused)
     writeSceneFolder(p.get("scene"), rig, key,
-                     {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""}, rs);
+                     {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""},
+                     job.settings());
   const bool oneFrame = rig.frameCount() == 1;
   fs::create_directories(outDir);
-  PoseFrameOptions fo;
+  PoseFrameOptions fo = job.frameOptions();
   fo.image = image ? &*image : nullptr;
   fo.background = p.getDouble("background");
-  fo.tissues = tissues ? &*tissues : nullptr;
-  fo.tissueTableName = tissueChoice.name;
   fo.spacingMm = spacingMm;
   fo.fillPockets = !p.has("keep-pockets");
-  fo.threads = threads;
   json summary = json::array();
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {
     const std::string frameName = rig.frameName(index);
@@ -207,14 +189,14 @@ int runPose(const Args& args) {
           std::to_string(grid.dims[1]) + " x " + std::to_string(grid.dims[2]) + " voxels");
     };
     fo.progress = quiet ? ProgressFn{} : terminalProgress();
+    // What a pose can do wrong (the body volume the posed mesh predicts, bones run into each
+    // other, folds), said on stderr as soon as it is known (stdout may be JSON).
+    fo.warn = [&](const std::string& line) {
+      std::cerr << "repose pose: warning: frame " << frameName << ": " << line << std::endl;
+    };
     PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
-    json report = json::parse(posed.reportJson);
-    report["input"] = p.get("input");
-    report["scene_reused"] = reused;
-    report["joint_rings"] = jointRings;
-    report["separations"] = json::parse(cuts.reportJson());
-    report["skeleton"] = skeleton ? json(skeleton->source) : json();
-    posed.reportJson = report.dump();
+    posed.reportJson = job.completeReport(posed.reportJson, reused);
+    const json report = json::parse(posed.reportJson);
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
     writePosedFrame(posed, dir.string());
     const json& q = report["quality"];
@@ -226,19 +208,6 @@ int runPose(const Args& args) {
              : std::string()) +
         "; quality targets " + (q["all_met"].get<bool>() ? "met" : "NOT all met") + " -> " +
         (dir / "report.json").string());
-    // What a drag or a pose can do wrong, said on stderr (stdout may be JSON): folds, body parts
-    // the cage cannot reach, labels gone (docs/RELIABILITY.md, degenerate geometry).
-    const auto warn = [&](std::int64_t n, const std::string& what) {
-      if (n > 0)
-        std::cerr << "repose pose: warning: frame " << frameName << ": " << n << " " << what
-                  << "\n";
-    };
-    warn(report["mesh"]["inverted_tets"].get<std::int64_t>(),
-         "tets turned inside out (the pose folds the body there; overlapping tissue is resolved "
-         "bone first)");
-    warn(report["mesh"]["unreachable_vertices_left_at_rest"].get<std::int64_t>(),
-         "mesh vertices in parts with no vertex inside the cage, left at rest");
-    warn(report["labels_lost"].get<std::int64_t>(), "labels vanished from the output");
     summary.push_back(report);
   }
   const double seconds =

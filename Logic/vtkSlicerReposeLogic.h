@@ -21,7 +21,8 @@
 #include <vector>
 
 namespace repose {
-struct RigSettings;
+class PoseJob;
+struct Pose;
 class Volume;
 }  // namespace repose
 class vtkMRMLReposeCageNode;
@@ -213,7 +214,13 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   void OnParameterNodeModified();
   void OnLivePoseModified();
   void ReleaseLivePose();  // StopLivePose without the ModifiedEvent
-  repose::RigSettings RigSettingsFor(const repose::Volume& G) const;
+  // The pose job of a segmentation (Core's policy, as `repose pose` and Python use it): its
+  // tissue table, skeleton and joints, separations, the rig's settings from the parameter node.
+  // G and S must outlive it.
+  std::shared_ptr<const repose::PoseJob> PoseJobFor(vtkMRMLReposeSegmentationNode* seg,
+                                                    const repose::Pose& pose,
+                                                    const repose::Volume& G,
+                                                    const repose::Volume& S) const;
   // S's file as the parameter node names it ("" without one): where a tissue table from
   // `repose rig` is looked for.
   std::string PartsPath() const;

@@ -29,6 +29,9 @@ PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose);
 // The segmentation's skeleton (its SkeletonJSON), or none.
 std::optional<repose::Skeleton> SkeletonOf(vtkMRMLReposeSegmentationNode* seg);
 
+// S of a segmentation, or the body mask of G (label 1 where G is not 0) when it has none.
+repose::Volume PartsOf(vtkMRMLReposeSegmentationNode* seg);
+
 // S's label table, or the one-label table of the body mask when the segmentation has no S.
 repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg);
 

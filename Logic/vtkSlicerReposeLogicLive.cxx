@@ -12,6 +12,7 @@
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
+#include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseRig.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/util/Error.h>
@@ -117,10 +118,15 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
         vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()),
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(nodes.TransferMesh->GetMesh())};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    // The joints bend live as they do in the export and in `repose pose` (Core's pose job).
+    auto S = std::make_shared<const repose::Volume>(
+        vtkSlicerReposeLogicInputs::PartsOf(nodes.Segmentation));
+    const std::shared_ptr<const repose::PoseJob> job =
+        this->PoseJobFor(nodes.Segmentation, pose, *G, *S);
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(
         "live pose",
-        [=, geometry = std::move(geometry)](
+        [=, S = S, geometry = std::move(geometry)](
             const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
           repose::reportProgress(progress, 0, "embedding");
           auto session = std::make_shared<LiveSession>();
@@ -130,8 +136,7 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
             imageWindow(*image, session->ImageBackground, session->ImageWindow,
                         session->ImageLevel);
           }
-          session->Rig =
-              std::make_shared<const repose::PoseRig>(std::move(geometry), pose, partLabels);
+          session->Rig = std::shared_ptr<const repose::PoseRig>(job->makeRig(std::move(geometry)));
           session->PartLabels = partLabels;
           session->OuterFaces = repose::outerFaces(session->Rig->mesh());
           session->Cage = vtkSlicerReposeMeshConversion::ToPolyData(session->Rig->cage());

@@ -49,28 +49,6 @@ std::string stemOf(const std::string& path) {
   return name;
 }
 
-// Densities and rigid tissues: the table set, else the one `repose rig` wrote beside S, else the
-// phantom's when G's labels are the phantom's (Core's pose-job policy, as `repose pose` does).
-repose::TissueChoice tissuesFor(const std::string& path, const repose::Volume& G,
-                                const std::string& partsPath) {
-  return repose::chooseTissues(G, path, partsPath);
-}
-
-// S of a segmentation node, or the body mask of G (label 1 where G is not 0) when it has none.
-repose::Volume partsOf(vtkMRMLReposeSegmentationNode* seg) {
-  if (seg->GetBodyPartMap()) return Conversion::FromImageData(seg->GetBodyPartMap());
-  const repose::Volume G = Conversion::FromImageData(seg->GetLabelMap());
-  repose::Volume mask(G.geometry(), repose::ScalarType::UInt8);
-  repose::dispatchScalar(G.scalarType(), [&](auto* tag) {
-    using T = std::remove_pointer_t<decltype(tag)>;
-    for (std::int64_t v = 0; v < G.numVoxels(); ++v)
-      mask.data<std::uint8_t>()[v] = G.data<T>()[v] != 0;
-  });
-  mask.labels() = vtkSlicerReposeLogicInputs::BodyPartLabels(seg);
-  mask.setLabelMap(true);
-  return mask;
-}
-
 std::string readText(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw repose::Error(path + ": cannot open");
@@ -82,6 +60,20 @@ std::string readText(const std::string& path) {
 }  // namespace
 
 namespace vtkSlicerReposeLogicInputs {
+
+repose::Volume PartsOf(vtkMRMLReposeSegmentationNode* seg) {
+  if (seg->GetBodyPartMap()) return Conversion::FromImageData(seg->GetBodyPartMap());
+  const repose::Volume G = Conversion::FromImageData(seg->GetLabelMap());
+  repose::Volume mask(G.geometry(), repose::ScalarType::UInt8);
+  repose::dispatchScalar(G.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    for (std::int64_t v = 0; v < G.numVoxels(); ++v)
+      mask.data<std::uint8_t>()[v] = G.data<T>()[v] != 0;
+  });
+  mask.labels() = BodyPartLabels(seg);
+  mask.setLabelMap(true);
+  return mask;
+}
 
 PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose) {
   if (!pose) throw repose::Error("no pose");
@@ -196,54 +188,53 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
     if (!seg || !seg->GetLabelMap() || !poseNode)
       throw repose::Error("building the rig needs a segmentation with a label map and a pose");
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
-    auto parts = std::make_shared<repose::Volume>(partsOf(seg));
+    auto parts = std::make_shared<repose::Volume>(vtkSlicerReposeLogicInputs::PartsOf(seg));
     auto G = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
-    repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
-    const std::optional<repose::Skeleton> skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
-    if (repose::poseNamesJoints(pose)) {
-      if (!skeleton)
-        throw repose::Error("pose " + poseNode->GetName() + " names joints, but segmentation " +
-                            seg->GetName() + " has no skeleton (skeleton.json beside its S)");
-      repose::resolvePoseJoints(pose, *skeleton);
+    const repose::Pose named = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
+    if (repose::poseNamesJoints(named) && !vtkSlicerReposeLogicInputs::SkeletonOf(seg))
+      throw repose::Error("pose " + poseNode->GetName() + " names joints, but segmentation " +
+                          seg->GetName() + " has no skeleton (skeleton.json beside its S)");
+    // The job decides what `repose pose` decides: joints, separations (the pose's and the
+    // automatic ones), whole pieces, the joints' finer tets.
+    const std::shared_ptr<const repose::PoseJob> job = this->PoseJobFor(seg, named, *G, *parts);
+    const repose::Pose pose = job->pose();
+    if (repose::poseNamesJoints(named))
       poseNode->SetPoseJSON(repose::poseToJson(pose));  // the rig's pose, in numbers
-    }
-    // The pose's separations and the automatic ones: parts moving apart are cut where they touch.
-    const std::vector<repose::LimbSeparation> separations =
-        repose::poseSeparations(pose, *parts, skeleton ? &*skeleton : nullptr, true).all;
-    const repose::RigSettings settings = this->RigSettingsFor(*G);
+    const repose::RigSettings settings = job->settings();
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
-    this->Job->Start("rig", [=](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
-      auto geometry = std::make_shared<repose::RigGeometry>(
-          repose::buildRigGeometry(*parts, separations, settings, progress, G.get()));
-      auto handles = std::make_shared<std::vector<repose::RigidHandle>>(
-          repose::resolveHandles(pose, geometry->cage, geometry->mesh, parts->labels()));
-      return [=] {
-        auto cage = vtkSmartPointer<vtkMRMLReposeCageNode>::New();
-        cage->SetName(segRef->GetName() + " cage");
-        cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(geometry->cage));
-        cage->SetTargetVertexCount(settings.cageVertices);
-        cage->SetDilationMm(settings.dilateMm);
-        std::vector<vtkMRMLReposeCageNode::HandleGroup> groups;
-        for (std::size_t g = 0; g < handles->size(); ++g)
-          groups.push_back({pose.groups[g].name, (*handles)[g].cageVertices});
-        cage->SetHandleGroups(groups);
-        cage->SetNodeReferenceID("segmentation", segRef->GetID());
-        auto mesh = vtkSmartPointer<vtkMRMLReposeTransferMeshNode>::New();
-        mesh->SetName(segRef->GetName() + " transfer mesh");
-        mesh->SetMesh(vtkSlicerReposeMeshConversion::ToUnstructuredGrid(geometry->mesh));
-        mesh->SetSizeMm(settings.meshMm);
-        this->Scene->AddNode(cage);
-        mesh->SetNodeReferenceID("segmentation", segRef->GetID());
-        mesh->SetNodeReferenceID("cage", cage->GetID());
-        this->Scene->AddNode(mesh);
-        const int state = poseRef->StartModify();
-        poseRef->SetNodeReferenceID("segmentation", segRef->GetID());
-        poseRef->SetNodeReferenceID("cage", cage->GetID());
-        poseRef->SetNodeReferenceID("transfer_mesh", mesh->GetID());
-        poseRef->EndModify(state);
-      };
-    });
+    // The job holds G and S: the worker keeps them alive while it builds.
+    this->Job->Start(
+        "rig", [=, G = G](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
+          auto geometry = std::make_shared<repose::RigGeometry>(job->buildGeometry(progress));
+          auto handles = std::make_shared<std::vector<repose::RigidHandle>>(
+              repose::resolveHandles(pose, geometry->cage, geometry->mesh, parts->labels()));
+          return [=] {
+            auto cage = vtkSmartPointer<vtkMRMLReposeCageNode>::New();
+            cage->SetName(segRef->GetName() + " cage");
+            cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(geometry->cage));
+            cage->SetTargetVertexCount(settings.cageVertices);
+            cage->SetDilationMm(settings.dilateMm);
+            std::vector<vtkMRMLReposeCageNode::HandleGroup> groups;
+            for (std::size_t g = 0; g < handles->size(); ++g)
+              groups.push_back({pose.groups[g].name, (*handles)[g].cageVertices});
+            cage->SetHandleGroups(groups);
+            cage->SetNodeReferenceID("segmentation", segRef->GetID());
+            auto mesh = vtkSmartPointer<vtkMRMLReposeTransferMeshNode>::New();
+            mesh->SetName(segRef->GetName() + " transfer mesh");
+            mesh->SetMesh(vtkSlicerReposeMeshConversion::ToUnstructuredGrid(geometry->mesh));
+            mesh->SetSizeMm(settings.meshMm);
+            this->Scene->AddNode(cage);
+            mesh->SetNodeReferenceID("segmentation", segRef->GetID());
+            mesh->SetNodeReferenceID("cage", cage->GetID());
+            this->Scene->AddNode(mesh);
+            const int state = poseRef->StartModify();
+            poseRef->SetNodeReferenceID("segmentation", segRef->GetID());
+            poseRef->SetNodeReferenceID("cage", cage->GetID());
+            poseRef->SetNodeReferenceID("transfer_mesh", mesh->GetID());
+            poseRef->EndModify(state);
+          };
+        });
     return true;
   } catch (const std::exception& e) {
     this->LastErrorMessage = e.what();
@@ -255,17 +246,21 @@ std::string vtkSlicerReposeLogic::PartsPath() const {
   return this->ParameterNode ? this->ParameterNode->GetBodyPartMapPath() : std::string();
 }
 
-repose::RigSettings vtkSlicerReposeLogic::RigSettingsFor(const repose::Volume& G) const {
-  repose::RigSettings settings;
+std::shared_ptr<const repose::PoseJob> vtkSlicerReposeLogic::PoseJobFor(
+    vtkMRMLReposeSegmentationNode* seg, const repose::Pose& pose, const repose::Volume& G,
+    const repose::Volume& S) const {
+  repose::PoseJobRequest request;
+  request.organsName =
+      seg->GetLabelMapFileName().empty() ? seg->GetName() : seg->GetLabelMapFileName();
+  request.partsPath = this->PartsPath();
+  request.tissuesPath = this->TissueTablePath;
+  request.skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
   if (this->ParameterNode) {
-    settings.cageVertices = this->ParameterNode->GetCageVertexCount();
-    settings.dilateMm = this->ParameterNode->GetCageDilationMm();
-    settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
+    request.settings.cageVertices = this->ParameterNode->GetCageVertexCount();
+    request.settings.dilateMm = this->ParameterNode->GetCageDilationMm();
+    request.settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
   }
-  // Bones (the tissue table's rigid labels) and organs move as whole pieces, as in `repose pose`.
-  const repose::TissueChoice tissues = tissuesFor(this->TissueTablePath, G, this->PartsPath());
-  if (tissues.table) settings.rigidLabels = repose::rigidLabelsOf(*tissues.table);
-  return settings;
+  return std::make_shared<const repose::PoseJob>(pose, G, S, std::move(request));
 }
 
 bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int iterations) {
@@ -277,15 +272,15 @@ bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int 
     if (poseNode != this->GetLivePose() || !posed)
       throw repose::Error("pose " + poseNode->GetName() +
                           " is not being posed live: the refinement adapts to its current frame");
-    auto parts = std::make_shared<repose::Volume>(partsOf(nodes.Segmentation));
+    auto parts =
+        std::make_shared<repose::Volume>(vtkSlicerReposeLogicInputs::PartsOf(nodes.Segmentation));
     auto G = std::make_shared<repose::Volume>(
         Conversion::FromImageData(nodes.Segmentation->GetLabelMap()));
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
-    const std::optional<repose::Skeleton> skeleton =
-        vtkSlicerReposeLogicInputs::SkeletonOf(nodes.Segmentation);
-    const auto separations =
-        repose::poseSeparations(pose, *parts, skeleton ? &*skeleton : nullptr, true).all;
-    const repose::RigSettings settings = this->RigSettingsFor(*G);
+    const std::shared_ptr<const repose::PoseJob> job =
+        this->PoseJobFor(nodes.Segmentation, pose, *G, *parts);
+    const std::vector<repose::LimbSeparation> separations = job->separations().all;
+    const repose::RigSettings settings = job->settings();
     auto cage = std::make_shared<repose::TriangleMesh>(
         vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()));
     Eigen::MatrixX3d posedCage(posed->GetNumberOfPoints(), 3);
@@ -346,7 +341,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     if (!outputFolder.empty() && !fs::is_directory(fs::absolute(outputFolder).parent_path()))
       throw repose::Error(outputFolder + ": its parent folder does not exist");
     auto G = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetLabelMap()));
-    auto S = std::make_shared<repose::Volume>(partsOf(seg));
+    auto S = std::make_shared<repose::Volume>(vtkSlicerReposeLogicInputs::PartsOf(seg));
     std::shared_ptr<repose::Volume> I;
     if (seg->GetImage())
       I = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetImage()));
@@ -355,10 +350,8 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
-    const repose::TissueChoice choice = tissuesFor(this->TissueTablePath, *G, this->PartsPath());
-    const std::shared_ptr<repose::TissueTable> tissues =
-        choice.table ? std::make_shared<repose::TissueTable>(*choice.table) : nullptr;
-    const std::string tissueTableName = choice.name;
+    // Tissues, skeleton and the joints' bends as `repose pose` has them.
+    const std::shared_ptr<const repose::PoseJob> job = this->PoseJobFor(seg, pose, *G, *S);
     // Memory: the posed G, S and image and the displacement field (3 floats a voxel), refused
     // above the budget with the numbers: first on the input's grid (here), then on the frame's
     // (on the worker, before any voxel is written).
@@ -386,38 +379,26 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
       });
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
-    // The joints bend as `repose pose` bends them (the skeleton beside S).
-    const std::optional<repose::Skeleton> skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
-    const std::vector<repose::BendJoint> bends =
-        repose::bendJoints(skeleton ? &*skeleton : nullptr, S->labels());
     this->Job->Start(
         "pose",
         [=, geometry = std::move(geometry)](
             const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
           repose::reportProgress(progress, 0, "embedding");
-          const repose::PoseRig rig(std::move(geometry), pose, S->labels(), 0, -1, bends);
+          const std::unique_ptr<repose::PoseRig> rig = job->makeRig(std::move(geometry));
           // The frame as `repose pose` poses it (one implementation: repose::poseFrame).
-          repose::PoseFrameOptions fo;
+          repose::PoseFrameOptions fo = job->frameOptions();
           fo.image = I.get();
           fo.background = background;
-          fo.tissues = tissues.get();
-          fo.tissueTableName = tissueTableName;
           fo.checkGrid = [&](const repose::VolumeGeometry& grid) { checkBudget(grid.numVoxels()); };
           fo.progress = [&](double x, const std::string& stage) {
             return progress(0.1 + 0.8 * x, stage);
           };
           auto f = std::make_shared<repose::PosedFrame>(
-              repose::poseFrame(rig, std::min(frame, rig.frameCount() - 1), *G, *S, fo));
+              repose::poseFrame(*rig, std::min(frame, rig->frameCount() - 1), *G, *S, fo));
+          f->reportJson = job->completeReport(f->reportJson, true);  // the scene's nodes' rig
           // Written here, on the worker: past the rasterization nothing can cancel the job, and
           // the files are atomic, so a cancelled export still leaves the folder as it was.
-          if (!outputFolder.empty()) {
-            nlohmann::json report = nlohmann::json::parse(f->reportJson);
-            report["input"] = segRef->GetLabelMapFileName();
-            report["scene_reused"] = true;  // the rig of the scene's nodes
-            report["joint_rings"] = pose.jointRings;
-            f->reportJson = report.dump();
-            repose::writePosedFrame(*f, outputFolder);
-          }
+          if (!outputFolder.empty()) repose::writePosedFrame(*f, outputFolder);
           repose::reportProgress(progress, 1, "posed");
           return [=] {
             auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();

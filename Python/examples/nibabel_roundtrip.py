@@ -7,7 +7,9 @@ pose edited in code, and the posed label map handed back as a nibabel image and 
     PYTHONPATH=build/python /usr/bin/python3 Python/examples/nibabel_roundtrip.py \
         --organs G.nii.gz --parts S.nii.gz --angle 60 --out posed.nii.gz
 
-Without --organs/--parts it writes the generated phantom with nibabel first (--phantom-mm).
+Without --organs/--parts it writes the generated phantom with nibabel first (--phantom-mm). The
+pose names the elbow: its place comes from the skeleton.json beside S (`repose rig` writes it), or
+--skeleton, or the phantom's.
 """
 import argparse
 import pathlib
@@ -28,6 +30,7 @@ def main(argv=None):
     p.add_argument("--parts", help="body-part map S (NIfTI, G's grid)")
     p.add_argument("--phantom-mm", type=float, default=4.0)
     p.add_argument("--angle", type=float, default=90.0, help="elbow flexion in degrees")
+    p.add_argument("--skeleton", help="skeleton.json (default: the one beside --parts)")
     p.add_argument("--out", required=True, help="the posed label map (.nii.gz)")
     a = p.parse_args(argv)
 
@@ -37,9 +40,11 @@ def main(argv=None):
         if a.organs:
             g_img, s_img = nib.load(a.organs), nib.load(a.parts)
             part_names = repose.read_volume(a.parts).labels
+            skeleton = a.skeleton or str(pathlib.Path(a.parts).parent / "skeleton.json")
         else:  # a NIfTI pair as another tool would have written it (no label names)
             ph = repose.make_phantom(a.phantom_mm)
             part_names = ph["parts"].labels
+            skeleton = ph["skeleton"]
             nib.save(repose.to_nibabel(ph["organs"]), f"{tmp}/G.nii.gz")
             nib.save(repose.to_nibabel(ph["parts"]), f"{tmp}/S.nii.gz")
             g_img, s_img = nib.load(f"{tmp}/G.nii.gz"), nib.load(f"{tmp}/S.nii.gz")
@@ -52,7 +57,7 @@ def main(argv=None):
 
     pose = repose.Pose.read(str(REPO / "bench" / "poses" / "elbow90.pose.json"))
     pose.set_transform("left forearm and hand", angle_deg=a.angle)
-    rig = repose.build_rig(organs, parts, pose, tissues=None)
+    rig = repose.build_rig(organs, parts, pose, tissues=None, skeleton=skeleton)
     frame = rig.pose_frame(organs, parts)
 
     # The posed labels out: a numpy view in a nibabel image, saved by nibabel.

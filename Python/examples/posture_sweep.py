@@ -5,9 +5,11 @@ and a CSV of the whole-body mass change per posture.
 
     PYTHONPATH=build/python /usr/bin/python3 Python/examples/posture_sweep.py --out sweep
     PYTHONPATH=build/python /usr/bin/python3 Python/examples/posture_sweep.py \
-        --organs G.nii.gz --parts S.nii.gz --pose my.pose.json --spacing-mm 2 --out sweep
+        --organs G.nii.gz --parts rig/S.nii.gz --pose my.pose.json --spacing-mm 2 --out sweep
 
-Without --organs/--parts it poses the generated phantom (--phantom-mm). Writes
+Without --organs/--parts it poses the generated phantom (--phantom-mm). With them, the joints the
+pose names and the tissue table come from the skeleton.json and tissues.csv beside S, as
+`repose rig` writes them (or --skeleton, --tissues). Writes
 OUT/<frame>/{posed_G.nii.gz, posed_S.nii.gz, transform.nrrd, report.json} and
 OUT/mass_summary.csv, and prints the table.
 """
@@ -32,7 +34,10 @@ def main(argv=None):
     p.add_argument("--spacing-mm", type=float, default=2.0,
                    help="output voxel size (the FDTD grid); 0 keeps the input's")
     p.add_argument("--tissues", default="auto",
-                   help="tissue table CSV (label,name,density_kg_m3,rigid); 'auto': the phantom's")
+                   help="tissue table CSV (label,name,density_kg_m3,rigid); 'auto': the one "
+                        "beside S, else the phantom's")
+    p.add_argument("--skeleton", help="skeleton.json for the joints the pose names (default: "
+                                      "the one beside S, or the phantom's)")
     p.add_argument("--out", required=True, help="output folder")
     a = p.parse_args(argv)
 
@@ -40,9 +45,14 @@ def main(argv=None):
         if not a.parts:
             p.error("--parts is required with --organs")
         organs, parts = repose.read_volume(a.organs), repose.read_volume(a.parts)
+        beside = pathlib.Path(a.parts).parent
+        skeleton = a.skeleton or beside / "skeleton.json"
+        if a.tissues == "auto" and (beside / "tissues.csv").exists():
+            a.tissues = str(beside / "tissues.csv")
     else:
         phantom = repose.make_phantom(a.phantom_mm)
         organs, parts = phantom["organs"], phantom["parts"]
+        skeleton = a.skeleton or phantom["skeleton"]
     pose = repose.Pose.read(a.pose)
     out = pathlib.Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -54,7 +64,8 @@ def main(argv=None):
     progress = show if sys.stderr.isatty() else None
 
     start = time.time()
-    rig = repose.build_rig(organs, parts, pose, tissues=a.tissues, progress=progress)
+    rig = repose.build_rig(organs, parts, pose, tissues=a.tissues, skeleton=skeleton,
+                           progress=progress)
     print(f"\rrig: {len(rig.cage_vertices)} cage vertices, {len(rig.mesh_vertices)} mesh "
           f"vertices, tissue table: {rig.tissue_table} ({time.time() - start:.1f} s)")
 

@@ -47,8 +47,6 @@ __all__ = [
     "read_volume", "rig_body", "to_nibabel", "volume_from_array", "write_volume",
 ]
 
-_PHANTOM_TISSUES = os.path.join(os.path.dirname(__file__), "phantom_tissues.csv")
-
 # Voxel types Repose keeps; others are converted (labels to the smallest integer type that holds
 # them, intensities to float32).
 _KEPT = ("uint8", "uint16", "int16", "int32", "float32")
@@ -107,10 +105,12 @@ def to_nibabel(volume: Volume):
 
 
 def _tissues(tissues):
+    """(path, auto) for the rig: None no table; "auto" the tissues.csv beside S (a scene's), else
+    the phantom's when G's labels are the phantom's; else the table at that path."""
     if tissues is None:
         return "", False
-    if tissues == "auto":  # the phantom's table, when G's labels are the phantom's
-        return _PHANTOM_TISSUES, True
+    if tissues == "auto":
+        return "", True
     return os.fspath(tissues), False
 
 
@@ -129,16 +129,16 @@ def build_rig(organs: Volume, parts: Volume, pose: Pose, *, body: Optional[Rigge
     (label,name,density_kg_m3,rigid[,bone]) for masses and bones, "auto" (the phantom's table
     when G's labels are the phantom's) or None. The rest as `repose pose`.
     """
-    path, if_covering = _tissues(tissues)
+    path, auto = _tissues(tissues)
     csv = ""
     if body is not None:
         skeleton = body.skeleton if skeleton is None else skeleton
         if tissues == "auto":
-            path, if_covering, csv = "", False, body.tissues_csv
+            path, auto, csv = "", False, body.tissues_csv
     if isinstance(skeleton, (str, os.PathLike)):
         skeleton = Skeleton.read(os.fspath(skeleton))
     return Rig(organs, parts, pose, cage_vertices=cage_vertices, dilate_mm=dilate_mm,
-               mesh_mm=mesh_mm, _tissues_path=path, _tissues_if_covering=if_covering,
+               mesh_mm=mesh_mm, _tissues_path=path, _tissues_auto=auto,
                _tissues_csv=csv, whole_organs=whole_organs, joint_rings=joint_rings,
                threads=threads, skeleton=skeleton, auto_separate=auto_separate,
                progress=progress)
@@ -167,8 +167,8 @@ def load_scene(folder, pose: Optional[Pose] = None, *, tissues="auto", joint_rin
     if parts is None:
         raise Error(f"{folder}: the scene names no body-part map")
     image = read_volume(inputs["image"], memory_bytes=memory_bytes) if inputs["image"] else None
-    path, if_covering = _tissues(tissues)
+    path, auto = _tissues(tissues)
     rig, inputs = _repose._rig_from_scene(folder, organs, parts, pose, joint_rings=joint_rings,
                                           threads=threads, _tissues_path=path,
-                                          _tissues_if_covering=if_covering)
+                                          _tissues_auto=auto)
     return Scene(organs, parts, image, rig, dict(inputs))

@@ -26,14 +26,39 @@ namespace repose::python {
 
 namespace {
 
-// A rig as Python holds it: the prepared PoseRig and what it was built with.
+// A rig as Python holds it: the job (Core's pose-job policy, holding G and S, which the bindings
+// keep alive) and the prepared PoseRig.
 struct Rig {
+  std::unique_ptr<PoseJob> job;
   std::unique_ptr<PoseRig> rig;
-  RigSettings settings;
-  std::optional<TissueTable> tissues;
-  std::string tissueTableName = "none";
-  int jointRings = -1;
+  bool sceneReused = false;
+  py::object organs, parts;  // the Volumes the job holds, kept alive with the rig
 };
+
+// The job's request from the Python layer's arguments: tissues "auto" (beside S, else the
+// phantom's when G's labels are the phantom's), a path, a table given as CSV text, or none.
+PoseJobRequest requestFrom(const std::string& tissuesPath, bool tissuesAuto,
+                           const std::string& tissuesCsv, const py::object& skeleton,
+                           const std::string& partsPath) {
+  PoseJobRequest request;
+  request.partsPath = partsPath;
+  request.tissuesPath = tissuesPath;
+  request.tissuesAuto = tissuesAuto;
+  if (!tissuesCsv.empty()) {
+    request.tissues = parseTissueTable(tissuesCsv, "the rigged body's tissues");
+    request.tissuesName = "rig_body";
+  }
+  if (!skeleton.is_none()) request.skeleton = skeleton.cast<Skeleton>();
+  return request;
+}
+
+// Each warning of a frame (PoseFrameOptions::warn) as a Python warning, once the GIL is back.
+void issueWarnings(const std::string& frame, const std::vector<std::string>& lines) {
+  if (lines.empty()) return;
+  const py::object warn = py::module_::import("warnings").attr("warn");
+  for (const std::string& line : lines)
+    warn("frame " + frame + ": " + line, py::arg("stacklevel") = 2);
+}
 
 // Runs `work` with the GIL released and the callback bridged; a cancellation raised by the
 // callback (or Ctrl+C) comes back as that Python exception, else as repose.Cancelled.
@@ -92,19 +117,6 @@ PoseKeyframe* keyframeNamed(Pose& pose, const py::object& keyframe) {
 
 Eigen::MatrixX3d verticesOf(const Eigen::MatrixX3d& v) {
   return v;
-}
-
-// The tissue table of a rig: the file at `path`, used only when it covers G's labels if
-// `ifCovering` (the phantom's default table); its rigid labels become whole pieces.
-void applyTissues(Rig& r, const Volume& organs, const std::string& path, bool ifCovering) {
-  if (path.empty()) return;
-  TissueTable t = readTissueTable(path);
-  if (ifCovering && !tissueTableCovers(t, organs.labels())) return;
-  r.tissues = std::move(t);
-  r.tissueTableName = ifCovering ? "phantom default" : path;
-  r.settings.rigidLabels.clear();
-  for (const auto& [label, tissue] : *r.tissues)
-    if (tissue.rigid) r.settings.rigidLabels.push_back(label);
 }
 
 }  // namespace
@@ -234,45 +246,38 @@ groups resolved. Each frame of the pose is then a few solves: `deform` gives the
 mesh, `pose_frame` the full-resolution volumes and report.)doc")
       .def(py::init([](const Volume& organs, const Volume& parts, const Pose& named,
                        int cageVertices, double dilateMm, double meshMm,
-                       const std::string& tissuesPath, bool tissuesIfCovering,
+                       const std::string& tissuesPath, bool tissuesAuto,
                        const std::string& tissuesCsv, bool wholeOrgans, int jointRings, int threads,
-                       const py::object& skeleton, bool autoSeparate, const py::object& progress) {
-             if (parts.dims() != organs.dims() ||
-                 !parts.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6))
-               throw Error("the body-part map is not on the organ map's grid");
+                       const py::object& skeleton, bool autoSeparate, const py::object& progress,
+                       const std::string& partsPath) {
              if (!isIntegerType(organs.scalarType()))
                throw Error("the organ map holds float voxels, not labels");
+             PoseJobRequest request =
+                 requestFrom(tissuesPath, tissuesAuto, tissuesCsv, skeleton, partsPath);
+             request.settings.cageVertices = cageVertices;
+             request.settings.dilateMm = dilateMm;
+             request.settings.meshMm = meshMm;
+             request.settings.threads = threads;
+             request.settings.wholeOrgans = wholeOrgans;
+             request.jointRings = jointRings;
+             request.autoSeparate = autoSeparate;
              auto r = std::make_unique<Rig>();
-             r->settings.cageVertices = cageVertices;
-             r->settings.dilateMm = dilateMm;
-             r->settings.meshMm = meshMm;
-             r->settings.threads = threads;
-             r->settings.wholeOrgans = wholeOrgans;
-             r->jointRings = jointRings;
-             applyTissues(*r, organs, tissuesPath, tissuesIfCovering);
-             if (!tissuesCsv.empty()) {
-               r->tissues = parseTissueTable(tissuesCsv, "the rigged body's tissues");
-               r->tissueTableName = "rig_body";
-               r->settings.rigidLabels = rigidLabelsOf(*r->tissues);
-             }
-             const Skeleton* body = skeleton.is_none() ? nullptr : skeleton.cast<const Skeleton*>();
-             Pose pose = named;
-             resolveJointsWith(pose, body, "");
+             r->job = std::make_unique<PoseJob>(named, organs, parts, std::move(request));
              withProgress(progress, [&](const ProgressFn& fn) {
-               const auto separations = poseSeparations(pose, parts, body, autoSeparate).all;
-               RigGeometry g = buildRigGeometry(parts, separations, r->settings, fn, &organs);
-               r->rig = std::make_unique<PoseRig>(std::move(g), pose, parts.labels(), threads,
-                                                  jointRings, bendJoints(body, parts.labels()));
+               r->rig = r->job->makeRig(r->job->buildGeometry(fn), threads);
                return 0;
              });
              return r;
            }),
            py::arg("organs"), py::arg("parts"), py::arg("pose"), py::kw_only(),
            py::arg("cage_vertices") = 300, py::arg("dilate_mm") = 10.0, py::arg("mesh_mm") = 0.0,
-           py::arg("_tissues_path") = "", py::arg("_tissues_if_covering") = false,
+           py::arg("_tissues_path") = "", py::arg("_tissues_auto") = true,
            py::arg("_tissues_csv") = "", py::arg("whole_organs") = true,
            py::arg("joint_rings") = -1, py::arg("threads") = 0, py::arg("skeleton") = py::none(),
-           py::arg("auto_separate") = true, py::arg("progress") = py::none())
+           py::arg("auto_separate") = true, py::arg("progress") = py::none(),
+           py::arg("_parts_path") = "",
+           // The job holds G and S: they live as long as the rig.
+           py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
       .def_property_readonly("frame_count", [](const Rig& r) { return r.rig->frameCount(); })
       .def_property_readonly("frame_names",
                              [](const Rig& r) {
@@ -291,7 +296,19 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
           "Rest transfer-mesh vertices (n x 3, RAS mm).")
       .def_property_readonly("mesh_tets", [](const Rig& r) { return r.rig->mesh().tets; })
       .def_property_readonly(
-          "tissue_table", [](const Rig& r) { return r.tissueTableName; },
+          "mesh_tet_parts", [](const Rig& r) { return r.rig->mesh().labels; },
+          "Per tet: the body-part label of S it meshes.")
+      .def_property_readonly(
+          "mesh_tet_pieces",
+          [](const Rig& r) {
+            const std::vector<int>& rigid = r.rig->mesh().rigid;
+            return rigid.empty() ? std::vector<int>(std::size_t(r.rig->mesh().tets.rows()), 0)
+                                 : rigid;
+          },
+          "Per tet: the label of G of the whole piece (bone, organ) it belongs to, 0 for soft "
+          "tissue.")
+      .def_property_readonly(
+          "tissue_table", [](const Rig& r) { return r.job->tissues().name; },
           "Which tissue table gives densities and bones ('phantom default', a path, or 'none').")
       .def(
           "deform",
@@ -311,19 +328,20 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
           [](const Rig& r, const Volume& organs, const Volume& parts, std::size_t index,
              const py::object& image, double background, double spacingMm, bool fillPockets,
              const py::object& progress) {
-            PoseFrameOptions o;
-            const Volume* img = image.is_none() ? nullptr : &image.cast<const Volume&>();
-            o.image = img;
+            PoseFrameOptions o = r.job->frameOptions();
+            o.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
             o.background = background;
-            o.tissues = r.tissues ? &*r.tissues : nullptr;
-            o.tissueTableName = r.tissueTableName;
             o.fillPockets = fillPockets;
             o.spacingMm = spacingMm;
-            o.threads = r.settings.threads;
+            std::vector<std::string> warnings;
+            o.warn = [&](const std::string& line) { warnings.push_back(line); };
             PosedFrame f = withProgress(progress, [&](const ProgressFn& fn) {
               o.progress = fn;
-              return poseFrame(*r.rig, index, organs, parts, o);
+              PosedFrame posed = poseFrame(*r.rig, index, organs, parts, o);
+              posed.reportJson = r.job->completeReport(posed.reportJson, r.sceneReused);
+              return posed;
             });
+            issueWarnings(f.name, warnings);
             return f;
           },
           py::arg("organs"), py::arg("parts"), py::arg("index") = 0, py::kw_only(),
@@ -362,10 +380,8 @@ slabs), so label maps larger than memory can be posed.)doc")
           "save_scene",
           [](const Rig& r, const std::string& folder, const std::string& organsPath,
              const std::string& partsPath, const std::string& imagePath) {
-            const Volume parts = readVolume(partsPath);
-            const std::string key = sceneRigKey(
-                partsPath, resolveSeparations(r.rig->pose(), parts.labels()), r.settings);
-            writeSceneFolder(folder, *r.rig, key, {organsPath, partsPath, imagePath}, r.settings);
+            writeSceneFolder(folder, *r.rig, r.job->sceneKey(partsPath),
+                             {organsPath, partsPath, imagePath}, r.job->settings());
           },
           py::arg("folder"), py::arg("organs_path"), py::arg("parts_path"),
           py::arg("image_path") = "",
@@ -374,19 +390,25 @@ slabs), so label maps larger than memory can be posed.)doc")
 
   m.def(
       "_rig_from_scene",
-      [](const std::string& folder, const Volume& organs, const Volume& parts,
+      [](const std::string& folder, const py::object& organsObject, const py::object& partsObject,
          const py::object& pose, int jointRings, int threads, const std::string& tissuesPath,
-         bool tissuesIfCovering) {
+         bool tissuesAuto) {
+        const Volume& organs = organsObject.cast<const Volume&>();
+        const Volume& parts = partsObject.cast<const Volume&>();
         SceneContents scene = readSceneFolder(folder);
+        PoseJobRequest request =
+            requestFrom(tissuesPath, tissuesAuto, "", py::none(), scene.inputs.parts);
+        request.organsName = scene.inputs.organs;
+        request.settings.threads = threads;
+        request.jointRings = jointRings;
         auto r = std::make_unique<Rig>();
-        r->jointRings = jointRings;
-        r->settings.threads = threads;
-        applyTissues(*r, organs, tissuesPath, tissuesIfCovering);
-        const Pose p = pose.is_none() ? scene.pose : pose.cast<Pose>();
+        r->sceneReused = true;
+        r->organs = organsObject, r->parts = partsObject;
+        r->job = std::make_unique<PoseJob>(pose.is_none() ? scene.pose : pose.cast<Pose>(), organs,
+                                           parts, std::move(request));
         {
           py::gil_scoped_release release;
-          r->rig = std::make_unique<PoseRig>(std::move(scene.geometry), p, parts.labels(), threads,
-                                             jointRings);
+          r->rig = r->job->makeRig(std::move(scene.geometry), threads);
         }
         py::dict inputs;
         inputs["organs"] = scene.inputs.organs;
@@ -396,7 +418,7 @@ slabs), so label maps larger than memory can be posed.)doc")
       },
       py::arg("folder"), py::arg("organs"), py::arg("parts"), py::arg("pose") = py::none(),
       py::arg("joint_rings") = -1, py::arg("threads") = 0, py::arg("_tissues_path") = "",
-      py::arg("_tissues_if_covering") = false);
+      py::arg("_tissues_auto") = true);
   m.def(
       "_scene_inputs",
       [](const std::string& folder) {

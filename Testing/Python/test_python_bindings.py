@@ -30,6 +30,15 @@ def elbow_rig(phantom):
                         rp.Pose.read(str(POSES / "elbow90.pose.json")), skeleton=phantom["skeleton"])
 
 
+def phantom_bones(organs):
+    """The phantom's bone labels (rigid in its tissue table) present in `organs`."""
+    import csv
+    rows = csv.DictReader(line for line in (REPO / "Resources" / "Tissues" / "phantom.csv")
+                          .read_text().splitlines() if not line.startswith("#"))
+    rigid = {int(r["label"]) for r in rows if r["rigid"] == "1"}
+    return sorted(rigid & set(organs.label_volumes_ml()))
+
+
 def test_version_is_the_projects():
     cmake = (REPO / "CMakeLists.txt").read_text()
     assert f"VERSION {rp.__version__}" in cmake
@@ -113,6 +122,8 @@ def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose, phan
     g, s = phantom["organs"], phantom["parts"]
     rp.write_volume(g, str(tmp_path / "G.nii.gz"))
     rp.write_volume(s, str(tmp_path / "S.nii.gz"))
+    # The suite's poses name joints: the skeleton beside S says where they are, for both.
+    (tmp_path / "skeleton.json").write_text(phantom["skeleton"].to_json())
     pose_file = POSES / "elbow90.pose.json"
     repose("pose", "--input", tmp_path / "G.nii.gz", "--parts", tmp_path / "S.nii.gz",
            "--pose", pose_file, "--scene", tmp_path / "scene", "--out", tmp_path / "cli")
@@ -141,13 +152,23 @@ def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     before = sum(g.label_volumes_ml().values())
     after = sum(frame.organs.label_volumes_ml().values())
     assert abs(after / before - 1) < 0.01
-    # Out of core: the same labels as in core, under a small budget.
+    # Out of core, under a small budget: the labels in core, except where the in-core frame
+    # uses G and S at rest, which the stream does not hold (docs/ARCHITECTURE.md, "Whole
+    # pieces"): a bone's rim moved with the bone, the shell outside the body kept off a
+    # neighbour's tissue. Those differ only beside a bone or at the body's surface, in a handful
+    # of voxels.
     rp.write_volume(g, str(tmp_path / "G.nii"))
     elbow_rig.pose_labels_to_file(str(tmp_path / "G.nii"), str(tmp_path / "posed.nii.gz"),
                                   memory_bytes=32 * 2**20)
-    in_core = elbow_rig.pose_frame(g, s, fill_pockets=False)
-    streamed = nib.load(tmp_path / "posed.nii.gz")
-    np.testing.assert_array_equal(np.asanyarray(streamed.dataobj), in_core.organs.array)
+    in_core = elbow_rig.pose_frame(g, s, fill_pockets=False).organs.array
+    streamed = np.asanyarray(nib.load(tmp_path / "posed.nii.gz").dataobj)
+    assert streamed.shape == in_core.shape
+    differ = np.argwhere(streamed != in_core)
+    assert len(differ) <= 1e-4 * in_core.size
+    bones = set(phantom_bones(g)) | {0}  # a bone, or outside the body
+    for i, j, k in differ:
+        near = in_core[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]
+        assert bones & set(np.unique(near).tolist()), (i, j, k)
 
 
 def test_progress_cancellation_and_the_gil(phantom, elbow_rig):

@@ -4,7 +4,9 @@ alone (named joints, automatic contact separation), checked against docs/QUALITY
 from each frame's report.json:
 
   body volume within +-0.5 %; every label of >= 1000 voxels within +-1 % beyond its resampling
-  floor; each bone (all its labels) Dice >= 0.95; no new holes; no label lost.
+  floor; each bone (all its labels) Dice >= 0.95; no new holes; no label lost; and no two bones
+  run into each other (issue 21: with the rig's joint centres the standard poses must not
+  collide).
 
 usage: pose_suite_quality.py BIN_DIR POSES_DIR WORK_DIR [phantom options...]
        [--label-bound PERCENT]  the per-label bound beyond the floor (default 1, the target)
@@ -56,12 +58,14 @@ def main():
             body = f["body"]["volume_change_percent"]
             worst = q["labels_within_1_percent"]
             beyond = worst["worst_change_beyond_floor_percent"]
-            print(f"{where}: body {body:+.3f} %, worst label {worst['worst_name']} "
+            collided = f["bone_collisions"]["voxels"]
+            print(f"{where}: body {body:+.3f} % (predicted {f['predicted']['body_change_percent']:+.3f} %), "
+                  f"worst label {worst['worst_name']} "
                   f"{worst['worst_change_percent']:+.2f} % (floor "
                   f"{worst['worst_resampling_floor_percent']:+.2f} %), bones min Dice "
                   f"{q['bones_rigid']['min_dice']:.3f}, new holes "
                   f"{q['no_new_holes']['new_enclosed_voxels']}, lost "
-                  f"{q['no_label_lost']['labels_lost']}")
+                  f"{q['no_label_lost']['labels_lost']}, bones collided in {collided} voxels")
             if abs(body) > 0.5:
                 failures.append(f"{where}: body volume {body:+.3f} % (target +-0.5 %)")
             if abs(beyond) > bound:
@@ -73,6 +77,9 @@ def main():
             if not q["no_new_holes"]["met"]:
                 failures.append(f"{where}: {q['no_new_holes']['new_enclosed_voxels']} new "
                                 "enclosed voxels")
+            if collided:
+                pairs = ", ".join(f"{c['a']} / {c['b']}" for c in f["bone_collisions"]["pairs"])
+                failures.append(f"{where}: bones run into each other in {collided} voxels ({pairs})")
             if not q["no_label_lost"]["met"]:
                 failures.append(f"{where}: {q['no_label_lost']['labels_lost']} labels lost")
             seps = f["separations"]

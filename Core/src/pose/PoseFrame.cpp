@@ -5,7 +5,9 @@
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/NrrdIO.h"
 #include "repose/io/VolumeIO.h"
+#include "repose/mesh/VolumePrediction.h"
 #include "repose/pose/PoseReport.h"
+#include "repose/raster/PieceOverlap.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
@@ -13,12 +15,120 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <stdlib.h>
 #include <set>
 
 namespace repose {
+namespace {
+
+std::string percent(double value, int digits = 1) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%+.*f %%", digits, value);
+  return text;
+}
+
+// A label of S by name ("part 7" without one), and the pose group that carries it.
+std::string partName(const Volume& parts, int label) {
+  const Label* l = parts.labels().find(label);
+  return l && !l->name.empty() ? l->name : "part " + std::to_string(label);
+}
+std::string groupCarrying(const PoseRig& rig, const std::vector<RigidHandle>& handles, int part) {
+  for (std::size_t g = 0; g < handles.size() && g < rig.pose().groups.size(); ++g)
+    if (std::find(handles[g].parts.begin(), handles[g].parts.end(), part) != handles[g].parts.end())
+      return rig.pose().groups[g].name;
+  return "";
+}
+
+// The guard rail: the body volume the posed mesh predicts, and when it breaks the target
+// (docs/QUALITY.md: +-0.5 %), one line saying which part drags which and what to do.
+nlohmann::json predictionReport(const VolumePrediction& p, const PoseRig& rig,
+                                const std::vector<RigidHandle>& handles, const Volume& parts,
+                                std::string& warning) {
+  nlohmann::json out = {{"body_change_percent", p.changePercent()}};
+  nlohmann::json perPart = nlohmann::json::array();
+  for (const PartVolumeChange& c : p.parts)
+    perPart.push_back({{"part", partName(parts, c.part)}, {"change_percent", c.changePercent()}});
+  out["parts"] = perPart;
+  if (std::fabs(p.changePercent()) <= 0.5 || p.worstPart == 0) return out;
+  const auto worst = std::find_if(p.parts.begin(), p.parts.end(),
+                                  [&](const PartVolumeChange& c) { return c.part == p.worstPart; });
+  const std::string worstName = partName(parts, p.worstPart);
+  warning = "the posed mesh predicts a body volume change of " + percent(p.changePercent()) +
+            " (target within 0.5 %): " + worstName + " " + percent(worst->changePercent());
+  out["worst_part"] = worstName;
+  const std::string worstGroup = groupCarrying(rig, handles, p.worstPart);
+  const std::string dragGroup = p.draggedBy ? groupCarrying(rig, handles, p.draggedBy) : "";
+  if (p.draggedBy != 0 && dragGroup != worstGroup) {
+    const std::string dragName = partName(parts, p.draggedBy);
+    out["dragged_by"] = dragName;
+    warning += ", dragged where it is tied to " + dragName +
+               (dragGroup.empty() ? std::string() : " (group \"" + dragGroup + "\")") +
+               ": cut the two apart where they touch (automatic separation, or \"separations\" "
+               "in the pose) or move them with one group";
+  } else {
+    warning +=
+        ", folded or stretched inside itself: widen its joints (--joint-rings) or pose it "
+        "less far";
+  }
+  out["message"] = warning;
+  return out;
+}
+
+// Rigid pieces that run into each other on the output grid, by bone (the tissue table's bone
+// column: a bone's cortex and marrow are one) or label, in their body parts.
+nlohmann::json collisionReport(const std::vector<PieceOverlap>& overlaps, const Volume& organs,
+                               const Volume& parts, const TissueTable* tissues, double voxelMm3,
+                               std::string& warning) {
+  auto pieceName = [&](const PieceId& id) {
+    std::string name;
+    if (tissues) {
+      const auto t = tissues->find(id.label);
+      if (t != tissues->end()) name = !t->second.bone.empty() ? t->second.bone : t->second.name;
+    }
+    if (name.empty()) {
+      const Label* l = organs.labels().find(id.label);
+      name = l && !l->name.empty() ? l->name : "label " + std::to_string(id.label);
+    }
+    return name + " (" + partName(parts, id.part) + ")";
+  };
+  std::map<std::pair<std::string, std::string>, std::int64_t> byName;
+  std::int64_t total = 0;
+  for (const PieceOverlap& o : overlaps) {
+    std::string a = pieceName(o.a), b = pieceName(o.b);
+    if (a == b) continue;  // a bone's own labels (cortex and marrow) in one part
+    if (b < a) std::swap(a, b);
+    byName[{a, b}] += o.voxels;
+    total += o.voxels;
+  }
+  nlohmann::json pairs = nlohmann::json::array();
+  std::pair<std::string, std::string> worst;
+  std::int64_t most = 0;
+  for (const auto& [names, n] : byName) {
+    pairs.push_back({{"a", names.first},
+                     {"b", names.second},
+                     {"voxels", n},
+                     {"volume_ml", double(n) * voxelMm3 / 1000}});
+    if (n > most) most = n, worst = names;
+  }
+  if (total > 0) {
+    char ml[32];
+    std::snprintf(ml, sizeof ml, "%.2f", double(most) * voxelMm3 / 1000);
+    warning = "rigid pieces run into each other in " + std::to_string(total) + " voxels; most " +
+              worst.first + " and " + worst.second + " (" + std::to_string(most) + " voxels, " +
+              ml +
+              " ml): a turn about a pivot off the joint's own centre (check the skeleton's "
+              "joint, or the pose's pivot), or a pose beyond the joint's range";
+  }
+  return {{"voxels", total}, {"volume_ml", double(total) * voxelMm3 / 1000}, {"pairs", pairs}};
+}
+
+}  // namespace
 
 double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volume* image) {
   return double(scalarSize(organs.scalarType())) + double(scalarSize(parts.scalarType())) + 12 +
@@ -36,6 +146,17 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   const TransferMesh& mesh = rig.mesh();
   PosedFrame out;
   out.name = frame.name;
+  std::vector<std::string> warnings;
+  auto warn = [&](const std::string& line) {
+    if (line.empty()) return;
+    warnings.push_back(line);
+    if (options.warn) options.warn(line);
+  };
+  // Before any voxel: what the posed mesh predicts for the body's volume.
+  std::string predictionWarning;
+  const nlohmann::json prediction = predictionReport(predictVolumeChange(mesh, frame.deformed), rig,
+                                                     frame.handles, parts, predictionWarning);
+  warn(predictionWarning);
   out.grid = deformedGrid(organs.geometry(), frame.deformed, options.spacingMm);
   if (options.checkGrid) options.checkGrid(out.grid);
   const std::vector<std::uint8_t> outer = outerFaces(mesh);
@@ -55,6 +176,13 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   if (options.image)
     out.image =
         rasterizeImage(*options.image, mesh, frame.deformed, out.grid, options.background, ro);
+
+  // Rigid pieces run into each other.
+  std::string collisionWarning;
+  const nlohmann::json collisions = collisionReport(
+      pieceOverlaps(mesh, frame.deformed, out.grid), organs, parts, options.tissues,
+      std::fabs(out.grid.ijkToRas.block<3, 3>(0, 0).determinant()), collisionWarning);
+  warn(collisionWarning);
 
   std::set<int> pieceLabels;
   std::int64_t pieceTets = 0;
@@ -92,7 +220,20 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
        {{"filled_voxels", pockets.filled},
         {"kept_cavity_voxels", pockets.keptCavities},
         {"filled", options.fillPockets}}}};
+  report["predicted"] = prediction;
+  report["bone_collisions"] = collisions;
   report.update(nlohmann::json::parse(poseReportJson(ri)));
+  // Folds, parts the cage cannot reach, labels gone (docs/RELIABILITY.md, degenerate geometry).
+  auto count = [&](std::int64_t n, const std::string& what) {
+    if (n > 0) warn(std::to_string(n) + " " + what);
+  };
+  count(report["mesh"]["inverted_tets"].get<std::int64_t>(),
+        "tets turned inside out (the pose folds the body there; overlapping tissue is resolved "
+        "bone first)");
+  count(report["mesh"]["unreachable_vertices_left_at_rest"].get<std::int64_t>(),
+        "mesh vertices in parts with no vertex inside the cage, left at rest");
+  count(report["labels_lost"].get<std::int64_t>(), "labels vanished from the output");
+  report["warnings"] = warnings;
   out.reportJson = report.dump();
   return out;
 }

@@ -1,5 +1,6 @@
 #include "repose/pose/PoseJob.h"
 
+#include "repose/pose/SceneFolder.h"
 #include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
 
@@ -157,6 +158,79 @@ std::string PoseSeparations::reportJson() const {
   nlohmann::json doc = {{"manual", manual}, {"automatic", automaticOn}};
   if (automaticOn) doc.update(nlohmann::json::parse(automatic.json()));
   return doc.dump();
+}
+
+PoseJob::PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRequest request,
+                 const Volume* image)
+    : organs_(&organs), parts_(&parts), request_(std::move(request)), pose_(std::move(pose)) {
+  const std::string partsName = request_.partsPath.empty() ? "S" : request_.partsPath;
+  auto sameGrid = [&](const Volume& v) {
+    return v.dims() == organs.dims() &&
+           v.geometry().ijkToRas.isApprox(organs.geometry().ijkToRas, 1e-6);
+  };
+  if (!sameGrid(parts)) throw Error(partsName + ": not on the grid of " + request_.organsName);
+  if (image && image->dims() != organs.dims())
+    throw Error(request_.imageName + ": not on the grid of " + request_.organsName);
+  // The skeleton: given, else the file named, else the one beside S.
+  if (request_.skeleton)
+    skeleton_ = request_.skeleton;
+  else
+    skeleton_ = skeletonFor(request_.partsPath, request_.skeletonPath);
+  resolveJointsWith(pose_, skeleton_ ? &*skeleton_ : nullptr, request_.partsPath);
+  // The tissue table: given, else chooseTissues' order; its rigid labels move whole.
+  if (request_.tissues) {
+    tissues_.table = request_.tissues;
+    tissues_.name = request_.tissuesName;
+  } else if (request_.tissuesAuto || !request_.tissuesPath.empty()) {
+    tissues_ = chooseTissues(organs, request_.tissuesPath, request_.partsPath);
+  }
+  if (!tissues_.warning.empty()) warnings_.push_back(tissues_.warning);
+  settings_ = request_.settings;
+  if (tissues_.table) settings_.rigidLabels = rigidLabelsOf(*tissues_.table);
+  jointRings_ = request_.jointRings >= 0 ? request_.jointRings : pose_.jointRings;
+  const Skeleton* skeleton = skeleton_ ? &*skeleton_ : nullptr;
+  separations_ = poseSeparations(pose_, parts, skeleton, request_.autoSeparate);
+  for (const std::string& why : separations_.automatic.skipped)
+    warnings_.push_back("not separated: " + why);
+  settings_.refineJoints = jointRefinements(pose_, parts, skeleton);
+}
+
+std::string PoseJob::sceneKey(const std::string& partsPath) const {
+  return sceneRigKey(partsPath.empty() ? request_.partsPath : partsPath, separations_.all,
+                     settings_);
+}
+
+RigGeometry PoseJob::buildGeometry(const ProgressFn& progress) const {
+  return buildRigGeometry(*parts_, separations_.all, settings_, progress, organs_);
+}
+
+std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, int threads) const {
+  return makeRig(std::move(geometry), pose_, threads);
+}
+
+std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, const Pose& pose,
+                                          int threads) const {
+  return std::make_unique<PoseRig>(std::move(geometry), pose, parts_->labels(), threads,
+                                   jointRings_,
+                                   bendJoints(skeleton_ ? &*skeleton_ : nullptr, parts_->labels()));
+}
+
+PoseFrameOptions PoseJob::frameOptions() const {
+  PoseFrameOptions o;
+  o.tissues = tissues_.table ? &*tissues_.table : nullptr;
+  o.tissueTableName = tissues_.name;
+  o.threads = settings_.threads;
+  return o;
+}
+
+std::string PoseJob::completeReport(const std::string& reportJson, bool sceneReused) const {
+  nlohmann::json report = nlohmann::json::parse(reportJson);
+  report["input"] = request_.organsName;
+  report["scene_reused"] = sceneReused;
+  report["joint_rings"] = jointRings_;
+  report["separations"] = nlohmann::json::parse(separations_.reportJson());
+  report["skeleton"] = skeleton_ ? nlohmann::json(skeleton_->source) : nlohmann::json();
+  return report.dump();
 }
 
 }  // namespace repose

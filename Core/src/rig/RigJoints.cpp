@@ -76,6 +76,39 @@ bool circleFit(const std::vector<Surface>& pts, const V& axis, V& c, double& r) 
   return true;
 }
 
+// The geometric fit from an algebraic start: Gauss-Newton on the distances to the surface,
+// sum w_i (|p_i - c| - r)^2, with |.| in the plane across `axis` for a circle. The algebraic fit
+// alone shrinks the radius of a partial arc measured on a coarse grid (the humeral condyles seen
+// only on their distal side, in 4 to 8 mm voxels), moving the centre towards the tip; the
+// geometric one does not. For the round ends (heads, condyles); the carpals and the talar dome,
+// flatter than a circle across, keep the algebraic centre, which stays inside them.
+void refineGeometric(const std::vector<Surface>& pts, const V* axis, V& c, double& r) {
+  for (int it = 0; it < 30; ++it) {
+    Eigen::Matrix4d JtJ = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d Jtr = Eigen::Vector4d::Zero();
+    for (const Surface& s : pts) {
+      V d = s.p - c;
+      if (axis) d -= d.dot(*axis) * *axis;
+      const double n = d.norm();
+      if (!(n > 1e-9)) continue;
+      const double w = 1 / (s.size * s.size);
+      Eigen::Vector4d J;
+      J << -d / n, -1;  // d(|p - c| - r) / d(c, r)
+      JtJ += w * J * J.transpose();
+      Jtr += w * J * (n - r);
+    }
+    if (axis) {  // the centre moves only across the axis
+      const Eigen::Vector4d a(axis->x(), axis->y(), axis->z(), 0);
+      JtJ += 1e6 * JtJ.trace() * a * a.transpose();
+    }
+    const Eigen::Vector4d step = JtJ.ldlt().solve(-Jtr);
+    if (!step.allFinite()) return;
+    c += step.head<3>();
+    r += step[3];
+    if (step.head<3>().norm() < 1e-6 && std::fabs(step[3]) < 1e-6) return;
+  }
+}
+
 struct EndFit {
   V centre = V::Zero();
   double radius = 0, rms = -1;
@@ -89,7 +122,7 @@ struct EndFit {
 // or with `axis` a roll about that axis (centred between the end's extremes along it, measured
 // at the level of the centre so a tilted end counts both its sides).
 EndFit fitEnd(const Bone& bone, const V& tip, const V& inward, double reach, const V* axis,
-              double voxel, double shaft = 0.35) {
+              double voxel, double shaft = 0.35, bool geometric = true) {
   EndFit f;
   std::vector<Surface> pts;
   for (std::size_t i = 0; i < bone.boundary.size(); ++i)
@@ -101,7 +134,10 @@ EndFit fitEnd(const Bone& bone, const V& tip, const V& inward, double reach, con
     return (d - d.dot(*axis) * *axis).norm();
   };
   auto fit = [&](const std::vector<Surface>& q) {
-    return axis ? circleFit(q, *axis, f.centre, f.radius) : sphereFit(q, f.centre, f.radius);
+    if (!(axis ? circleFit(q, *axis, f.centre, f.radius) : sphereFit(q, f.centre, f.radius)))
+      return false;
+    if (geometric) refineGeometric(q, axis, f.centre, f.radius);
+    return f.radius > 0 && f.centre.allFinite();
   };
   if (!fit(pts)) return f;
   for (int it = 0; it < 10; ++it) {
@@ -327,7 +363,10 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
       const V uhd = orientedAway(Hd->axis, F->centroid, Hd->centroid);
       FittedJoint j;
       const V tip = Hd->extreme(-uhd);
-      const EndFit e = fitEnd(*Hd, tip, uhd, std::max(0.3 * Hd->length, 15.0), nullptr, voxel);
+      // The carpals' end is an ellipsoid more than a ball (the radiocarpal joint is condyloid):
+      // the algebraic fit's centre stays inside it where the geometric one is drawn along it.
+      const EndFit e =
+          fitEnd(*Hd, tip, uhd, std::max(0.3 * Hd->length, 15.0), nullptr, voxel, 0.35, false);
       j.centre = e.ok ? e.centre : gap(*F, uhd, *Hd);
       j.method = e.ok ? describeFit("sphere fit of the proximal carpals", e)
                       : "middle of the gap between forearm and hand bones";
@@ -382,7 +421,8 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
         if ((p - bottom).norm() < best) best = (p - bottom).norm(), tip = p;
       V axis = right;  // the talar dome rolls about the line between the malleoli
       // Only the dome itself: the foot's other bones leave the talus below its centre.
-      const EndFit e = fitEnd(*Ft, tip, ut, std::max(0.1 * T->length, 20.0), &axis, voxel, 0.0);
+      const EndFit e =
+          fitEnd(*Ft, tip, ut, std::max(0.1 * T->length, 20.0), &axis, voxel, 0.0, false);
       j.centre = e.ok ? e.centre : V(0.5 * (bottom + tip));
       j.method = e.ok ? describeFit("roll of the talar dome about the left-right line", e)
                       : "middle of the gap between tibia and foot bones";

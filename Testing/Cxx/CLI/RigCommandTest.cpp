@@ -1,7 +1,9 @@
 // `repose rig` and `repose pose` end to end, as a user brings a segmentation: the rig folder's
 // four files, a pose by named joints with automatic contact separation (each cut in the report)
-// and with separations drawn by hand (--no-auto-separate), and one-line errors for a
-// segmentation with no limb bones (TotalSegmentator's CT example: a chest, no humerus or femur).
+// and with separations drawn by hand (--no-auto-separate), the guard rail that names what drags
+// the body when nothing is cut, bones run into each other by a pivot off the joint, and one-line
+// errors for a segmentation with no limb bones (TotalSegmentator's CT example: a chest, no
+// humerus or femur).
 #include "CliTestFiles.h"
 #include "CommandRunner.h"
 #include "TestPaths.h"
@@ -60,8 +62,65 @@ TEST(RigCommand, RigsTheArmsRestingPhantomAndPosesItByNamedJointsWithAutomaticCu
   ASSERT_EQ(uncut.exitCode, 0) << uncut.err;
   const nlohmann::json u = nlohmann::json::parse(uncut.out);
   EXPECT_FALSE(u["separations"]["automatic"].get<bool>());
-  EXPECT_GT(std::fabs(u["body"]["volume_change_percent"].get<double>()),
+  const double uncutBody = u["body"]["volume_change_percent"].get<double>();
+  EXPECT_GT(std::fabs(uncutBody),
             2 * std::fabs(report["body"]["volume_change_percent"].get<double>()));
+  // The guard rail saw it before any voxel was written: the posed mesh's prediction is near what
+  // the voxels then measured, and one line on stderr names the trunk dragged by the left arm.
+  const double predicted = u["predicted"]["body_change_percent"].get<double>();
+  EXPECT_GT(std::fabs(predicted), 0.5);
+  EXPECT_NEAR(predicted, uncutBody, 0.5 * std::fabs(uncutBody));
+  EXPECT_EQ(u["predicted"]["worst_part"], "torso");
+  EXPECT_NE(u["predicted"]["dragged_by"].get<std::string>().find("_left"), std::string::npos);
+  const std::string line = "predicts a body volume change of";
+  ASSERT_NE(uncut.err.find(line), std::string::npos) << uncut.err;
+  const std::string said = uncut.err.substr(uncut.err.find(line));
+  EXPECT_NE(said.substr(0, said.find('\n')).find("torso"), std::string::npos) << said;
+  // With the cut, nothing to warn of: the prediction is within the target, no bones collide.
+  EXPECT_LT(std::fabs(report["predicted"]["body_change_percent"].get<double>()), 0.5);
+  EXPECT_EQ(pose.err.find(line), std::string::npos) << pose.err;
+  EXPECT_EQ(report["bone_collisions"]["voxels"], 0);
+}
+
+TEST(RigCommand, AForearmTurnedAboutAPivotOffTheElbowRunsIntoTheHumerusAndIsReported) {
+  ScratchDir dir;
+  const std::string d = shellQuote(dir.path().string());
+  ASSERT_EQ(runCommand("repose", "phantom --voxel 3 --out " + d).exitCode, 0);
+  const nlohmann::json skeleton = readJsonFile(dir.file("skeleton.json"));
+  nlohmann::json elbow;
+  for (const auto& j : skeleton["joints"])
+    if (j["name"] == "elbow_left") elbow = j;
+  ASSERT_FALSE(elbow.is_null());
+  // The suite's elbow flexion about the skeleton's own centre, and about a pivot 20 mm behind
+  // it (posterior is -y in RAS): the olecranon then swings into the humerus.
+  auto pose = [&](const std::string& name, double back) {
+    nlohmann::json p = readJsonFile(suitePoseFile("elbow90"));
+    auto& rotation = p["groups"][0]["rotation"];
+    rotation["axis"] = elbow["axes"]["flexion"];
+    rotation["pivot"] = {elbow["ras"][0], elbow["ras"][1].get<double>() - back, elbow["ras"][2]};
+    std::ofstream(dir.file(name + ".pose.json")) << p.dump();
+    return runCommand("repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                                    shellQuote(dir.file("S.nii.gz")) + " --pose " +
+                                    shellQuote(dir.file(name + ".pose.json")) + " --out " +
+                                    shellQuote(dir.file(name)) + " --json");
+  };
+  const CommandResult ok = pose("centred", 0);
+  ASSERT_EQ(ok.exitCode, 0) << ok.err;
+  EXPECT_EQ(nlohmann::json::parse(ok.out)["bone_collisions"]["voxels"], 0);
+  EXPECT_EQ(ok.err.find("run into each other"), std::string::npos) << ok.err;
+  const CommandResult off = pose("behind", 20);
+  ASSERT_EQ(off.exitCode, 0) << off.err;
+  const nlohmann::json c = nlohmann::json::parse(off.out)["bone_collisions"];
+  ASSERT_GT(c["voxels"].get<int>(), 0) << c.dump();
+  bool humerusAndForearm = false;
+  for (const auto& pair : c["pairs"]) {
+    const std::string a = pair["a"], b = pair["b"];
+    humerusAndForearm =
+        humerusAndForearm || ((a.find("humerus") == 0 && b.find("radius_ulna") == 0) ||
+                              (b.find("humerus") == 0 && a.find("radius_ulna") == 0));
+  }
+  EXPECT_TRUE(humerusAndForearm) << c.dump();
+  EXPECT_NE(off.err.find("rigid pieces run into each other"), std::string::npos) << off.err;
 }
 
 TEST(RigCommand, SeparationsDrawnByHandPoseTheArmsTouchingPhantom) {

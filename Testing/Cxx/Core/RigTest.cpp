@@ -91,7 +91,12 @@ INSTANTIATE_TEST_SUITE_P(
         Variant{"arms_resting_2mm", Eigen::Vector3d(2, 2, 2), true, PhantomLabelling::Phantom},
         Variant{"arms_resting_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true,
                 PhantomLabelling::Phantom},
-        Variant{"icrp110_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true, PhantomLabelling::Icrp110}),
+        Variant{"icrp110_thick", Eigen::Vector3d(1.8, 1.8, 4.8), true, PhantomLabelling::Icrp110},
+        // The adult male reference phantom's grid (8 mm slices) and a coarse isotropic one: the
+        // ends' fits must not shrink on a coarse grid.
+        Variant{"icrp110_am_grid", Eigen::Vector3d(2.137, 2.137, 8.0), true,
+                PhantomLabelling::Icrp110},
+        Variant{"arms_resting_4mm", Eigen::Vector3d(4, 4, 4), true, PhantomLabelling::Phantom}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(Rig, ACsvConventionGivesThePhantomsRig) {

@@ -28,6 +28,11 @@ struct PoseFrameOptions {
   // Called with the output grid before anything is allocated for it: a memory budget's check
   // (throw to refuse the frame).
   std::function<void(const VolumeGeometry& grid)> checkGrid;
+  // Called with each warning as soon as it is known, one line each, without the frame's name
+  // (the front end says which frame): the body volume the posed mesh predicts beyond the target
+  // (before rasterizing), rigid pieces run into each other, folds. The report's "warnings"
+  // holds them too.
+  std::function<void(const std::string&)> warn;
 };
 
 struct PosedFrame {

@@ -1,17 +1,22 @@
 // The policy of a pose job that every front end shares (the command line, the module's Logic,
-// Python): which tissue table applies to G, which skeleton belongs to S, and which separations a
-// pose needs (its own and the automatic contact separations). Front ends translate their
-// arguments into these calls and show progress; they decide nothing of this themselves.
+// Python): which tissue table applies to G, which skeleton belongs to S, the pose's joints, which
+// separations the pose needs (its own and the automatic contact separations), how the rig is
+// built (whole pieces, finer tets at the bent joints) and bent, and what the report says of the
+// job. Front ends translate their arguments into a PoseJobRequest, build a PoseJob, and show
+// progress; they decide nothing of this themselves, so the same request gives the same voxels
+// from `repose pose`, the workbench and Python.
 #pragma once
 
 #include "repose/cage/CageBuilder.h"
 #include "repose/pose/ContactSeparation.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseFrame.h"
 #include "repose/pose/PoseRig.h"
 #include "repose/pose/Skeleton.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,5 +62,70 @@ std::vector<JointRefinement> jointRefinements(const Pose& pose, const Volume& pa
 // The skeleton's joints as PoseRig bends them: each joint with its two parts (labels of S by
 // name), its centre, its distal direction (its "rotation" axis) and its radius.
 std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& partLabels);
+
+// What a front end was given, translated from its own arguments.
+struct PoseJobRequest {
+  std::string organsName = "G";  // G's file or node: the report's "input", messages
+  std::string partsPath;  // S's file, where tissues.csv and skeleton.json are looked for beside it
+  std::string imageName = "the image";  // the image's file, for messages
+  std::string tissuesPath;  // an explicit tissue table ("": beside S, else the phantom's)
+  bool tissuesAuto = true;  // without an explicit table: look beside S, then the phantom's
+  std::optional<TissueTable> tissues;  // a table in memory (a rig just made); wins over the paths
+  std::string tissuesName = "given";   // how the report names an in-memory table
+  std::string skeletonPath;            // an explicit skeleton ("": beside S)
+  std::optional<Skeleton> skeleton;    // a skeleton in memory; wins over the paths
+  RigSettings settings;  // cage vertices, dilation, mesh size, threads, wholeOrgans; the job adds
+                         // the rigid labels and the joints' refinement
+  int jointRings = -1;   // -1: the pose file's
+  bool autoSeparate = true;
+};
+
+// One pose of one body, decided: everything above, resolved once. G and S must outlive the job.
+class PoseJob {
+ public:
+  // Checks S (and the image, when given) against G's grid (dimensions and matrix), resolves the
+  // pose's joints, picks the tissue table and skeleton, finds the separations and the joints to
+  // refine. Throws repose::Error with one line naming what is wrong.
+  PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRequest request,
+          const Volume* image = nullptr);
+
+  const Pose& pose() const { return pose_; }  // joints resolved to places and axes
+  const RigSettings& settings() const { return settings_; }
+  const PoseSeparations& separations() const { return separations_; }
+  const TissueChoice& tissues() const { return tissues_; }
+  const std::optional<Skeleton>& skeleton() const { return skeleton_; }
+  int jointRings() const { return jointRings_; }
+  // One line each: a tissue table beside S that does not fit G, touching parts left joined.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  // The scene key of the rig this job builds (SceneFolder.h: sceneRigKey), for S at partsPath
+  // ("": the request's).
+  std::string sceneKey(const std::string& partsPath = "") const;
+
+  // Cage and transfer mesh as this job builds them (progress: cage 0-0.5, mesh 0.5-1).
+  RigGeometry buildGeometry(const ProgressFn& progress = {}) const;
+  // The rig of a geometry (built here, or a scene's) for this job's pose, with its joints bent.
+  std::unique_ptr<PoseRig> makeRig(RigGeometry geometry, int threads = 0) const;
+  // A rig for another pose of the same body (an edit of the groups, a live session): the same
+  // joints bent.
+  std::unique_ptr<PoseRig> makeRig(RigGeometry geometry, const Pose& pose, int threads) const;
+  // The frame options the job decides (the tissue table and its name); the caller adds output
+  // spacing, image, progress and warnings.
+  PoseFrameOptions frameOptions() const;
+  // report.json completed with what the job knows: the input, whether the rig came from a scene,
+  // the joint rings, the separations and the skeleton.
+  std::string completeReport(const std::string& reportJson, bool sceneReused) const;
+
+ private:
+  const Volume* organs_;
+  const Volume* parts_;
+  PoseJobRequest request_;
+  Pose pose_;
+  RigSettings settings_;
+  PoseSeparations separations_;
+  TissueChoice tissues_;
+  std::optional<Skeleton> skeleton_;
+  int jointRings_ = 0;
+  std::vector<std::string> warnings_;
+};
 
 }  // namespace repose
