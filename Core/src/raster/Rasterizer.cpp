@@ -520,32 +520,37 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
   const std::vector<std::int32_t> owner = options.pieceLabels == &labels
                                               ? pieceOwnerTets(mesh, labels.geometry(), options)
                                               : std::vector<std::int32_t>();
-  // Each piece tet's map from rest (input IJK) to output IJK.
-  std::vector<Eigen::Matrix<double, 3, 4>> pieceMap;
+  // Each piece tet's map back from output IJK to rest (input IJK): where the piece itself would
+  // sample an output voxel.
+  std::vector<Eigen::Matrix<double, 3, 4>> pieceBack;
   if (!owner.empty()) {
-    pieceMap.resize(std::size_t(mesh.tets.rows()));
+    pieceBack.resize(std::size_t(mesh.tets.rows()));
     for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
       if (!mesh.rigid[std::size_t(t)]) continue;
       Eigen::Matrix3d R, O;
       for (int c = 0; c < 3; ++c) {
-        R.col(c) =
-            in.rest[std::size_t(mesh.tets(t, c + 1))] - in.rest[std::size_t(mesh.tets(t, 0))];
+        R.col(c) = in.rest[std::size_t(mesh.tets(t, c + 1))] - in.rest[std::size_t(mesh.tets(t, 0))];
         O.col(c) = in.out[std::size_t(mesh.tets(t, c + 1))] - in.out[std::size_t(mesh.tets(t, 0))];
       }
-      const Eigen::Matrix3d A = O * R.inverse();
-      pieceMap[std::size_t(t)].leftCols<3>() = A;
-      pieceMap[std::size_t(t)].col(3) =
-          in.out[std::size_t(mesh.tets(t, 0))] - A * in.rest[std::size_t(mesh.tets(t, 0))];
+      const Eigen::Matrix3d B = R * O.inverse();
+      pieceBack[std::size_t(t)].leftCols<3>() = B;
+      pieceBack[std::size_t(t)].col(3) =
+          in.rest[std::size_t(mesh.tets(t, 0))] - B * in.out[std::size_t(mesh.tets(t, 0))];
     }
   }
+  // Whether the piece owning rest voxel `at` would sample another rest voxel at output voxel
+  // (i,j,k): then the piece does not put `at` here (its own tets and rim put it where it does),
+  // and a soft tet that samples `at` here would copy the piece beside itself. Decided in the
+  // input's voxels, whatever the output grid (a thick-slice map posed onto 1 mm).
   auto movedAway = [&](std::int64_t at, std::int64_t i, std::int64_t j, std::int64_t k) {
     const std::int32_t p = owner[std::size_t(at)];
     if (p < 0) return false;
     const Eigen::Vector3d x(double(at % d[0]), double((at / d[0]) % d[1]),
                             double(at / (d[0] * d[1])));
-    const Eigen::Vector3d y =
-        pieceMap[std::size_t(p)].leftCols<3>() * x + pieceMap[std::size_t(p)].col(3);
-    return (y - Eigen::Vector3d(double(i), double(j), double(k))).squaredNorm() > 1.0;
+    const Eigen::Vector3d r =
+        pieceBack[std::size_t(p)].leftCols<3>() * Eigen::Vector3d(double(i), double(j), double(k)) +
+        pieceBack[std::size_t(p)].col(3);
+    return (r - x).cwiseAbs().maxCoeff() > 0.5;
   };
   dispatchScalar(labels.scalarType(), [&](auto* tag) {
     using T = std::remove_pointer_t<decltype(tag)>;
