@@ -17,6 +17,7 @@
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 namespace repose::cli {
 
@@ -36,6 +37,10 @@ int runRig(const Args& args) {
               "totalsegmentator (v2 class names from G's label table), or a CSV "
               "label,bone[,side][,name][,density_kg_m3]",
               "auto")
+      .option("image", "FILE",
+              "the scan G was segmented from (CT or MR, any grid over the same place): the "
+              "body's outline, for segmentations that label organs and bones but not the skin, "
+              "fat and muscle between them (TotalSegmentator's)")
       .option("threads", "N", "worker threads (0: all cores)", "0")
       .flag("json", "print rig.json on stdout");
   declareMemoryOption(p, "G larger than this is refused before it is read");
@@ -55,7 +60,12 @@ int runRig(const Args& args) {
   const Volume organs = readVolume(input, readOptionsWithin(budget, !quiet));
   requirePoseableLabels(organs, input);
 
+  std::optional<Volume> image;
+  if (p.has("image")) image = readVolume(p.get("image"), readOptionsWithin(budget, !quiet));
+
   RigOptions options;
+  options.image = image ? &*image : nullptr;
+  options.imageSource = p.has("image") ? p.get("image") : "the image";
   options.labels = p.get("labels");
   options.source = input;
   options.threads = static_cast<int>(p.getInt("threads"));

@@ -72,8 +72,9 @@ does.)doc")
   m.def(
       "rig_body",
       [](const Volume& organs, const std::string& labels, const std::string& source, int threads,
-         const py::object& progress) {
+         const py::object& progress, const py::object& image) {
         RigOptions o;
+        if (!image.is_none()) o.image = &image.cast<const Volume&>();
         o.labels = labels;
         o.source = source;
         o.threads = threads;
@@ -88,10 +89,12 @@ does.)doc")
         }
       },
       py::arg("organs"), py::kw_only(), py::arg("labels") = "auto", py::arg("source") = "G",
-      py::arg("threads") = 0, py::arg("progress") = py::none(),
+      py::arg("threads") = 0, py::arg("progress") = py::none(), py::arg("image") = py::none(),
       R"doc(Rigs a segmentation G from its bones (`repose rig`): the body-part map S, the skeleton
 and the tissue table. labels: "auto", "phantom", "icrp110", "totalsegmentator" or a CSV path
-(label,bone[,side][,name][,density_kg_m3]).)doc");
+(label,bone[,side][,name][,density_kg_m3]). image: the scan G was segmented from (a CT or MR
+Volume, any grid over the same place), whose outline is the body where G labels organs and bones
+but not the tissue between them.)doc");
 }
 
 }  // namespace repose::python

@@ -433,7 +433,9 @@ LabelConvention labelConvention(const Volume& organs, const std::string& request
     if (phantomBones >= 3 && phantomNames * 2 >= int(labels.size())) {
       c = byNames(organs, labels, "phantom", phantomRole);
       c.detection = "auto: G's label names are the phantom's";
-    } else if (tsBones >= 3 && tsNames * 2 >= int(labels.size())) {
+    } else if ((tsBones >= 3 || tsNames >= 5) && tsNames * 2 >= int(labels.size())) {
+      // Names alone tell TotalSegmentator (an abdominal MR of its total_mr task names one bone,
+      // the vertebrae): whether its bones make a rig is said next, by name.
       c = byNames(organs, labels, "totalsegmentator", totalSegmentatorRole);
       c.detection = "auto: G's label names are TotalSegmentator's";
     } else if (icrpValues && icrpBones) {

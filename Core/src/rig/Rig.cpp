@@ -10,6 +10,8 @@
 
 #include <Eigen/LU>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +19,22 @@
 namespace repose {
 
 using rig::V;
+
+namespace {
+// Whether G names any soft tissue of the body's wall (skin, fat, muscle, ICRP's residual tissue,
+// a body mask): without one, an organ segmentation's bones float in unlabelled space.
+bool labelsSoftTissue(const LabelConvention& convention) {
+  for (const auto& [value, role] : convention.roles) {
+    std::string name = role.name;
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) {
+      return char(std::tolower(c));
+    });
+    for (const char* word : {"skin", "fat", "adipose", "muscle", "residual", "body"})
+      if (name.find(word) != std::string::npos) return true;
+  }
+  return false;
+}
+}  // namespace
 
 RigResult rigBody(const Volume& organs, const RigOptions& options) {
   const std::string& source = options.source;
@@ -37,13 +55,44 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
     limb = limb || bones.find(BoneKind::Humerus, side) || bones.find(BoneKind::Femur, side);
   if (!limb) throw Error(source + ": no humerus or femur found: nothing to rig beyond the torso");
   out.warnings = bones.frame.warnings;
+  // A limb bone the scan cuts (a chest CT through the humeral heads): its end may be the cut,
+  // not the joint's surface, and a joint fitted to it is a guess.
+  for (const auto& [key, bone] : bones.byKind) {
+    if (bone.side == 0) continue;
+    const bool cut = std::any_of(bone.voxels.begin(), bone.voxels.end(), [&](std::int64_t v) {
+      const std::int64_t ijk[3] = {v % grid.dims[0], (v / grid.dims[0]) % grid.dims[1],
+                                   v / (grid.dims[0] * grid.dims[1])};
+      for (int a = 0; a < 3; ++a)
+        if (ijk[a] == 0 || ijk[a] == grid.dims[a] - 1) return true;
+      return false;
+    });
+    if (cut)
+      out.warnings.push_back(std::string("the scan's edge cuts the ") +
+                             (bone.side < 0 ? "left " : "right ") + boneKindName(bone.kind) +
+                             ": a joint fitted to its cut end is a guess");
+  }
   out.warnings.insert(out.warnings.end(), out.convention.notes.begin(), out.convention.notes.end());
 
   reportProgress(options.progress, 0.3, "rig: joints");
   const std::vector<rig::FittedJoint> joints = rig::fitJoints(bones, out.missing);
   reportProgress(options.progress, 0.4, "rig: body parts");
   rig::PartStats stats;
-  out.parts = rig::assignParts(organs, out.convention, bones, joints, grid, options.threads, stats);
+  std::vector<std::uint8_t> outline;
+  std::string outlineHow;
+  if (options.image) {
+    try {
+      outline = rig::bodyOutline(*options.image, organs, grid, outlineHow);
+    } catch (const Error& e) {
+      throw Error(options.imageSource + ": " + e.what());
+    }
+  } else if (!labelsSoftTissue(out.convention)) {
+    out.warnings.push_back(
+        "G labels no skin, fat or muscle: S holds only its labelled structures, and the tissue "
+        "between them is not posed; give the scan it was segmented from (--image) for the body's "
+        "outline, or a segmentation of the body");
+  }
+  out.parts = rig::assignParts(organs, out.convention, bones, joints, grid, options.threads, stats,
+                               options.image ? &outline : nullptr);
   if (stats.unreached > 0)
     out.warnings.push_back(std::to_string(stats.unreached) +
                            " body voxels are joined to no bone (a separate piece): put in the "
@@ -117,6 +166,10 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
                            {"missing", out.missing},
                            {"warnings", out.warnings},
                            {"parts", partsJson},
+                           {"body_outline", options.image
+                                                ? nlohmann::json{{"image", options.imageSource},
+                                                                 {"method", outlineHow}}
+                                                : nlohmann::json()},
                            {"unreached_voxels", stats.unreached}};
   out.reportJson = report.dump();
   out.skeleton.source = "";

@@ -87,9 +87,19 @@ LabelTable rigPartLabels();
 struct PartStats {
   std::int64_t unreached = 0;  // body voxels no bone's flood reached (taken as torso)
 };
+// `body` (optional): the body's voxels where G labels no tissue (bodyOutline), which any flood
+// may cross.
 Volume assignParts(const Volume& organs, const LabelConvention& convention, const Bones& bones,
                    const std::vector<FittedJoint>& joints, const Grid& grid, int threads,
-                   PartStats& stats);
+                   PartStats& stats, const std::vector<std::uint8_t>* body = nullptr);
+
+// The body on G's grid from the scan G was segmented from (any grid over the same place): a CT
+// above -300 HU (else the image above its Otsu threshold), its connected pieces that hold some of
+// G's labels (not the table), with G's labels, and the holes of each slice filled (lungs, bowel
+// gas). `how` says so, with the body
+// found beyond G's labels. Throws repose::Error when the image covers less than half of G.
+std::vector<std::uint8_t> bodyOutline(const Volume& image, const Volume& organs, const Grid& grid,
+                                      std::string& how);
 
 // How far from its centre each joint's two parts meet across its plane (radius_mm).
 double jointRadius(const Volume& parts, const FittedJoint& joint, const Grid& grid);

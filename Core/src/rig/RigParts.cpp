@@ -64,7 +64,7 @@ bool beyond(const FittedJoint* j, const V& p) {
 
 Volume assignParts(const Volume& organs, const LabelConvention& convention, const Bones& bones,
                    const std::vector<FittedJoint>& joints, const Grid& grid, int threads,
-                   PartStats& stats) {
+                   PartStats& stats, const std::vector<std::uint8_t>* body) {
   const std::int64_t n = grid.count();
   const auto& d = grid.dims;
   // Per voxel: which floods it may join (0: not body).
@@ -83,6 +83,10 @@ Volume assignParts(const Volume& organs, const LabelConvention& convention, cons
       }
     });
   }
+  // The body beyond G's labels (the image's outline): tissue no label names, any flood's.
+  if (body)
+    for (std::int64_t i = 0; i < n; ++i)
+      if ((*body)[std::size_t(i)] && !allowed[std::size_t(i)]) allowed[std::size_t(i)] = 31;
   // The distance of every body voxel to the body's surface (mm).
   std::vector<std::uint8_t> outside(static_cast<std::size_t>(n));
   for (std::int64_t i = 0; i < n; ++i) outside[std::size_t(i)] = allowed[std::size_t(i)] == 0;

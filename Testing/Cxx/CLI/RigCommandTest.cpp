@@ -148,17 +148,61 @@ TEST(RigCommand, SeparationsDrawnByHandPoseTheArmsTouchingPhantom) {
 }
 
 TEST(RigCommand, ASegmentationWithoutLimbBonesIsAOneLineErrorAndWritesNothing) {
-  const std::string seg = std::string(REPOSE_DATA_DIR) + "/totalsegmentator/example_seg.nii.gz";
-  if (!std::filesystem::exists(seg)) GTEST_SKIP() << seg << " not found";
+  // TotalSegmentator's CT example (a chest) and its MR one (an abdomen, the total_mr task's
+  // names: one bone, the vertebrae): both told by their names, both without limb bones.
+  for (const char* file : {"example_seg.nii.gz", "example_seg_mr.nii.gz"}) {
+    const std::string seg = std::string(REPOSE_DATA_DIR) + "/totalsegmentator/" + file;
+    if (!std::filesystem::exists(seg)) GTEST_SKIP() << seg << " not found";
+    ScratchDir dir;
+    const CommandResult r = runCommand(
+        "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("rig")));
+    EXPECT_NE(r.exitCode, 0) << file;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("humerus"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("femur"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("rig")));
+  }
+}
+
+TEST(RigCommand, ARealOrganSegmentationTakesItsBodyFromItsCtSeries) {
+  // TotalSegmentator's segmentation of a real 20-slice CT (both humeral heads in it), rigged
+  // without and with the DICOM series it was made from (LPS, rows flipped against the NIfTI).
+  const std::string data = std::string(REPOSE_DATA_DIR) + "/totalsegmentator/";
+  const std::string seg = data + "example_seg_dicom.nii.gz";
+  const std::string ct = data + "example_ct_dicom_uncompressed";
+  if (!std::filesystem::exists(seg) || !std::filesystem::exists(ct)) GTEST_SKIP() << "no data";
   ScratchDir dir;
-  const CommandResult r = runCommand(
-      "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("rig")));
-  EXPECT_NE(r.exitCode, 0);
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_NE(r.err.find("example_seg.nii.gz"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("humerus"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("femur"), std::string::npos) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir.file("rig")));
+  const CommandResult bare = runCommand(
+      "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("bare")));
+  ASSERT_EQ(bare.exitCode, 0) << bare.err;
+  EXPECT_NE(bare.err.find("no skin, fat or muscle"), std::string::npos) << bare.err;
+  const CommandResult withCt =
+      runCommand("repose", "rig --input " + shellQuote(seg) + " --image " + shellQuote(ct) +
+                               " --out " + shellQuote(dir.file("ct")) + " --json");
+  ASSERT_EQ(withCt.exitCode, 0) << withCt.err;
+  EXPECT_EQ(withCt.err.find("no skin, fat or muscle"), std::string::npos) << withCt.err;
+  // The 40 mm slab cuts both humeri: their shoulder fits are said to be guesses.
+  for (const char* side : {"left", "right"})
+    EXPECT_NE(withCt.err.find(std::string("the scan's edge cuts the ") + side + " humerus"),
+              std::string::npos)
+        << withCt.err;
+  const nlohmann::json a = readJsonFile(dir.file("bare/rig.json")),
+                       b = nlohmann::json::parse(withCt.out);
+  EXPECT_EQ(b["body_outline"]["image"], ct);
+  auto partMl = [](const nlohmann::json& r, const std::string& name) {
+    for (const auto& p : r["parts"])
+      if (p["part"] == name) return p["volume_ml"].get<double>();
+    return 0.0;
+  };
+  // Bare, an upper arm is its humerus alone; with the CT, the arm's flesh too (several times
+  // the bone), and the trunk's unlabelled fat and muscle join the torso.
+  for (const char* arm : {"upper_arm_left", "upper_arm_right"}) {
+    EXPECT_GT(partMl(a, arm), 10) << arm;
+    EXPECT_GT(partMl(b, arm), 4 * partMl(a, arm)) << arm;
+  }
+  EXPECT_GT(partMl(b, "torso"), 1.5 * partMl(a, "torso"));
+  EXPECT_EQ(b["unreached_voxels"], 0);
 }
 
 TEST(RigCommand, AThickSliceBodyPosedOntoAFinerGridKeepsEveryBone) {

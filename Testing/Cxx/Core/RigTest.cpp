@@ -1,9 +1,10 @@
 // `repose rig` from the organ map alone (rig/Rig.h), checked against the generated phantom's own
 // truth: its body-part map S on >= 95 % of body voxels and its joint centres within 5 mm, on the
 // free-armed phantom, the arms-resting one (arms on the trunk, hands on the thighs, thighs
-// touching) at 2 mm, its thick-slice variant (1.8 x 1.8 x 4.8 mm) and its ICRP 110 labelling (no
-// sides in the bone labels); a CSV convention gives the phantom's rig; a body without arms is
-// rigged for its legs and says which joints it could not make.
+// touching) at 2 mm, its thick-slice variant (1.8 x 1.8 x 4.8 mm), its ICRP 110 labelling (no
+// sides in the bone labels) and the ICRP adult male's 8 mm slices; a CSV convention gives the
+// phantom's rig; a body without arms is rigged for its legs and says which joints it could not
+// make; an organ segmentation (no skin, fat or muscle) gets its body from its CT.
 #include "repose/phantom/Phantom.h"
 #include "repose/rig/Rig.h"
 #include "repose/util/Error.h"
@@ -11,6 +12,9 @@
 #include "TestPaths.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 
 #include <fstream>
 #include <map>
@@ -58,6 +62,8 @@ TEST_P(RigPhantom, ReproducesThePhantomsPartsAndJoints) {
   ro.source = v.name;
   const RigResult rig = rigBody(G, ro);
   EXPECT_TRUE(rig.missing.empty()) << rig.missing.front();
+  for (const std::string& w : rig.warnings)  // the phantom's margin leaves every bone whole
+    EXPECT_EQ(w.find("edge cuts"), std::string::npos) << w;
   EXPECT_GE(agreement(S, rig.parts), 0.95);
   // The parts keep the phantom's names and numbers, so pose files written for it pose this rig.
   for (const Label& l : S.labels().labels())
@@ -181,5 +187,65 @@ TEST(Rig, NoLimbBonesIsAOneLineErrorNamingThem) {
     EXPECT_NE(m.find("trunk.nii.gz"), std::string::npos) << m;
     EXPECT_NE(m.find("humerus"), std::string::npos) << m;
     EXPECT_NE(m.find("femur"), std::string::npos) << m;
+  }
+}
+
+TEST(Rig, AnOrganSegmentationIsGivenItsBodyByTheScanItWasMadeFrom) {
+  // TotalSegmentator-like: the arms-resting phantom's organs and bones only (skin, fat, muscle
+  // and vessels erased to 0), and the CT of the whole phantom.
+  PhantomOptions o;
+  o.voxelMm = 4;
+  o.armsResting = true;
+  const Phantom phantom(o);
+  const auto [G, S] = phantom.makeVolumes();
+  const Volume ct = syntheticCT(G);
+  Volume organs = G;
+  std::int64_t erased = 0;
+  for (std::int64_t i = 0; i < organs.numVoxels(); ++i) {
+    const Label* l = G.labels().find(int(G.valueAsDouble(i)));
+    const std::string name = l ? l->name : "";
+    if (name == "skin" || name == "subcutaneous_fat" || name == "muscle" ||
+        name.rfind("blood_vessels", 0) == 0) {
+      organs.data<std::uint8_t>()[i] = 0;
+      ++erased;
+    }
+  }
+  ASSERT_GT(erased, G.numVoxels() / 10);
+  RigOptions ro;
+  ro.source = "organs";
+  // Without the scan: S is the organs alone, and the rig says the tissue between is missing.
+  const RigResult bare = rigBody(organs, ro);
+  EXPECT_TRUE(std::any_of(bare.warnings.begin(), bare.warnings.end(), [](const std::string& w) {
+    return w.find("no skin, fat or muscle") != std::string::npos &&
+           w.find("--image") != std::string::npos;
+  }));
+  // With it: the body's outline is the phantom's, and its parts are the phantom's own on >= 95 %
+  // of the body (the arm resting on the trunk still goes to the arm).
+  ro.image = &ct;
+  const RigResult rig = rigBody(organs, ro);
+  EXPECT_TRUE(std::none_of(rig.warnings.begin(), rig.warnings.end(), [](const std::string& w) {
+    return w.find("no skin, fat or muscle") != std::string::npos;
+  }));
+  std::int64_t body = 0, inOutline = 0;
+  for (std::int64_t i = 0; i < S.numVoxels(); ++i)
+    if (S.valueAsDouble(i) > 0) ++body, inOutline += rig.parts.valueAsDouble(i) > 0;
+  EXPECT_GE(double(inOutline) / double(body), 0.98);
+  EXPECT_GE(agreement(S, rig.parts), 0.95);
+  EXPECT_NE(nlohmann::json::parse(rig.reportJson)["body_outline"]["method"].get<std::string>().find(
+                "CT above -300 HU"),
+            std::string::npos);
+  // A scan of somewhere else is refused by name.
+  Volume elsewhere = ct;
+  VolumeGeometry far = ct.geometry();
+  far.ijkToRas(2, 3) += 5000;
+  elsewhere.setGeometry(far);
+  ro.image = &elsewhere;
+  ro.imageSource = "CT.nii.gz";
+  try {
+    rigBody(organs, ro);
+    FAIL() << "a scan that misses G was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("CT.nii.gz: the image covers 0 %"), std::string::npos)
+        << e.what();
   }
 }

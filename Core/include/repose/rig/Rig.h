@@ -20,6 +20,10 @@ namespace repose {
 struct RigOptions {
   std::string labels = "auto";  // phantom, icrp110, totalsegmentator, auto, or a CSV path
   std::string source = "G";     // the file G came from, for messages
+  // The scan G was segmented from (CT, MR; any grid over the same place): the body's outline,
+  // so S covers the skin, fat and muscle an organ segmentation leaves unlabelled.
+  const Volume* image = nullptr;
+  std::string imageSource = "the image";
   int threads = 0;
   ProgressFn progress;
 };
