@@ -305,8 +305,8 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
             return rigid.empty() ? std::vector<int>(std::size_t(r.rig->mesh().tets.rows()), 0)
                                  : rigid;
           },
-          "Per tet: the label of G of the whole piece (bone, organ) it belongs to, 0 for soft "
-          "tissue.")
+          "Per tet: the whole piece (bone, organ) it belongs to, 0 for soft tissue: the piece's "
+          "label of G, or for a bone of several labels (cortex, marrow) its smallest.")
       .def_property_readonly(
           "tissue_table", [](const Rig& r) { return r.job->tissues().name; },
           "Which tissue table gives densities and bones ('phantom default', a path, or 'none').")

@@ -155,8 +155,8 @@ def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     # Out of core, under a small budget: the labels in core, except where the in-core frame
     # uses G and S at rest, which the stream does not hold (docs/ARCHITECTURE.md, "Whole
     # pieces"): a bone's rim moved with the bone, the shell outside the body kept off a
-    # neighbour's tissue. Those differ only beside a bone or at the body's surface, in a handful
-    # of voxels.
+    # neighbour's tissue and off the voxels another part's shell fills with its skin. Those differ
+    # only beside a bone or at the body's surface, in a few dozen voxels (53 of 511K at 8 mm).
     rp.write_volume(g, str(tmp_path / "G.nii"))
     elbow_rig.pose_labels_to_file(str(tmp_path / "G.nii"), str(tmp_path / "posed.nii.gz"),
                                   memory_bytes=32 * 2**20)
@@ -164,7 +164,7 @@ def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     streamed = np.asanyarray(nib.load(tmp_path / "posed.nii.gz").dataobj)
     assert streamed.shape == in_core.shape
     differ = np.argwhere(streamed != in_core)
-    assert len(differ) <= 1e-4 * in_core.size
+    assert len(differ) <= 2e-4 * in_core.size
     bones = set(phantom_bones(g)) | {0}  # a bone, or outside the body
     for i, j, k in differ:
         near = in_core[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]

@@ -12,11 +12,14 @@
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
 #include <CGAL/Random.h>
+#include <CGAL/Mesh_3/initialize_triangulation_from_labeled_image.h>
 #include <CGAL/make_mesh_3.h>
 
 #include <Eigen/LU>
 #include <cstring>
+#include <iostream>
 #include <map>
+#include <sstream>
 
 namespace repose {
 namespace {
@@ -48,6 +51,30 @@ struct SizeFunction {
   double scale;
   FT operator()(const Point_3& p, int, const Index&) const {
     return scale * field->at(frame->toRas(p.x(), p.y(), p.z()));
+  }
+};
+
+// CGAL's labelled-image initializer reports to std::cout, where `repose ... --json` writes its
+// JSON: its lines go nowhere while it runs.
+class QuietStdout {
+ public:
+  QuietStdout() : old_(std::cout.rdbuf(sink_.rdbuf())) {}
+  ~QuietStdout() { std::cout.rdbuf(old_); }
+  QuietStdout(const QuietStdout&) = delete;
+  QuietStdout& operator=(const QuietStdout&) = delete;
+
+ private:
+  std::ostringstream sink_;
+  std::streambuf* old_;
+};
+
+// Subdomain index -> the body part it meshes, for finding the parts' connected components (a
+// piece inside a part belongs to the part's component).
+struct PartOfSubdomain {
+  using result_type = std::uint16_t;
+  const std::vector<std::pair<int, int>>* subdomains = nullptr;  // null: the index is the part
+  std::uint16_t operator()(std::uint16_t word) const {
+    return subdomains ? std::uint16_t((*subdomains)[word].first) : word;
   }
 };
 
@@ -132,10 +159,22 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
   // Exudation removes slivers (without it dihedral angles go down to 0.1 degree, which makes the
   // tets' linear maps ill-conditioned); no time limit, since a limit makes the result depend on
   // the machine's speed. Perturbation costs seconds for little more.
-  const C3t3 c3t3 =
-      CGAL::make_mesh_3<C3t3>(domain, criteria, CGAL::parameters::no_perturb(),
-                              CGAL::parameters::exude(CGAL::parameters::time_limit = 0,
-                                                      CGAL::parameters::sliver_bound = 10));
+  // The initial points come from every connected component of every body part (points on its
+  // surface seen from its deepest voxel), not only from rays shot from the image's centre: those
+  // can miss a small part, and a hand on 8 mm slices got no tet at all (CGAL's
+  // initialize_triangulation_from_labeled_image, as in its mesh_3D_image_with_custom_initialization
+  // example). Components of parts, not of every (part, piece) subdomain: seeding each bone
+  // fragment of a thick-slice map made five times the tets.
+  C3t3 c3t3;
+  {
+    const QuietStdout quiet;
+    initialize_triangulation_from_labeled_image(c3t3, domain, image, criteria, std::uint16_t(),
+                                                false,
+                                                PartOfSubdomain{rigid ? &subdomains : nullptr});
+  }
+  CGAL::refine_mesh_3(c3t3, domain, criteria, CGAL::parameters::no_perturb(),
+                      CGAL::parameters::exude(CGAL::parameters::time_limit = 0,
+                                              CGAL::parameters::sliver_bound = 10));
   reportProgress(options.progress, 0.9, "transfer mesh");
 
   TransferMesh mesh;

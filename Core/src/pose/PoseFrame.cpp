@@ -166,6 +166,7 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   ro.outerFaces = &outer;
   ro.restParts = &parts;
   ro.pieceLabels = &organs;
+  ro.bonePieces = &options.bonePieces;
   RasterReport raster;
   out.organs = rasterizeLabels(organs, mesh, frame.deformed, out.grid, ro, &raster);
   ro.progress = {};
@@ -188,6 +189,8 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   std::int64_t pieceTets = 0;
   for (const int label : mesh.rigid)
     if (label != 0) pieceLabels.insert(label), ++pieceTets;
+  for (const auto& [label, piece] : options.bonePieces)
+    if (pieceLabels.count(piece)) pieceLabels.insert(label);
   std::vector<std::string> groupNames;
   for (const PoseGroup& g : rig.pose().groups) groupNames.push_back(g.name);
   PoseReportInput ri;

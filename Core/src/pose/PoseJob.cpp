@@ -186,7 +186,10 @@ PoseJob::PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRe
   }
   if (!tissues_.warning.empty()) warnings_.push_back(tissues_.warning);
   settings_ = request_.settings;
-  if (tissues_.table) settings_.rigidLabels = rigidLabelsOf(*tissues_.table);
+  if (tissues_.table) {
+    settings_.rigidLabels = rigidLabelsOf(*tissues_.table);
+    settings_.bonePieces = bonePiecesOf(*tissues_.table);
+  }
   jointRings_ = request_.jointRings >= 0 ? request_.jointRings : pose_.jointRings;
   const Skeleton* skeleton = skeleton_ ? &*skeleton_ : nullptr;
   separations_ = poseSeparations(pose_, parts, skeleton, request_.autoSeparate);
@@ -220,6 +223,7 @@ PoseFrameOptions PoseJob::frameOptions() const {
   o.tissues = tissues_.table ? &*tissues_.table : nullptr;
   o.tissueTableName = tissues_.name;
   o.threads = settings_.threads;
+  o.bonePieces = settings_.bonePieces;
   return o;
 }
 

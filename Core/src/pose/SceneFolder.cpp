@@ -30,6 +30,12 @@ std::string sceneRigKey(const std::string& partsPath, const std::vector<LimbSepa
       {"dilate_mm", settings.dilateMm},
       {"mesh_size_mm", settings.meshMm},
       {"rigid_labels", settings.rigidLabels},
+      {"bone_pieces",
+       [&] {
+         json pairs = json::array();
+         for (const auto& [label, piece] : settings.bonePieces) pairs.push_back({label, piece});
+         return pairs;
+       }()},
       {"whole_organs", settings.wholeOrgans},
       {"refine_joints",
        [&] {

@@ -190,3 +190,78 @@ TEST(PoseRig, EveryPieceMovesExactlyWithOneGroupInEveryFrame) {
       EXPECT_EQ(groups.size(), 1u) << "frame " << f << ", body part " << part;
   }
 }
+
+TEST(PoseRig, ABoneOfSeveralLabelsIsMeshedAsOnePiece) {
+  // The tissue table's bone column groups a bone's labels under its smallest one; other rigid
+  // labels (no bone named) and soft tissue have no entry.
+  TissueTable table;
+  table[11] = {"humerus", 1908, true, "humerus"};
+  table[28] = {"humerus_marrow", 1178, true, "humerus"};
+  table[14] = {"femur", 1908, true, "femur"};
+  table[30] = {"femur_marrow", 1178, true, "femur"};
+  table[40] = {"patella", 1900, true, ""};
+  table[3] = {"muscle", 1050, false, ""};
+  const std::map<int, int> pieces = bonePiecesOf(table);
+  EXPECT_EQ(pieces, (std::map<int, int>{{11, 11}, {28, 11}, {14, 14}, {30, 14}}));
+
+  // The arms-resting phantom's long bones are a cortex and a marrow: one piece each, so no tet
+  // carries a marrow label as its piece and the marrow lies in its bone's piece tets.
+  PhantomOptions o;
+  o.voxelMm = 4;
+  o.armsResting = true;
+  const auto [organs, parts] = Phantom(o).makeVolumes();
+  const TissueTable tissues =
+      readTissueTable(std::string(REPOSE_SOURCE_DIR) + "/Resources/Tissues/phantom.csv");
+  RigSettings settings;
+  for (const auto& [label, tissue] : tissues)
+    if (tissue.rigid) settings.rigidLabels.push_back(label);
+  settings.bonePieces = bonePiecesOf(tissues);
+  settings.cageVertices = 200;
+  const int humerus = labelNamed(organs, "humerus"), marrow = labelNamed(organs, "humerus_marrow");
+  ASSERT_EQ(settings.bonePieces.at(marrow), humerus);
+  const Volume map = wholePieceMap(organs, parts, settings);
+  std::int64_t marrowVoxels = 0, marrowInHumerus = 0;
+  for (std::int64_t i = 0; i < organs.numVoxels(); ++i)
+    if (organs.valueAsDouble(i) == marrow) {
+      ++marrowVoxels;
+      marrowInHumerus += map.valueAsDouble(i) == humerus;
+      ASSERT_NE(map.valueAsDouble(i), marrow);
+    }
+  EXPECT_GE(marrowInHumerus, 0.9 * double(marrowVoxels));  // all but the seam at the joints
+
+  const RigGeometry g = buildRigGeometry(parts, {}, settings, {}, &organs);
+  std::int64_t humerusTets = 0, marrowCentres = 0, marrowCentresInPiece = 0;
+  for (Eigen::Index t = 0; t < g.mesh.tets.rows(); ++t) {
+    ASSERT_NE(g.mesh.rigid[t], marrow);
+    humerusTets += g.mesh.rigid[t] == humerus;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += g.mesh.vertices.row(g.mesh.tets(t, k)).transpose() / 4;
+    const Eigen::Vector3d ijk = organs.geometry().rasToVoxel(c);
+    if (organs.valueAsDouble(organs.index(std::lround(ijk.x()), std::lround(ijk.y()),
+                                          std::lround(ijk.z()))) != marrow)
+      continue;
+    ++marrowCentres;
+    marrowCentresInPiece += g.mesh.rigid[t] == humerus;
+  }
+  EXPECT_GT(humerusTets, 0);
+  ASSERT_GT(marrowCentres, 0);
+  EXPECT_GE(marrowCentresInPiece, 0.8 * double(marrowCentres));
+}
+
+TEST(PoseRig, WherePiecesOfTwoPartsShareAVertexOnlyTheSmallerSideGoesSoft) {
+  // Two rigid tets of different parts meet at vertex 0: the larger (part 1) keeps it; the
+  // smaller (part 2) becomes soft tissue. Before, both went soft, and a bone end beside a bent
+  // joint bent with it on both sides.
+  TransferMesh mesh;
+  mesh.vertices.resize(7, 3);
+  mesh.vertices << 0, 0, 0, 10, 0, 0, 0, 10, 0, 0, 0, 10,  // part 1's tet: 166.7 mm^3
+      -2, 0, 0, 0, -2, 0, 0, 0, -2;                        // part 2's tet: 1.3 mm^3
+  mesh.tets.resize(2, 4);
+  mesh.tets << 0, 1, 2, 3, 0, 5, 4, 6;
+  mesh.labels.resize(2);
+  mesh.labels << 1, 2;
+  mesh.rigid = {11, 14};
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 1);
+  EXPECT_EQ(mesh.rigid, (std::vector<int>{11, 0}));
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
+}

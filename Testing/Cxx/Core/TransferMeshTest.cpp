@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -289,4 +290,32 @@ TEST(TransferMesh, CleaningDropsFlatTetsAndReorientsInvertedOnes) {
   cleanTransferMesh(mirrored, -1.0, report);
   EXPECT_EQ(report.invertedTets, 0);
   EXPECT_EQ(report.degenerateTets, 0);
+}
+
+TEST(TransferMesh, EveryBodyPartGetsItsTetsOnThickSlices) {
+  // A small part against a large one on 8 mm slices (a hand resting on a thigh): the meshing
+  // starts from a point in every connected component of every part, so the small part gets tets
+  // covering about its volume (rays shot from the image's centre once left a hand with none).
+  VolumeGeometry g;
+  g.dims = {80, 40, 30};
+  g.ijkToRas.diagonal() << 2, 2, 8, 1;
+  Volume s(g, ScalarType::UInt8);
+  std::int64_t small = 0;
+  for (std::int64_t k = 0; k < g.dims[2]; ++k)
+    for (std::int64_t j = 0; j < g.dims[1]; ++j)
+      for (std::int64_t i = 0; i < g.dims[0]; ++i) {
+        std::uint8_t part = 0;
+        if (i >= 5 && i <= 70 && j >= 5 && j <= 35 && k >= 2 && k <= 27) part = 1;
+        if (i >= 71 && i <= 75 && j >= 15 && j <= 22 && k >= 2 && k <= 4) part = 2, ++small;
+        s.data<std::uint8_t>()[s.index(i, j, k)] = part;
+      }
+  for (const double size : {0.0, 30.0}) {
+    TransferMeshOptions o;
+    o.sizeMm = size;  // 0: 5 % of the diagonal
+    const TransferMesh mesh = buildTransferMesh(s, o);
+    double volume = 0;
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+      if (mesh.labels[t] == 2) volume += std::fabs(tetVolume(mesh.vertices, mesh.tets.row(t)));
+    EXPECT_NEAR(volume, double(small) * 32.0, 0.5 * double(small) * 32.0) << "size " << size;
+  }
 }

@@ -17,9 +17,10 @@ struct TransferMesh {
   Eigen::MatrixX3d vertices;  // #V by 3 rest positions, RAS mm
   Eigen::MatrixX4i tets;      // #T by 4 vertex indices, positively oriented (volume > 0)
   Eigen::VectorXi labels;     // #T body-part label (subdomain of S) of each tet
-  // #T labels of rigid tissue (bone; a label of G), 0 for soft tissue; empty when not meshed with
-  // bones. Bones are subdomains of their own (TransferMeshOptions::rigidTissue), so a bone is a
-  // union of whole tets, which a pose moves as one piece (computeHandleInfluence).
+  // #T piece ids of rigid tissue (bone: a label of G, or for a bone of several labels its smallest,
+  // RigSettings::bonePieces), 0 for soft tissue; empty when not meshed with bones. Bones are
+  // subdomains of their own (TransferMeshOptions::rigidTissue), so a bone is a union of whole tets,
+  // which a pose moves as one piece (computeHandleInfluence).
   std::vector<int> rigid;
   // The largest voxel size of the grid it was meshed from (mm; 0 when unknown). Mesh_3 puts the
   // surface to within about this of the label boundary; the rasterizer's shell covers the gap.

@@ -33,6 +33,8 @@ struct PoseFrameOptions {
   // (before rasterizing), rigid pieces run into each other, folds. The report's "warnings"
   // holds them too.
   std::function<void(const std::string&)> warn;
+  // The rig's RigSettings::bonePieces: which labels of G a bone's one piece holds.
+  std::map<int, int> bonePieces;
 };
 
 struct PosedFrame {

@@ -10,8 +10,10 @@
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
 #include "repose/util/Progress.h"
+#include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 
+#include <map>
 #include <memory>
 
 namespace repose {
@@ -33,6 +35,12 @@ struct RigSettings {
   // Labels of G that are rigid tissue (bones; TissueTable's rigid column). Meshed as pieces of
   // their own that a pose moves whole with their body part, so they stay rigid at the joints.
   std::vector<int> rigidLabels;
+  // Labels of one bone (TissueTable's bone column: a humerus's cortex, spongiosa and marrow) ->
+  // the id of the one piece they are meshed as: the bone's smallest label. A bone is one rigid
+  // body however many labels segment it; meshed label by label, a one-voxel cortex on thick
+  // slices (Mesh_3 follows borders to within the largest spacing) gets no tets of its own and
+  // bends with the soft tissue at the joint. Labels not listed are pieces of their own.
+  std::map<int, int> bonePieces;
   // Also mesh as whole pieces the labels of G that lie in one body part of S (organs: the
   // bladder beside the hip moves with the pelvis instead of bending with the thigh).
   bool wholeOrgans = true;
@@ -60,14 +68,19 @@ struct RigGeometry {
   TransferMesh mesh;
 };
 
+// settings.bonePieces for a tissue table: each bone's rigid labels -> the bone's smallest label.
+std::map<int, int> bonePiecesOf(const TissueTable& table);
+
 // The map buildRigGeometry meshes the pieces from (TransferMeshOptions::rigidTissue): on S's grid,
-// the label of G where it is one of the labelsMovingWhole, else 0, with a seam of 0 where pieces
+// the piece of G's label (settings.bonePieces, else the label) where it is one of the
+// labelsMovingWhole, else 0, with a seam of 0 where pieces
 // of different body parts touch (a joint). An empty Volume when no label moves whole.
 Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSettings& settings);
 
-// Tets of pieces that share a vertex with a piece of another body part (a bone end meshed onto
-// its neighbour across a joint, closer than the seam) become soft tissue, so that pieces of
-// different parts never share a vertex and each moves exactly with its group. Returns how many.
+// Where pieces of two body parts share a vertex (a bone end meshed onto its neighbour across a
+// joint, closer than the seam), the part with more piece volume around the vertex keeps it and
+// the other parts' piece tets at it become soft tissue, so that pieces of different parts never
+// share a vertex and each moves exactly with its group. Returns how many tets went soft.
 int demotePiecesAcrossJoints(TransferMesh& mesh);
 
 // Cage and transfer mesh of S, separated where asked; with G (organs, on S's grid) the mesh has

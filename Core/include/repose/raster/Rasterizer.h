@@ -55,11 +55,15 @@ struct RasterOptions {
   // boundary tets into the trunk's tissue it rested against (thick slices make the shell wide:
   // 9.6 mm on 4.8 mm slices). Costs one coverage scan of the rest mesh on the input's grid.
   const Volume* restParts = nullptr;
-  // The label map G the mesh's whole pieces come from (TransferMesh::rigid holds their labels),
+  // The label map G the mesh's whole pieces come from (TransferMesh::rigid holds their ids),
   // on the input's grid. With it each piece also writes its rim: the voxels of its own label
   // within a voxel beyond its tets (Mesh_3 puts a piece's surface only that close), over the
   // soft tissue around it, so a bone or organ beside a bending joint keeps all its voxels.
   const Volume* pieceLabels = nullptr;
+  // Labels of pieceLabels meshed in a piece whose id is another label (RigSettings::bonePieces:
+  // a bone's cortex and marrow are one piece): label -> piece id. Labels not listed are their
+  // own piece's id.
+  const std::map<int, int>* bonePieces = nullptr;
 };
 
 struct RasterReport {
