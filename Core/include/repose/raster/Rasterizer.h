@@ -51,9 +51,11 @@ struct RasterOptions {
   const std::vector<std::uint8_t>* outerFaces = nullptr;  // outerFaces(mesh), computed if null
   // The body-part map S the mesh was built from (its tets' labels), on the input's grid. With
   // it a tet's shell does not write a voxel whose rest position is another part's tissue that a
-  // rest tet already carries: a limb moved away from the trunk does not extrapolate its
-  // boundary tets into the trunk's tissue it rested against (thick slices make the shell wide:
-  // 9.6 mm on 4.8 mm slices). Costs one coverage scan of the rest mesh on the input's grid.
+  // rest tet, or the rest shell of that part's own tets, already carries: a limb moved away from
+  // the trunk does not extrapolate its boundary tets into the trunk's tissue it rested against
+  // (thick slices make the shell wide: 9.6 mm on 4.8 mm slices); and for labels a shell voxel
+  // whose rest position is outside the body stays open to the other tets' shells. Costs one
+  // coverage scan of the rest mesh and of its outer tets' shells on the input's grid.
   const Volume* restParts = nullptr;
   // The label map G the mesh's whole pieces come from (TransferMesh::rigid holds their ids),
   // on the input's grid. With it each piece also writes its rim: the voxels of its own label
