@@ -86,8 +86,8 @@ int demotePiecesAcrossJoints(TransferMesh& mesh) {
   }
   // Where pieces of two parts share a vertex, the part with more piece volume there keeps it
   // (ties: the smaller label) and the other parts' piece tets at it become soft tissue: one bone
-  // end bends instead of both (a humerus meshed as one piece with its marrow lost 0.7 % of the
-  // marrow at a bent elbow when both ends went soft).
+  // end bends instead of both (with both soft, a humerus meshed as one piece with its marrow
+  // lost more than RigCommand.AThickSliceBodyPosedOntoAFinerGridKeepsEveryBone allows).
   std::vector<int> keeper(std::size_t(mesh.vertices.rows()), -1);
   for (std::size_t v = 0; v < around.size(); ++v) {
     if (around[v].size() < 2) continue;
