@@ -1,5 +1,6 @@
 #include "repose/raster/Rasterizer.h"
 
+#include "PieceGhosts.h"
 #include "TetScan.h"
 #include "repose/io/NiftiIO.h"
 #include "repose/util/Error.h"
@@ -70,6 +71,9 @@ struct Shell {
   double pieceMm = 0;
   std::array<double, 3> pieceGrowth{0, 0, 0};
   std::vector<char> boneLabel;       // per label value: some tet is a piece of it
+  // Soft tets holding a piece's tissue, written like rims through their piece's map
+  // (raster/PieceGhosts.h): a bone end a joint demoted to soft tissue still moves rigidly.
+  std::vector<raster::PieceGhost> ghosts;
   const Volume* rimParts = nullptr;  // RasterOptions::restParts, for the rims
   // A rim voxel is taken when its rest label is bone of the tet's own body part: a thin cortex
   // that Mesh_3 merged into its marrow's tets still moves with the bone.
@@ -193,6 +197,14 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
     if (options.bonePieces)
       for (const auto& [label, piece] : *options.bonePieces)
         if (label > 0 && ids.count(piece)) mark(label);
+    // Per label, the piece it is meshed in (0: none).
+    std::vector<int> pieceOf(sh.boneLabel.size(), 0);
+    for (const int v : ids)
+      if (v > 0) pieceOf[std::size_t(v)] = v;
+    if (options.bonePieces)
+      for (const auto& [label, piece] : *options.bonePieces)
+        if (label > 0 && ids.count(piece)) pieceOf[std::size_t(label)] = piece;
+    sh.ghosts = raster::pieceGhosts(mesh, *options.pieceLabels, pieceOf);
     sh.pieceMm = std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm);
     const Eigen::Matrix3d Minv = output.ijkToRas.block<3, 3>(0, 0).inverse();
     for (int c = 0; c < 3; ++c) sh.pieceGrowth[c] = sh.pieceMm * Minv.row(c).norm();
@@ -239,6 +251,9 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // crossing it, found with plain comparisons first since every tet is looked at.
   const bool withShell = !shell.outer.empty();
   const bool withRims = !shell.pieceFaces.empty();
+  Eigen::MatrixX4i ghostTets;
+  const ScanInput ghostIn = withRims ? raster::ghostScanInput(in, shell.ghosts, ghostTets)
+                                     : ScanInput();
   // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
   struct Candidates {
     std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;
@@ -332,16 +347,9 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                               write(k, j, i0, i1, rest0, step, t);
                             });
           }
-          // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
-          // follows its surface to within a voxel) move with the piece, over the soft tissue
-          // that covered them.
-          for (std::size_t c = 0; c < candidates.size() && withRims; ++c) {
-            const std::int32_t t = candidates[c];
-            const unsigned rim = shell.pieceFaces[std::size_t(t)];
-            if (!rim || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareShell(in, t, rim, shell.pieceMm, shell.normalToMm,
-                                      shell.pieceGrowth, s))
-              continue;
+          // Writes, over soft tissue, the voxels of the prepared region `s` whose rest label is
+          // bone of piece tet t's body part, through t's map (a rim, or a ghost hosted by t).
+          auto scanRim = [&](std::int32_t t) {
             raster::scanTet(s, k0, k1, j0, j1,
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
@@ -353,6 +361,28 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                                 write(k, j, a, a, p, step, t);
                               }
                             });
+          };
+          // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
+          // follows its surface to within a voxel) move with the piece, over the soft tissue
+          // that covered them.
+          for (std::size_t c = 0; c < candidates.size() && withRims; ++c) {
+            const std::int32_t t = candidates[c];
+            const unsigned rim = shell.pieceFaces[std::size_t(t)];
+            if (!rim || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
+                !raster::prepareShell(in, t, rim, shell.pieceMm, shell.normalToMm,
+                                      shell.pieceGrowth, s))
+              continue;
+            scanRim(t);
+          }
+          // The ghosts: piece tissue in soft tets (a bone end a joint demoted), where the piece
+          // puts it.
+          for (std::size_t g = 0; g < shell.ghosts.size() && withRims; ++g) {
+            const std::int32_t t = shell.ghosts[g].host;
+            if (!raster::prepareShell(ghostIn, Eigen::Index(g), 0xF, shell.pieceMm,
+                                      shell.normalToMm, shell.pieceGrowth, s) ||
+                s.hi[2] < k0 || s.lo[2] >= k1 || s.hi[1] < j0 || s.lo[1] >= j1)
+              continue;
+            scanRim(t);
           }
           for (std::size_t c = 0; c < candidates.size() && withShell; ++c) {
             const std::int32_t t = candidates[c];
@@ -431,6 +461,8 @@ static std::vector<std::int32_t> pieceOwnerTets(const TransferMesh& mesh,
   rest.threads = options.threads;
   rest.shellMm = 0;  // only the pieces' rims
   rest.pieceLabels = options.pieceLabels;
+  rest.bonePieces = options.bonePieces;
+  rest.restParts = options.restParts;
   const ScanInput in = raster::makeScanInput(mesh, mesh.vertices, input, input);
   const std::int64_t nx = input.dims[0], plane = nx * input.dims[1];
   runScan(in, makeShell(mesh, input, input, rest), rest, "pieces at rest", nullptr,

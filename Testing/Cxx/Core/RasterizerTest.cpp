@@ -474,3 +474,57 @@ TEST(Rasterizer, AWholePieceKeepsItsVoxelsWhereSoftTissueFoldsOverIt) {
         notBone += withPieces.data<std::uint8_t>()[withPieces.index(i, j, k)] != 1;
   EXPECT_EQ(notBone, 0);
 }
+
+// A bone whose end lies in soft tets (a joint demoted them: demotePiecesAcrossJoints) still
+// moves rigidly there. The bone fills a box meshed as tets; those beyond x = 14 are soft, and
+// their far vertices follow a shear (the other side of a bent joint) instead of the bone's turn.
+// Through its piece tets, rims and the ghosts of its soft tets (raster/PieceGhosts.h) every bone
+// voxel lands where the bone's own motion puts it; without the pieces' label map the soft end
+// bends with the joint.
+TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
+  TransferMesh mesh = tetBox({2, 2, 2}, {20, 11, 11}, {6, 3, 3});
+  mesh.rigid.assign(std::size_t(mesh.tets.rows()), 0);
+  int soft = 0;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    double x = 0;
+    for (int c = 0; c < 4; ++c) x += mesh.vertices(mesh.tets(t, c), 0) / 4;
+    if (x < 14)
+      mesh.rigid[std::size_t(t)] = 5;
+    else
+      ++soft;
+  }
+  ASSERT_GT(soft, 0);
+  const Eigen::Isometry3d motion = Eigen::Translation3d(14, 12, 6) *
+                                   Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()) *
+                                   Eigen::Translation3d(-2, -6, -6);
+  Eigen::MatrixX3d deformed = mesh.vertices;
+  for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
+    const Eigen::Vector3d p = mesh.vertices.row(v).transpose();
+    Eigen::Vector3d q = motion * p;
+    if (p.x() > 14) q.y() -= 0.8 * (p.x() - 14);  // the joint's side: sheared
+    deformed.row(v) = q.transpose();
+  }
+  const VolumeGeometry grid = unitGrid({36, 36, 14});
+  Volume G(grid, ScalarType::UInt8), S(grid, ScalarType::UInt8);
+  for (std::int64_t k = 2; k < 11; ++k)
+    for (std::int64_t j = 2; j < 11; ++j)
+      for (std::int64_t i = 2; i < 20; ++i)
+        G.data<std::uint8_t>()[G.index(i, j, k)] = 5, S.data<std::uint8_t>()[S.index(i, j, k)] = 1;
+  const Volume expected =
+      mapDirectly(G, grid, [&](const Eigen::Vector3d& ras) { return motion.inverse() * ras; });
+  auto dice = [&](const Volume& posed) {
+    std::int64_t a = 0, b = 0, both = 0;
+    for (std::int64_t v = 0; v < grid.numVoxels(); ++v) {
+      const bool x = posed.data<std::uint8_t>()[v] == 5, y = expected.data<std::uint8_t>()[v] == 5;
+      a += x, b += y, both += x && y;
+    }
+    return double(2 * both) / double(a + b);
+  };
+  RasterOptions options;
+  options.pieceLabels = &G;
+  options.restParts = &S;
+  const double withPieces = dice(rasterizeLabels(G, mesh, deformed, grid, options));
+  const double without = dice(rasterizeLabels(G, mesh, deformed, grid));
+  EXPECT_LT(without, 0.95);  // the sheared end is a third of the bone
+  EXPECT_GT(withPieces, 0.995) << "without the pieces' map: " << without;
+}

@@ -1,0 +1,118 @@
+#include "PieceGhosts.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <utility>
+
+namespace repose::raster {
+
+std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& pieceLabels,
+                                    const std::vector<int>& pieceOf, int rings) {
+  std::vector<PieceGhost> out;
+  const Eigen::Index nt = mesh.tets.rows(), nv = mesh.vertices.rows();
+  if (mesh.rigid.size() != std::size_t(nt) || nt == 0) return out;
+  const Eigen::Matrix4d toIjk = pieceLabels.geometry().ijkToRas.inverse();
+  const auto d = pieceLabels.dims();
+  auto pieceAt = [&](const Eigen::Vector3d& ras) {
+    const Eigen::Vector3d p = toIjk.block<3, 3>(0, 0) * ras + toIjk.block<3, 1>(0, 3);
+    std::int64_t x[3];
+    for (int c = 0; c < 3; ++c) {
+      x[c] = std::int64_t(std::floor(p[c] + 0.5));
+      if (x[c] < 0 || x[c] >= d[c]) return 0;
+    }
+    const double v = pieceLabels.valueAsDouble(pieceLabels.index(x[0], x[1], x[2]));
+    return v > 0 && v < double(pieceOf.size()) ? pieceOf[std::size_t(v)] : 0;
+  };
+  // Per soft tet, the pieces its rest volume holds (usually none or one).
+  std::vector<std::vector<int>> holds(static_cast<std::size_t>(nt));
+  bool any = false;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    if (mesh.rigid[std::size_t(t)]) continue;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += mesh.vertices.row(mesh.tets(t, k)).transpose();
+    c /= 4;
+    std::set<int> found;
+    if (const int p = pieceAt(c)) found.insert(p);
+    for (int k = 0; k < 4; ++k)
+      if (const int p = pieceAt(0.5 * (c + mesh.vertices.row(mesh.tets(t, k)).transpose())))
+        found.insert(p);
+    holds[std::size_t(t)].assign(found.begin(), found.end());
+    any = any || !found.empty();
+  }
+  if (!any) return out;
+  // Tets around each vertex (CSR).
+  std::vector<std::int64_t> start(std::size_t(nv) + 1, 0);
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int k = 0; k < 4; ++k) ++start[std::size_t(mesh.tets(t, k)) + 1];
+  for (std::size_t v = 0; v < std::size_t(nv); ++v) start[v + 1] += start[v];
+  std::vector<std::int32_t> around(std::size_t(start.back()));
+  {
+    std::vector<std::int64_t> fill(start.begin(), start.end() - 1);
+    for (Eigen::Index t = 0; t < nt; ++t)
+      for (int k = 0; k < 4; ++k)
+        around[std::size_t(fill[std::size_t(mesh.tets(t, k))]++)] = std::int32_t(t);
+  }
+  // Hosts spread from the piece's own tets through the soft tets holding it, ring by ring, within
+  // one body part: a demoted bone end can be a layer of tets deep.
+  std::vector<std::map<int, std::int32_t>> host(static_cast<std::size_t>(nt));
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (const int p = mesh.rigid[std::size_t(t)]) host[std::size_t(t)][p] = std::int32_t(t);
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<std::pair<std::int32_t, std::pair<int, std::int32_t>>> found;
+    for (Eigen::Index t = 0; t < nt; ++t)
+      for (const int p : holds[std::size_t(t)]) {
+        if (host[std::size_t(t)].count(p)) continue;
+        std::int32_t h = -1;
+        for (int k = 0; k < 4 && h < 0; ++k) {
+          const std::size_t v = std::size_t(mesh.tets(t, k));
+          for (std::int64_t a = start[v]; a < start[v + 1] && h < 0; ++a) {
+            const std::int32_t u = around[std::size_t(a)];
+            if (mesh.labels[u] != mesh.labels[t]) continue;
+            const auto it = host[std::size_t(u)].find(p);
+            if (it != host[std::size_t(u)].end()) h = it->second;
+          }
+        }
+        if (h >= 0) found.push_back({std::int32_t(t), {p, h}});
+      }
+    if (found.empty()) break;
+    for (const auto& [t, ph] : found) host[std::size_t(t)].insert(ph);
+  }
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (!mesh.rigid[std::size_t(t)])
+      for (const auto& [p, h] : host[std::size_t(t)]) out.push_back({std::int32_t(t), h});
+  return out;
+}
+
+ScanInput ghostScanInput(const ScanInput& in, const std::vector<PieceGhost>& ghosts,
+                         Eigen::MatrixX4i& tets) {
+  ScanInput g;
+  g.dims = in.dims;
+  tets.resize(Eigen::Index(ghosts.size()), 4);
+  g.tets = &tets;
+  g.out.reserve(4 * ghosts.size());
+  g.rest.reserve(4 * ghosts.size());
+  const Eigen::MatrixX4i& T = *in.tets;
+  for (std::size_t n = 0; n < ghosts.size(); ++n) {
+    // The host's map from rest (input IJK) to output IJK: affine, and rigid in RAS.
+    const std::int32_t h = ghosts[n].host;
+    Eigen::Matrix3d R, O;
+    for (int c = 0; c < 3; ++c) {
+      R.col(c) = in.rest[std::size_t(T(h, c + 1))] - in.rest[std::size_t(T(h, 0))];
+      O.col(c) = in.out[std::size_t(T(h, c + 1))] - in.out[std::size_t(T(h, 0))];
+    }
+    const Eigen::Matrix3d B = O * R.inverse();
+    const Eigen::Vector3d r0 = in.rest[std::size_t(T(h, 0))], o0 = in.out[std::size_t(T(h, 0))];
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d& r = in.rest[std::size_t(T(ghosts[n].soft, k))];
+      tets(Eigen::Index(n), k) = int(g.out.size());
+      g.rest.push_back(r);
+      g.out.push_back(o0 + B * (r - r0));
+    }
+  }
+  return g;
+}
+
+}  // namespace repose::raster

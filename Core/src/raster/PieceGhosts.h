@@ -1,0 +1,41 @@
+// A whole piece's tissue that lies in soft tets, placed by the piece's own rigid motion.
+//
+// A bone is meshed as whole tets that move with its group (TransferMesh::rigid), and its rim
+// takes the bone's voxels up to a voxel beyond them (Mesh_3's surface accuracy). Two kinds of soft
+// tet still hold bone: the tets a joint demoted (demotePiecesAcrossJoints: where two bones share a
+// mesh vertex, the smaller side's tets at it bend with the joint), and soft tets whose rest volume
+// reaches into the bone by more than the rim covers. On thick slices those are a whole 5-8 mm
+// layer at a bone's end: their bone bent with the joint (the radius lost 1 % beside a bent elbow,
+// the pelvis 1 % beside a bent hip). A ghost is such a soft tet placed by a neighbouring piece
+// tet's rigid map: scanned like a rim, it writes the voxels whose rest label is that body part's
+// bone where the bone itself puts them.
+#pragma once
+
+#include "TetScan.h"
+#include "repose/mesh/TransferMesh.h"
+#include "repose/volume/Volume.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace repose::raster {
+
+struct PieceGhost {
+  std::int32_t soft = -1;  // the soft tet whose rest volume holds the piece's tissue
+  std::int32_t host = -1;  // a tet of that piece (same body part) whose map places it
+};
+
+// The soft tets whose rest volume holds a label of a piece (sampled at the centroid and half way
+// to each vertex, on `pieceLabels`, the label map on the input's grid) and a tet of that piece in
+// the same body part within `rings` vertex-sharing steps through such tets. `pieceOf[label]`: the
+// piece id the label is meshed in (0: none). `input`: the grid of `pieceLabels`.
+std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& pieceLabels,
+                                    const std::vector<int>& pieceOf, int rings = 3);
+
+// The ghosts as a mesh of their own: per ghost four vertices, its soft tet's rest positions
+// (input IJK, from `in`) and their images under the host tet's map (output IJK). `tets` receives
+// the ghost tets' vertex indices and must outlive the result.
+ScanInput ghostScanInput(const ScanInput& in, const std::vector<PieceGhost>& ghosts,
+                         Eigen::MatrixX4i& tets);
+
+}  // namespace repose::raster
