@@ -120,7 +120,9 @@ void writeTriangleMesh(const TriangleMesh& mesh, const std::string& path) {
     if (!out) throwFileError(path, "cannot create the file");
     out << std::setprecision(17);
     if (obj) {
-      out << "# Repose cage, RAS millimetres, outward faces\n";
+      // 3D Slicer takes a model's coordinate system from the first comment of an .obj
+      // (vtkMRMLModelStorageNode::GetCoordinateSystemFromFileHeader: "SPACE=RAS"); else LPS.
+      out << "# Repose cage, SPACE=RAS, millimetres, outward faces\n";
       for (Eigen::Index i = 0; i < mesh.vertices.rows(); ++i)
         out << "v " << mesh.vertices(i, 0) << " " << mesh.vertices(i, 1) << " "
             << mesh.vertices(i, 2) << "\n";

@@ -416,6 +416,17 @@ void writeDisplacementFieldNrrd(const std::vector<float>& rasVectors, const Volu
   nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoKind, kinds);
   const double origin[3] = {m(0, 3), m(1, 3), m(2, 3)};
   nrrdSpaceOriginSet(nrrd.get(), origin);
+  // What 3D Slicer needs to open it as a transform: qSlicerTransformsReader.cxx takes a 3D vector
+  // image as a transform only with intent_code 1006 (NIfTI's displacement vector; else the
+  // volumes reader wins and it opens as a vector volume); vtkMRMLTransformStorageNode.cxx reads
+  // "displacement field type" resampling as a transform from parent (output -> input, as here,
+  // never inverted) and refuses a measurement frame other than the identity.
+  if (nrrdKeyValueAdd(nrrd.get(), "intent_code", "1006") != 0 ||
+      nrrdKeyValueAdd(nrrd.get(), "displacement field type", "resampling") != 0)
+    throwFileError(path, takeBiffMessage());
+  for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r)
+    for (int c = 0; c < NRRD_SPACE_DIM_MAX; ++c)
+      nrrd->measurementFrame[r][c] = r < 3 && c < 3 ? (r == c ? 1.0 : 0.0) : AIR_NAN;
   nio->encoding = nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
   nio->zlibLevel = 1;
   if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0)

@@ -795,19 +795,35 @@ std::vector<float> rasterizeDisplacement(const TransferMesh& mesh, const Eigen::
   const ScanInput in = raster::makeScanInput(mesh, deformed, input, output);
   const std::int64_t n = output.numVoxels();
   std::vector<float> field(static_cast<std::size_t>(3 * n));
-  // Uncovered voxels aim at one point ten diagonals below the input grid's lower corner.
-  const auto [lo, hi] = input.rasBounds();
-  const Eigen::Vector3d outside = lo - 10 * (hi - lo) - Eigen::Vector3d::Constant(1000);
   const Eigen::Matrix3d O = output.ijkToRas.block<3, 3>(0, 0), I = input.ijkToRas.block<3, 3>(0, 0);
   const Eigen::Vector3d oo = output.origin(), io = input.origin();
+  const Eigen::Matrix3d Iinv = I.inverse();
+  // Uncovered voxels aim just past the input grid (one voxel centre beyond its nearest face, or
+  // nowhere when they already lie a voxel beyond it), so nearest-neighbour resampling gives them
+  // background and the field stays within the grid's size: 3D Slicer interpolates a grid
+  // transform with a cubic kernel, and a jump of metres beside the skin threw tissue far away.
+  auto outside = [&](const Eigen::Vector3d& y) {
+    Eigen::Vector3d u = Iinv * (y - io);
+    int axis = -1;
+    double target = 0, cost = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < 3; ++c) {
+      const double n = double(input.dims[std::size_t(c)]);
+      if (u[c] <= -1 || u[c] >= n) return y;
+      const double spacing = I.col(c).norm();
+      if ((u[c] + 1) * spacing < cost) cost = (u[c] + 1) * spacing, axis = c, target = -1;
+      if ((n - u[c]) * spacing < cost) cost = (n - u[c]) * spacing, axis = c, target = n;
+    }
+    u[axis] = target;
+    return Eigen::Vector3d(I * u + io);
+  };
   parallelFor(
       output.dims[2], options.threads,
       [&](std::int64_t k0, std::int64_t k1) {
         for (std::int64_t k = k0; k < k1; ++k)
           for (std::int64_t j = 0; j < output.dims[1]; ++j)
             for (std::int64_t i = 0; i < output.dims[0]; ++i) {
-              const Eigen::Vector3d d =
-                  outside - (O * Eigen::Vector3d(double(i), double(j), double(k)) + oo);
+              const Eigen::Vector3d y = O * Eigen::Vector3d(double(i), double(j), double(k)) + oo;
+              const Eigen::Vector3d d = outside(y) - y;
               float* f = &field[static_cast<std::size_t>(
                   3 * (i + output.dims[0] * (j + output.dims[1] * k)))];
               f[0] = float(d.x()), f[1] = float(d.y()), f[2] = float(d.z());

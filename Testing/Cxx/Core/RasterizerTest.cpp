@@ -528,3 +528,48 @@ TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
   EXPECT_LT(without, 0.95);  // the sheared end is a third of the bone
   EXPECT_GT(withPieces, 0.995) << "without the pieces' map: " << without;
 }
+
+// Voxels no tet covers point one voxel centre past the input grid's nearest face (or nowhere when
+// they lie a voxel beyond it already): nearest-neighbour resampling gives them background, and
+// the field has no jump of metres beside the body (3D Slicer interpolates a grid transform with a
+// cubic kernel: vtkITKTransformConverter.h).
+TEST(Rasterizer, UncoveredVoxelsPointJustPastTheInputGrid) {
+  const TransferMesh box = tetBox({6, 5, 4}, {14, 12, 9}, {2, 2, 2});
+  const VolumeGeometry input = VolumeGeometry::make({20, 18, 12}, {1, 1.5, 2}, {0, 0, 0});
+  const VolumeGeometry output = VolumeGeometry::make({30, 24, 20}, {1, 1.5, 2}, {-5, -6, -8});
+  RasterOptions options;
+  options.shellMm = 0;
+  const std::vector<float> field = rasterizeDisplacement(box, box.vertices, input, output, options);
+  const Volume coverage = rasterizeCoverage(box, box.vertices, output);
+  const Eigen::Vector3d spacing(1, 1.5, 2), extent = spacing.cwiseProduct(Eigen::Vector3d(20, 18, 12));
+  int uncovered = 0, stayed = 0;
+  for (std::int64_t k = 0; k < 20; ++k)
+    for (std::int64_t j = 0; j < 24; ++j)
+      for (std::int64_t i = 0; i < 30; ++i) {
+        const std::int64_t v = coverage.index(i, j, k);
+        if (coverage.data<std::uint8_t>()[v]) continue;
+        ++uncovered;
+        const Eigen::Vector3d y = output.voxelToRas(double(i), double(j), double(k));
+        const Eigen::Vector3d d(field[3 * v], field[3 * v + 1], field[3 * v + 2]);
+        const Eigen::Vector3d u = input.rasToVoxel(y), t = input.rasToVoxel(y + d);
+        const bool beyond = (u.array() <= -1).any() ||
+                            (u.array() >= Eigen::Array3d(20, 18, 12)).any();
+        if (beyond) {
+          EXPECT_EQ(d.norm(), 0) << i << " " << j << " " << k;
+          ++stayed;
+          continue;
+        }
+        // One axis moved to the first voxel centre past the grid, the others kept.
+        int moved = 0;
+        for (int c = 0; c < 3; ++c) {
+          if (std::fabs(t[c] - u[c]) < 1e-4) continue;
+          ++moved;
+          EXPECT_TRUE(std::fabs(t[c] + 1) < 1e-4 || std::fabs(t[c] - input.dims[c]) < 1e-4);
+        }
+        EXPECT_EQ(moved, 1) << i << " " << j << " " << k;
+        EXPECT_LE(d.norm(), extent.minCoeff() / 2 + spacing.maxCoeff() + 1e-6);
+      }
+  EXPECT_GT(uncovered, 1000);
+  EXPECT_GT(stayed, 100);
+  EXPECT_LT(stayed, uncovered);
+}

@@ -107,8 +107,9 @@ Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
 // The inverse map as a displacement field on `output`: per voxel, 3 floats (x fastest, voxels in
 // IJK order) in RAS mm from the voxel centre to its rest position, the point of the input the
 // rasterizer samples (ITK's output-to-input resampling direction). Voxels no tet (or shell)
-// covers point to `outside`, a place beyond the input grid, so any resampler gives them
-// background as the rasterizer does.
+// covers point one voxel centre past the input grid's nearest face (or stay put when they lie a
+// voxel beyond it already), so nearest-neighbour resampling gives them background as the
+// rasterizer does, and no vector is longer than about half the input grid's smallest extent.
 std::vector<float> rasterizeDisplacement(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
                                          const VolumeGeometry& input, const VolumeGeometry& output,
                                          const RasterOptions& options = {});
