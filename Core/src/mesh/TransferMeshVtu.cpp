@@ -49,7 +49,8 @@ void writeTransferMesh(const TransferMesh& mesh, const std::string& path) {
            "byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n"
         << "<FieldData>\n<DataArray type=\"Float64\" Name=\"source_spacing_mm\" "
            "NumberOfTuples=\"1\" format=\"ascii\">\n"
-        << mesh.sourceSpacingMm << "\n</DataArray>\n"
+        << mesh.sourceSpacingMm
+        << "\n</DataArray>\n"
         // 3D Slicer reads a .vtu's coordinate system from the field-data string array "SPACE"
         // (vtkMRMLModelStorageNode::GetCoordinateSystemFromFieldData; without it: LPS). VTK's
         // ASCII string arrays hold character codes, each string ending in 0.

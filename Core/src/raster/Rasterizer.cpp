@@ -70,7 +70,7 @@ struct Shell {
   const Volume* pieceLabels = nullptr;
   double pieceMm = 0;
   std::array<double, 3> pieceGrowth{0, 0, 0};
-  std::vector<char> boneLabel;       // per label value: some tet is a piece of it
+  std::vector<char> boneLabel;  // per label value: some tet is a piece of it
   // Soft tets holding a piece's tissue, written like rims through their piece's map
   // (raster/PieceGhosts.h): a bone end a joint demoted to soft tissue still moves rigidly.
   std::vector<raster::PieceGhost> ghosts;
@@ -252,8 +252,8 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   const bool withShell = !shell.outer.empty();
   const bool withRims = !shell.pieceFaces.empty();
   Eigen::MatrixX4i ghostTets;
-  const ScanInput ghostIn = withRims ? raster::ghostScanInput(in, shell.ghosts, ghostTets)
-                                     : ScanInput();
+  const ScanInput ghostIn =
+      withRims ? raster::ghostScanInput(in, shell.ghosts, ghostTets) : ScanInput();
   // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
   struct Candidates {
     std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;

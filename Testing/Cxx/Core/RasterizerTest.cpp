@@ -541,7 +541,8 @@ TEST(Rasterizer, UncoveredVoxelsPointJustPastTheInputGrid) {
   options.shellMm = 0;
   const std::vector<float> field = rasterizeDisplacement(box, box.vertices, input, output, options);
   const Volume coverage = rasterizeCoverage(box, box.vertices, output);
-  const Eigen::Vector3d spacing(1, 1.5, 2), extent = spacing.cwiseProduct(Eigen::Vector3d(20, 18, 12));
+  const Eigen::Vector3d spacing(1, 1.5, 2),
+      extent = spacing.cwiseProduct(Eigen::Vector3d(20, 18, 12));
   int uncovered = 0, stayed = 0;
   for (std::int64_t k = 0; k < 20; ++k)
     for (std::int64_t j = 0; j < 24; ++j)
@@ -552,8 +553,8 @@ TEST(Rasterizer, UncoveredVoxelsPointJustPastTheInputGrid) {
         const Eigen::Vector3d y = output.voxelToRas(double(i), double(j), double(k));
         const Eigen::Vector3d d(field[3 * v], field[3 * v + 1], field[3 * v + 2]);
         const Eigen::Vector3d u = input.rasToVoxel(y), t = input.rasToVoxel(y + d);
-        const bool beyond = (u.array() <= -1).any() ||
-                            (u.array() >= Eigen::Array3d(20, 18, 12)).any();
+        const bool beyond =
+            (u.array() <= -1).any() || (u.array() >= Eigen::Array3d(20, 18, 12)).any();
         if (beyond) {
           EXPECT_EQ(d.norm(), 0) << i << " " << j << " " << k;
           ++stayed;
