@@ -187,23 +187,21 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
     sh.tetParts = &mesh.labels;
     if (options.restParts && options.restParts->dims() == input.dims)
       sh.rimParts = options.restParts;
+    // Per label, the piece it is meshed in (0: none): the piece ids themselves and, through
+    // RigSettings::bonePieces, the other labels of a bone.
     const std::set<int> ids(mesh.rigid.begin(), mesh.rigid.end());
-    auto mark = [&](int v) {
-      if (std::size_t(v) >= sh.boneLabel.size()) sh.boneLabel.resize(std::size_t(v) + 1, 0);
-      sh.boneLabel[std::size_t(v)] = 1;
+    std::vector<int> pieceOf;
+    auto assign = [&](int label, int piece) {
+      if (std::size_t(label) >= pieceOf.size()) pieceOf.resize(std::size_t(label) + 1, 0);
+      pieceOf[std::size_t(label)] = piece;
     };
     for (const int v : ids)
-      if (v > 0) mark(v);
+      if (v > 0) assign(v, v);
     if (options.bonePieces)
       for (const auto& [label, piece] : *options.bonePieces)
-        if (label > 0 && ids.count(piece)) mark(label);
-    // Per label, the piece it is meshed in (0: none).
-    std::vector<int> pieceOf(sh.boneLabel.size(), 0);
-    for (const int v : ids)
-      if (v > 0) pieceOf[std::size_t(v)] = v;
-    if (options.bonePieces)
-      for (const auto& [label, piece] : *options.bonePieces)
-        if (label > 0 && ids.count(piece)) pieceOf[std::size_t(label)] = piece;
+        if (label > 0 && ids.count(piece)) assign(label, piece);
+    sh.boneLabel.resize(pieceOf.size());
+    for (std::size_t v = 0; v < pieceOf.size(); ++v) sh.boneLabel[v] = pieceOf[v] != 0;
     sh.ghosts = raster::pieceGhosts(mesh, *options.pieceLabels, pieceOf);
     sh.pieceMm = std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm);
     const Eigen::Matrix3d Minv = output.ijkToRas.block<3, 3>(0, 0).inverse();
