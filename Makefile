@@ -8,7 +8,7 @@ CMAKE_FLAGS := -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) \
   $(if $(CCACHE),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache,)
 DEMO_DIR ?= $(BUILD_DIR)/demo
 
-.PHONY: deps configure build test test-asan fuzz-build fuzz-smoke demo clean
+.PHONY: deps configure build install test test-asan fuzz-build fuzz-smoke demo clean
 
 deps:
 	@bash scripts/install-deps.sh
@@ -20,6 +20,12 @@ configure: deps $(BUILD_DIR)/build.ninja
 
 build: configure
 	cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# `make install PREFIX=DIR`: repose, ReposeCore, the Python package and the 3D Slicer CLI module
+# folder DIR/lib/repose/cli-modules (docs/SLICER.md); the folder can be moved as a whole.
+PREFIX ?= /usr/local
+install: build
+	cmake --install $(BUILD_DIR) --prefix $(PREFIX)
 
 test: build fuzz-build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

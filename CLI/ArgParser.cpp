@@ -1,5 +1,7 @@
 #include "ArgParser.h"
 
+#include <cctype>
+
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
@@ -27,6 +29,23 @@ ArgParser& ArgParser::positional(const std::string& name, const std::string& hel
   return *this;
 }
 
+namespace {
+
+std::string kebabCase(const std::string& camel) {
+  std::string out;
+  for (char c : camel) {
+    if (std::isupper(static_cast<unsigned char>(c))) {
+      out += '-';
+      out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 bool ArgParser::parse(const std::vector<std::string>& args) {
   std::size_t nextPositional = 0;
   for (std::size_t a = 0; a < args.size(); ++a) {
@@ -42,6 +61,14 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
       const Spec* spec = nullptr;
       for (const Spec& s : options_)
         if (s.name == name) spec = &s;
+      // 3D Slicer passes a CLI module's long flags as declared in its XML, where a flag must be
+      // an identifier (ModuleDescriptionParser.cxx): --cageVertices stands for --cage-vertices.
+      if (!spec) {
+        const std::string kebab = kebabCase(name);
+        for (const Spec& s : options_)
+          if (s.name == kebab) spec = &s;
+        if (spec) name = kebab;
+      }
       if (!spec) throw UsageError{"unknown option --" + name};
       if (spec->isFlag) {
         if (inlineValue) throw UsageError{"--" + name + " takes no value"};

@@ -8,6 +8,7 @@
 #include "Commands.h"
 #include "InputChecks.h"
 #include "MemoryBudget.h"
+#include "SlicerModuleXml.h"
 #include "TerminalProgress.h"
 
 #include "repose/io/AtomicOutput.h"
@@ -23,6 +24,7 @@
 #include "repose/pose/SceneFolder.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
+#include "repose/rig/Rig.h"
 #include "repose/util/Error.h"
 
 #include <nlohmann/json.hpp>
@@ -31,7 +33,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <set>
+#include <sstream>
+
+#include <stdlib.h>
 
 namespace repose::cli {
 namespace {
@@ -41,21 +47,77 @@ using nlohmann::json;
 
 }  // namespace
 
+namespace {
+
+// The frame a 3D Slicer CLI module (or a script) takes back as single files, and the report's
+// headline figures as Slicer's return parameters.
+struct FrameOutputs {
+  std::string labels, parts, image, transform, returnParameters;
+  std::size_t frame = 0;
+  bool any() const {
+    return !labels.empty() || !parts.empty() || !image.empty() || !transform.empty();
+  }
+};
+
+void writeFrameOutputs(const FrameOutputs& o, const PosedFrame& posed) {
+  if (!o.labels.empty()) writeVolume(posed.organs, o.labels);
+  if (!o.parts.empty()) writeVolume(posed.parts, o.parts);
+  if (!o.image.empty() && posed.image) writeVolume(*posed.image, o.image);
+  if (!o.transform.empty()) writeDisplacementFieldNrrd(posed.field, posed.grid, o.transform);
+}
+
+// "name = value" lines, as ModuleDescription::ReadParameterFile reads them; the names are the
+// return parameters of the module's XML (SlicerModuleXml.cpp).
+void writeReturnParameters(const std::string& path, const json& report) {
+  const json& q = report["quality"];
+  std::ostringstream out;
+  out.precision(6);
+  out << "bodyVolumeChangePercent = " << report["body"]["volume_change_percent"].get<double>()
+      << "\nworstLabelChangePercent = "
+      << q["labels_within_1_percent"]["worst_change_percent"].get<double>()
+      << "\nlabelsLost = " << report["labels_lost"].get<std::int64_t>() << "\n";
+  if (q.contains("bones_rigid"))
+    out << "bonesMinDice = " << q["bones_rigid"]["min_dice"].get<double>() << "\n";
+  writeTextFileAtomically(path, out.str());
+}
+
+// A hidden folder for the frames when the caller wants only single files (no --out): beside the
+// first of them, removed at the end.
+struct ScratchFolder {
+  std::string path;
+  explicit ScratchFolder(const std::string& besideFile) {
+    std::string pattern =
+        (fs::absolute(besideFile).parent_path() / ".repose-frames-XXXXXX").string();
+    if (!::mkdtemp(pattern.data())) throw Error(besideFile + ": cannot write in its folder");
+    path = pattern;
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    fs::remove_all(path, ignored);
+  }
+};
+
+}  // namespace
+
 int runPose(const Args& args) {
+  if (printSlicerModuleXml(args, "pose")) return 0;  // 3D Slicer asking for the description
   ArgParser p("pose",
               "The whole job: pose a label map G (with its body-part map S, and an image) by a\n"
               "pose file. Writes, per frame (one, or one per keyframe, in DIR/<frame>/):\n"
-              "posed_G.nii.gz, posed_S.nii.gz, posed_image.nii.gz (with --image),\n"
+              "posed_G and posed_S (--output-format), posed_image.nii.gz (with --image),\n"
               "transform.nrrd (displacement field, LPS, output->input) and report.json.");
   p.option("input", "FILE", "label map G (NIfTI, NRRD, .seg.nrrd)")
       .option("parts", "FILE", "body-part map S on G's grid (the cage and mesh follow it)")
       .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
       .option("background", "VALUE", "image value where no tissue is (with --image)", "0")
       .option("pose", "FILE", "pose file (*.pose.json, docs/POSES.md)")
-      .option("out", "DIR", "output folder (created if missing; its parent must exist)")
+      .option("out", "DIR",
+              "output folder (created if missing; its parent must exist); may be left out when "
+              "--posed-labels, --posed-parts or --transform take the results")
       .option("scene", "DIR",
               "reuse the cage and mesh saved here when they match S and the settings, else "
-              "build them and save them here")
+              "build them and save them here; each frame then also gets scene.mrml, a 3D Slicer "
+              "scene of G, the posed G, the transform, the cage and the mesh")
       .option("tissues", "CSV",
               "label,name,density_kg_m3,rigid[,bone] (default: tissues.csv beside S, as "
               "`repose rig` writes it, else the phantom's table when G's labels are the "
@@ -67,6 +129,11 @@ int runPose(const Args& args) {
               "write the posed maps on an isotropic grid of this voxel size (0: the input's "
               "spacing; a finer grid keeps thin structures of thick-slice inputs)",
               "0")
+      .option("output-format", "FORMAT",
+              "the posed label maps as nii.gz (each with a 3D Slicer colour table, .ctbl), "
+              "seg.nrrd (Slicer segmentations: names, colours, terminology), both, or auto "
+              "(seg.nrrd when --input is a .seg.nrrd, else nii.gz)",
+              "auto")
       .option("cage-vertices", "N", "cage size", "300")
       .option("dilate-mm", "MM", "cage distance from the body", "10")
       .option("mesh-mm", "MM", "transfer-mesh tet size (0: 5% of S's diagonal)", "0")
@@ -85,11 +152,38 @@ int runPose(const Args& args) {
       .flag("keep-pockets",
             "keep the background pockets a bent joint traps inside the body (by default they "
             "are filled from their neighbours; docs/QUALITY.md)")
-      .flag("json", "print the frames' reports as JSON on stdout");
+      .flag("json", "print the frames' reports as JSON on stdout")
+      .option("posed-labels", "FILE", "also write the posed G of frame --frame here (any format)")
+      .option("posed-parts", "FILE", "also write the posed S of frame --frame here")
+      .option("posed-image", "FILE", "also write the posed image of frame --frame here")
+      .option("transform", "FILE", "also write frame --frame's displacement field here (.nrrd)")
+      .option("frame", "K", "the frame the four options above take (0: the first)", "0")
+      .option("returnparameterfile", "FILE",
+              "write frame --frame's headline figures here as 3D Slicer's return parameters "
+              "(name = value lines)")
+      .option("processinformationaddress", "ADDRESS",
+              "passed by 3D Slicer to in-process modules; ignored")
+      .flag("slicer-progress",
+            "progress as the <filter-progress> lines 3D Slicer's CLI modules print on stdout "
+            "(the installed ReposePose module sets it)");
   declareMemoryOption(p, "a pose that would need more is refused before the work");
   if (!p.parse(args)) return 0;
-  for (const char* required : {"input", "parts", "pose", "out"})
+  FrameOutputs single;
+  single.labels = p.get("posed-labels"), single.parts = p.get("posed-parts");
+  single.image = p.get("posed-image"), single.transform = p.get("transform");
+  single.returnParameters = p.get("returnparameterfile");
+  if (p.getInt("frame") < 0) throw UsageError{"--frame must be >= 0"};
+  single.frame = static_cast<std::size_t>(p.getInt("frame"));
+  for (const char* required : {"input", "parts", "pose"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
+  if (!p.has("out") && !single.any())
+    throw UsageError{"--out is required (or --posed-labels, --posed-parts, --transform)"};
+  if (!single.transform.empty() && formatForPath(single.transform) != FileFormat::Nrrd)
+    throw UsageError{"--transform must name a .nrrd file"};
+  for (const std::string& f : {single.labels, single.parts, single.image})
+    if (!f.empty()) formatForPath(f);  // an unknown extension is refused before the work
+  if (!single.image.empty() && !p.has("image")) throw UsageError{"--posed-image needs --image"};
+  if (p.has("slicer-progress")) startSlicerProgress("repose pose", "posing " + p.get("input"));
   const auto start = std::chrono::steady_clock::now();
   const bool quiet = p.has("json");
   auto say = [&](const std::string& text) {
@@ -109,7 +203,17 @@ int runPose(const Args& args) {
   request.autoSeparate = !p.has("no-auto-separate");
   const double spacingMm = p.getDouble("spacing-mm");
   if (!(spacingMm >= 0)) throw UsageError{"--spacing-mm must be >= 0"};
-  const std::string outDir = p.get("out");
+  std::optional<ScratchFolder> scratch;
+  if (!p.has("out"))
+    scratch.emplace(!single.labels.empty()      ? single.labels
+                    : !single.parts.empty()     ? single.parts
+                    : !single.transform.empty() ? single.transform
+                                                : single.image);
+  const std::string outDir = scratch ? scratch->path + "/frames" : p.get("out");
+  const std::string format = p.get("output-format");
+  if (format != "auto" && format != "nii.gz" && format != "seg.nrrd" && format != "both")
+    throw UsageError{"--output-format must be auto, nii.gz, seg.nrrd or both"};
+  const LabelMapFiles labelMapFiles = labelMapFilesFor(format, p.get("input"));
   for (const char* in : {"input", "parts", "image", "pose"})
     if (p.has(in) && fs::exists(p.get(in)) && fs::exists(outDir) &&
         fs::equivalent(p.get(in), outDir))
@@ -131,7 +235,9 @@ int runPose(const Args& args) {
   // The inputs are held in core for the whole job: each read refuses, with the numbers, what the
   // budget cannot hold; the frames are checked against what is left (checkGrid below).
   const Volume organs = readVolume(p.get("input"), readOptionsWithin(budget, !quiet));
-  const Volume parts = readVolume(p.get("parts"), readOptionsWithin(budget, !quiet));
+  Volume parts = readVolume(p.get("parts"), readOptionsWithin(budget, !quiet));
+  if (const std::string w = nameBodyPartsByRigConvention(parts, p.get("parts")); !w.empty())
+    std::cerr << "repose pose: warning: " << w << "\n";
   requirePoseableLabels(organs, p.get("input"));
   requirePoseableLabels(parts, p.get("parts"));
   warnUnnamedLabels(organs, p.get("input"), "pose");
@@ -167,12 +273,16 @@ int runPose(const Args& args) {
                      {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""},
                      job.settings());
   const bool oneFrame = rig.frameCount() == 1;
+  if (single.frame >= rig.frameCount())
+    throw Error(p.get("pose") + ": has " + std::to_string(rig.frameCount()) +
+                " frame(s); --frame " + std::to_string(single.frame) + " is not one of them");
   fs::create_directories(outDir);
   PoseFrameOptions fo = job.frameOptions();
   fo.image = image ? &*image : nullptr;
   fo.background = p.getDouble("background");
   fo.spacingMm = spacingMm;
   fo.fillPockets = !p.has("keep-pockets");
+  fo.labelMapFiles = labelMapFiles;
   json summary = json::array();
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {
     const std::string frameName = rig.frameName(index);
@@ -196,9 +306,20 @@ int runPose(const Args& args) {
     };
     PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
     posed.reportJson = job.completeReport(posed.reportJson, reused);
-    const json report = json::parse(posed.reportJson);
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
-    writePosedFrame(posed, dir.string());
+    FrameWriteOptions wo;
+    wo.labelMapFiles = labelMapFiles;
+    if (p.has("scene")) {  // a Slicer scene of the frame, with the rig kept in the scene folder
+      const fs::path scene = fs::absolute(p.get("scene"));
+      wo.sceneInputLabels = fs::absolute(p.get("input")).string();
+      wo.sceneCage = (scene / "cage.vtk").string();
+      wo.sceneTransferMesh = (scene / "tm.vtu").string();
+    }
+    const json report = json::parse(writePosedFrame(posed, dir.string(), wo));
+    if (index == single.frame) {
+      writeFrameOutputs(single, posed);
+      if (!single.returnParameters.empty()) writeReturnParameters(single.returnParameters, report);
+    }
     const json& q = report["quality"];
     say("  body volume " + std::to_string(report["body"]["volume_change_percent"].get<double>()) +
         " %, worst label " +
@@ -216,7 +337,8 @@ int runPose(const Args& args) {
     std::cout << (oneFrame ? summary[0] : json{{"frames", summary}, {"seconds", seconds}}).dump(2)
               << "\n";
   else
-    say("done in " + std::to_string(int(seconds)) + " s: " + outDir);
+    say("done in " + std::to_string(int(seconds)) + " s: " + (scratch ? "" : outDir));
+  endSlicerProgress("repose pose");
   return 0;
 }
 

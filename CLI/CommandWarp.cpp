@@ -5,6 +5,7 @@
 #include "Commands.h"
 #include "InputChecks.h"
 #include "MemoryBudget.h"
+#include "SlicerModuleXml.h"
 #include "TerminalProgress.h"
 
 #include "repose/io/AtomicOutput.h"
@@ -57,6 +58,7 @@ std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
 }  // namespace
 
 int runWarp(const Args& args) {
+  if (printSlicerModuleXml(args, "warp")) return 0;  // 3D Slicer asking for the description
   ArgParser p(
       "warp",
       "Pose a label map: deform the transfer mesh with a posed cage (Green coordinates\n"
@@ -79,9 +81,13 @@ int runWarp(const Args& args) {
               "was built on, whichever is coarser)",
               "-1")
       .option("threads", "N", "worker threads (0: all cores)", "0")
-      .flag("json", "print a JSON summary on stdout");
+      .flag("json", "print a JSON summary on stdout")
+      .flag("slicer-progress",
+            "progress as the <filter-progress> lines 3D Slicer's CLI modules print on stdout "
+            "(the installed ReposeWarp module sets it)");
   declareMemoryOption(p, "above it the posed volume is made out of core (NIfTI in and out)");
   if (!p.parse(args)) return 0;
+  if (p.has("slicer-progress")) startSlicerProgress("repose warp", "warping " + p.get("input"));
   for (const char* required : {"input", "mesh", "cage", "posed-cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
   if (p.has("image") != p.has("image-out")) throw UsageError{"--image and --image-out go together"};
@@ -264,6 +270,7 @@ int runWarp(const Args& args) {
       std::cout << "warning: " << deformation.solver().unconstrainedVertices()
                 << " mesh vertices in parts with no vertex inside the cage were left at rest\n";
   }
+  endSlicerProgress("repose warp");
   return 0;
 }
 

@@ -6,8 +6,33 @@
 #include <memory>
 
 namespace repose::cli {
+namespace {
+
+bool slicerMode = false;
+
+ProgressFn slicerProgress() {
+  struct State {
+    int lastPermille = -1;
+    std::string lastStage;
+  };
+  auto state = std::make_shared<State>();
+  return [state](double fraction, const std::string& stage) {
+    const int permille = static_cast<int>(fraction * 1000.0 + 0.5);
+    if (permille == state->lastPermille && stage == state->lastStage) return true;
+    if (stage != state->lastStage)
+      std::printf("<filter-comment>%s</filter-comment>\n", stage.c_str());
+    state->lastPermille = permille;
+    state->lastStage = stage;
+    std::printf("<filter-progress>%.3f</filter-progress>\n", permille / 1000.0);
+    std::fflush(stdout);
+    return true;
+  };
+}
+
+}  // namespace
 
 ProgressFn terminalProgress() {
+  if (slicerMode) return slicerProgress();
   if (!isatty(STDERR_FILENO)) return {};
   struct State {
     int lastPercent = -1;
@@ -27,6 +52,21 @@ ProgressFn terminalProgress() {
     std::fflush(stderr);
     return true;
   };
+}
+
+void startSlicerProgress(const std::string& filterName, const std::string& comment) {
+  slicerMode = true;
+  std::printf(
+      "<filter-start>\n<filter-name>%s</filter-name>\n<filter-comment>%s</filter-comment>\n"
+      "</filter-start>\n",
+      filterName.c_str(), comment.c_str());
+  std::fflush(stdout);
+}
+
+void endSlicerProgress(const std::string& filterName) {
+  if (!slicerMode) return;
+  std::printf("<filter-end>\n<filter-name>%s</filter-name>\n</filter-end>\n", filterName.c_str());
+  std::fflush(stdout);
 }
 
 }  // namespace repose::cli

@@ -15,6 +15,7 @@
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
+#include <repose/io/ColorTableIO.h>
 #include <repose/io/AtomicOutput.h>
 #include <repose/io/MeshIO.h>
 #include <repose/io/NrrdIO.h>
@@ -23,6 +24,7 @@
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseReport.h>
 #include <repose/pose/PoseRig.h>
+#include <repose/pose/SlicerSceneMrml.h>
 #include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/util/Error.h>
@@ -509,6 +511,29 @@ bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
         repose::writeTextFileAtomically((dir / pose->GetFileName()).string(), pose->GetPoseJSON());
       }
     }
+    // The same scene for 3D Slicer (docs/SLICER.md): the input and the last posed label maps
+    // (with a colour table: Slicer ignores a NIfTI's label table), the cage and the mesh.
+    repose::SlicerSceneFiles mrml;
+    for (int n = 0; n < this->Scene->GetNumberOfNodes(); ++n) {
+      vtkMRMLReposeNode* node = this->Scene->GetNthNode(n);
+      auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node);
+      if (seg && !seg->GetLabelMapFileName().empty()) {
+        const bool posed = this->Scene->GetReferencedNode(seg, "source") != nullptr;
+        std::string& slot = posed ? mrml.posedLabels : mrml.inputLabels;
+        if (slot.empty()) slot = (dir / seg->GetLabelMapFileName()).string();
+        if (!posed && mrml.colorTable.empty()) {
+          mrml.colorTable = (dir / (std::string(seg->GetID()) + "_G.ctbl")).string();
+          repose::writeColorTable(Conversion::FromImageData(seg->GetLabelMap()), mrml.colorTable);
+        }
+      }
+      if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node); cage && mrml.cage.empty())
+        mrml.cage = (dir / cage->GetFileName()).string();
+      if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node);
+          tm && mrml.transferMesh.empty())
+        mrml.transferMesh = (dir / tm->GetFileName()).string();
+    }
+    repose::writeTextFileAtomically((dir / "scene.mrml").string(),
+                                    repose::formatSlicerScene(mrml, dir.string()));
     repose::writeTextFileAtomically((dir / "scene.json").string(), this->Scene->WriteJSON() + "\n");
     return true;
   } catch (const std::exception& e) {

@@ -231,13 +231,17 @@ report.json dict: volumes, masses, distortion, bone rigidity, quality targets).)
                              })
       .def(
           "write",
-          [](const PosedFrame& f, const std::string& folder) {
+          [](const PosedFrame& f, const std::string& folder, const std::string& format) {
+            FrameWriteOptions options;
+            options.labelMapFiles = labelMapFilesFor(format, "");
             py::gil_scoped_release release;
-            writePosedFrame(f, folder);
+            writePosedFrame(f, folder, options);
           },
-          py::arg("folder"),
-          "Writes posed_G.nii.gz, posed_S.nii.gz, posed_image.nii.gz, transform.nrrd and "
-          "report.json into the folder, as `repose pose` does.");
+          py::arg("folder"), py::arg("output_format") = "nii.gz",
+          "Writes the posed maps (output_format 'nii.gz': posed_G.nii.gz and posed_S.nii.gz, "
+          "each with a 3D Slicer colour table .ctbl; 'seg.nrrd': Slicer segmentations; "
+          "'both'), posed_image.nii.gz, transform.nrrd and report.json into the folder, as "
+          "`repose pose` does.");
 
   py::class_<Rig>(m, "Rig", R"doc(
 A body rigged for a pose: the cage and transfer mesh (built from the body-part map S, with the

@@ -73,6 +73,7 @@ LabelTable labelsFromPython(const py::object& labels) {
       l.value = k.cast<int>();
       l.name = v.cast<std::string>();
       l.color = LabelTable::defaultColor(l.value);
+      l.colorGenerated = true;
       table.set(l);
     }
     return table;
@@ -83,10 +84,12 @@ LabelTable labelsFromPython(const py::object& labels) {
     l.value = d["value"].cast<int>();
     l.name = d.contains("name") ? d["name"].cast<std::string>() : std::string();
     l.color = LabelTable::defaultColor(l.value);
+    l.colorGenerated = true;
     if (d.contains("color")) {
       const auto c = d["color"].cast<std::vector<double>>();
       if (c.size() != 3) throw py::value_error("a label's color is three numbers in [0, 1]");
       l.color = {c[0], c[1], c[2]};
+      l.colorGenerated = false;
     }
     if (d.contains("layer")) l.layer = d["layer"].cast<int>();
     if (d.contains("id")) l.id = d["id"].cast<std::string>();

@@ -36,14 +36,32 @@ TriangleMesh assemble(const std::vector<Eigen::Vector3d>& v, const std::vector<E
   return m;
 }
 
+// 3D Slicer's rule for a model file (vtkMRMLModelStorageNode::GetCoordinateSystemFromFileHeader):
+// the header or first comment says SPACE=RAS or SPACE=LPS. Slicer writes LPS by default (so does
+// every model it hands a CLI module); files without the tag are read as RAS, Repose's own
+// convention (docs/FORMATS.md).
+bool saysLps(const std::string& header) {
+  return header.find("SPACE=LPS") != std::string::npos;
+}
+
+TriangleMesh toRas(TriangleMesh mesh, bool lps) {
+  if (lps) mesh.vertices.leftCols(2) *= -1.0;
+  return mesh;
+}
+
 TriangleMesh readObj(const std::string& path, std::istream& in) {
   std::vector<Eigen::Vector3d> v;
   std::vector<Eigen::Vector3i> f;
   std::string line;
+  bool lps = false, firstComment = true;
   for (int number = 1; std::getline(in, line); ++number) {
     std::istringstream s(line);
     std::string tag;
     s >> tag;
+    if (!tag.empty() && tag[0] == '#' && firstComment) {  // vtkOBJReader::GetComment: the first
+      lps = saysLps(line);
+      firstComment = false;
+    }
     if (tag == "v") {
       Eigen::Vector3d p;
       if (!(s >> p.x() >> p.y() >> p.z()))
@@ -64,12 +82,17 @@ TriangleMesh readObj(const std::string& path, std::istream& in) {
       for (std::size_t k = 1; k + 1 < idx.size(); ++k) f.emplace_back(idx[0], idx[k], idx[k + 1]);
     }
   }
-  return assemble(v, f, path);
+  return toRas(assemble(v, f, path), lps);
 }
 
 TriangleMesh readVtk(const std::string& path, std::istream& in) {
   std::vector<Eigen::Vector3d> v;
   std::vector<Eigen::Vector3i> f;
+  // The header line (the second) carries the coordinate system (vtkPolyDataReader::GetHeader).
+  std::string version, header;
+  std::getline(in, version);
+  std::getline(in, header);
+  const bool lps = saysLps(header);
   std::string word;
   bool ascii = false;
   while (in >> word) {
@@ -106,7 +129,7 @@ TriangleMesh readVtk(const std::string& path, std::istream& in) {
     }
   }
   if (!ascii) throwFileError(path, "not an ASCII legacy VTK file");
-  return assemble(v, f, path);
+  return toRas(assemble(v, f, path), lps);
 }
 
 }  // namespace

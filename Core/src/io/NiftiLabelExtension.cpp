@@ -2,6 +2,8 @@
 // XML parser is not worth the dependency; unknown elements and attributes are ignored.
 #include "NiftiLabelExtension.h"
 
+#include "repose/util/XmlText.h"
+
 #include <cstdlib>
 #include <sstream>
 
@@ -40,29 +42,6 @@ std::string unescapeXml(const std::string& s) {
       out += s.substr(i, semi - i + 1);
     }
     i = semi;
-  }
-  return out;
-}
-
-std::string escapeXml(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
   }
   return out;
 }
@@ -129,8 +108,10 @@ LabelTable parseCaretLabelTable(const std::string& xml) {
                       b = attribute(tag, "Blue");
     if (!r.empty() && !g.empty() && !b.empty())
       label.color = {std::atof(r.c_str()), std::atof(g.c_str()), std::atof(b.c_str())};
-    else
+    else {
       label.color = LabelTable::defaultColor(label.value);
+      label.colorGenerated = true;
+    }
     table.set(label);
   }
   return table;

@@ -3,10 +3,12 @@
 #include "repose/pose/PoseFrame.h"
 
 #include "repose/io/AtomicOutput.h"
+#include "repose/io/ColorTableIO.h"
 #include "repose/io/NrrdIO.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/VolumePrediction.h"
 #include "repose/pose/PoseReport.h"
+#include "repose/pose/SlicerSceneMrml.h"
 #include "repose/raster/PieceOverlap.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
@@ -128,7 +130,31 @@ nlohmann::json collisionReport(const std::vector<PieceOverlap>& overlaps, const 
   return {{"voxels", total}, {"volume_ml", double(total) * voxelMm3 / 1000}, {"pairs", pairs}};
 }
 
+// The report's "outputs": the label maps (the NIfTI when both formats are written), their Slicer
+// companions, and the field.
+nlohmann::json outputFiles(LabelMapFiles files) {
+  const bool nifti = files != LabelMapFiles::SegNrrd, seg = files != LabelMapFiles::Nifti;
+  const char* ext = nifti ? ".nii.gz" : ".seg.nrrd";
+  nlohmann::json out = {{"posed_labels", std::string("posed_G") + ext},
+                        {"posed_parts", std::string("posed_S") + ext},
+                        {"transform", "transform.nrrd"}};
+  if (nifti) out["color_tables"] = {"posed_G.ctbl", "posed_S.ctbl"};
+  if (seg) out["segmentations"] = {"posed_G.seg.nrrd", "posed_S.seg.nrrd"};
+  return out;
+}
+
 }  // namespace
+
+LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inputPath) {
+  if (choice == "nii.gz") return LabelMapFiles::Nifti;
+  if (choice == "seg.nrrd") return LabelMapFiles::SegNrrd;
+  if (choice == "both") return LabelMapFiles::Both;
+  if (choice == "auto")
+    return !inputPath.empty() && formatForPath(inputPath) == FileFormat::SegNrrd
+               ? LabelMapFiles::SegNrrd
+               : LabelMapFiles::Nifti;
+  throw Error("output format '" + choice + "' is not one of auto, nii.gz, seg.nrrd, both");
+}
 
 double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volume* image) {
   return double(scalarSize(organs.scalarType())) + double(scalarSize(parts.scalarType())) + 12 +
@@ -203,9 +229,8 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   ri.unreachableVertices = rig.deformation().solver().unconstrainedVertices();
   ri.rigidVertices = rig.influence().rigidVertices();
   const Eigen::Vector3d spacing = out.grid.spacing();
-  nlohmann::json outputs = {{"posed_labels", "posed_G.nii.gz"},
-                            {"posed_parts", "posed_S.nii.gz"},
-                            {"transform", "transform.nrrd"}};
+  out.labelMapFiles = options.labelMapFiles;
+  nlohmann::json outputs = outputFiles(out.labelMapFiles);
   if (out.image) outputs["posed_image"] = "posed_image.nii.gz";
   nlohmann::json report = {
       {"pose", rig.pose().name},
@@ -241,7 +266,15 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   return out;
 }
 
-void writePosedFrame(const PosedFrame& frame, const std::string& folder) {
+std::string writePosedFrame(const PosedFrame& frame, const std::string& folder) {
+  FrameWriteOptions options;
+  options.labelMapFiles = frame.labelMapFiles;
+  return writePosedFrame(frame, folder, options);
+}
+
+std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
+                            const FrameWriteOptions& options) {
+  const LabelMapFiles files = options.labelMapFiles;
   namespace fs = std::filesystem;
   fs::path dir = fs::absolute(fs::path(folder)).lexically_normal();
   if (!dir.has_filename()) dir = dir.parent_path();  // "OUT/frame/"
@@ -259,26 +292,54 @@ void writePosedFrame(const PosedFrame& frame, const std::string& folder) {
       fs::remove_all(path, ignored);
     }
   } cleanup{temp};
-  writeVolume(frame.organs, (temp / "posed_G.nii.gz").string());
-  writeVolume(frame.parts, (temp / "posed_S.nii.gz").string());
+  const bool nifti = files != LabelMapFiles::SegNrrd;
+  const bool seg = files != LabelMapFiles::Nifti;
+  for (const auto& [map, stem] : {std::pair{&frame.organs, "posed_G"}, {&frame.parts, "posed_S"}}) {
+    if (nifti) {
+      writeVolume(*map, (temp / (std::string(stem) + ".nii.gz")).string());
+      writeColorTable(*map, (temp / (std::string(stem) + ".ctbl")).string());
+    }
+    if (seg) writeVolume(*map, (temp / (std::string(stem) + ".seg.nrrd")).string());
+  }
   if (frame.image) writeVolume(*frame.image, (temp / "posed_image.nii.gz").string());
   writeDisplacementFieldNrrd(frame.field, frame.grid, (temp / "transform.nrrd").string());
-  writeTextFileAtomically((temp / "report.json").string(),
-                          nlohmann::json::parse(frame.reportJson).dump(2) + "\n");
+  // The report names the files this write made, whatever the frame's report said before.
+  nlohmann::json report = nlohmann::json::parse(frame.reportJson);
+  report["outputs"] = outputFiles(files);
+  if (frame.image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
+  if (!options.sceneInputLabels.empty()) {
+    // Written as it will lie in `dir`: the frame's files relative to it.
+    SlicerSceneFiles scene;
+    scene.inputLabels = fs::absolute(options.sceneInputLabels).string();
+    scene.posedLabels = (dir / (nifti ? "posed_G.nii.gz" : "posed_G.seg.nrrd")).string();
+    if (nifti) scene.colorTable = (dir / "posed_G.ctbl").string();
+    scene.transform = (dir / "transform.nrrd").string();
+    scene.cage = options.sceneCage;
+    scene.transferMesh = options.sceneTransferMesh;
+    writeTextFileAtomically((temp / "scene.mrml").string(), formatSlicerScene(scene, dir.string()));
+    report["outputs"]["slicer_scene"] = "scene.mrml";
+  }
+  const std::string written = report.dump();
+  writeTextFileAtomically((temp / "report.json").string(), report.dump(2) + "\n");
   throwIfInterrupted();
   std::error_code ec;
   if (!fs::exists(dir)) {
     fs::rename(temp, dir, ec);
     if (ec) throwFileError(folder, "cannot move the frame into place: " + ec.message());
-    return;
+    return written;
   }
-  // An existing folder (a re-run): its files are replaced one by one, the report last.
+  // An existing folder (a re-run): its files are replaced one by one, the report last; ours that
+  // this frame does not write are removed (a report never sits beside another run's files).
   for (const char* name :
-       {"posed_G.nii.gz", "posed_S.nii.gz", "posed_image.nii.gz", "transform.nrrd", "report.json"})
-    if (fs::exists(temp / name)) {
+       {"posed_G.nii.gz", "posed_G.ctbl", "posed_G.seg.nrrd", "posed_S.nii.gz", "posed_S.ctbl",
+        "posed_S.seg.nrrd", "posed_image.nii.gz", "transform.nrrd", "scene.mrml", "report.json"}) {
+    if (fs::exists(temp / name))
       fs::rename(temp / name, dir / name, ec);
-      if (ec) throwFileError((dir / name).string(), "cannot move into place: " + ec.message());
-    }
+    else if (fs::exists(dir / name))
+      fs::remove(dir / name, ec);
+    if (ec) throwFileError((dir / name).string(), "cannot move into place: " + ec.message());
+  }
+  return written;
 }
 
 }  // namespace repose

@@ -5,6 +5,7 @@
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/util/Error.h"
+#include "repose/volume/LabelStatistics.h"
 
 #include <nlohmann/json.hpp>
 
@@ -26,9 +27,8 @@ namespace {
 bool labelsSoftTissue(const LabelConvention& convention) {
   for (const auto& [value, role] : convention.roles) {
     std::string name = role.name;
-    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) {
-      return char(std::tolower(c));
-    });
+    std::transform(name.begin(), name.end(), name.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     for (const char* word : {"skin", "fat", "adipose", "muscle", "residual", "body"})
       if (name.find(word) != std::string::npos) return true;
   }
@@ -154,23 +154,23 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
                              {"volume_ml", double(count[std::size_t(v)]) * ml}});
   }
   nlohmann::json jointsJson = nlohmann::json::parse(skeletonToJson(out.skeleton))["joints"];
-  nlohmann::json report = {{"input", source},
-                           {"convention", out.convention.name},
-                           {"detection", out.convention.detection},
-                           {"body_frame",
-                            {{"superior", {up.x(), up.y(), up.z()}},
-                             {"anterior", {ant.x(), ant.y(), ant.z()}},
-                             {"midline_x_mm", bones.frame.midlineX}}},
-                           {"bones", bonesJson},
-                           {"joints", jointsJson},
-                           {"missing", out.missing},
-                           {"warnings", out.warnings},
-                           {"parts", partsJson},
-                           {"body_outline", options.image
-                                                ? nlohmann::json{{"image", options.imageSource},
-                                                                 {"method", outlineHow}}
-                                                : nlohmann::json()},
-                           {"unreached_voxels", stats.unreached}};
+  nlohmann::json report = {
+      {"input", source},
+      {"convention", out.convention.name},
+      {"detection", out.convention.detection},
+      {"body_frame",
+       {{"superior", {up.x(), up.y(), up.z()}},
+        {"anterior", {ant.x(), ant.y(), ant.z()}},
+        {"midline_x_mm", bones.frame.midlineX}}},
+      {"bones", bonesJson},
+      {"joints", jointsJson},
+      {"missing", out.missing},
+      {"warnings", out.warnings},
+      {"parts", partsJson},
+      {"body_outline", options.image
+                           ? nlohmann::json{{"image", options.imageSource}, {"method", outlineHow}}
+                           : nlohmann::json()},
+      {"unreached_voxels", stats.unreached}};
   out.reportJson = report.dump();
   out.skeleton.source = "";
   reportProgress(options.progress, 1.0, "rig: done");
@@ -204,6 +204,19 @@ void writeRigFolder(const RigResult& rig, const std::string& folder, const std::
                                        "label is part of."));
   text(report.tempPath(), nlohmann::json::parse(rig.reportJson).dump(2) + "\n");
   commitTogether({&parts, &skeleton, &tissues, &report});
+}
+
+std::string nameBodyPartsByRigConvention(Volume& parts, const std::string& source) {
+  if (!parts.labels().empty() || !isIntegerType(parts.scalarType())) return "";
+  const LabelTable names = rig::rigPartLabels();
+  const std::vector<LabelCount> present = countLabels(parts);
+  if (present.empty()) return "";
+  for (const LabelCount& c : present)
+    if (c.layer != 0 || !names.find(c.value)) return "";
+  parts.labels() = names;
+  return source +
+         ": no part names in the file; its values are named as `repose rig` names them (1 head, "
+         "2 torso, 3 upper_arm_left, ... 14 foot_right)";
 }
 
 }  // namespace repose

@@ -461,6 +461,7 @@ LabelTable rigPartLabels() {
     l.value = v;
     l.name = names[v];
     l.color = LabelTable::defaultColor(v);
+    l.colorGenerated = true;
     t.set(l);
   }
   return t;

@@ -249,3 +249,31 @@ TEST(Rig, AnOrganSegmentationIsGivenItsBodyByTheScanItWasMadeFrom) {
         << e.what();
   }
 }
+
+// 3D Slicer hands a CLI module its label maps as plain NRRD, without names: S's values are named
+// as the rig names them only when S has no table and every value is one of the rig's parts.
+TEST(Rig, AnUnnamedBodyPartMapIsNamedByTheRigsConventionOnlyWhenItFits) {
+  VolumeGeometry g;
+  g.dims = {4, 4, 4};
+  Volume s(g, ScalarType::UInt8);
+  s.data<std::uint8_t>()[0] = 4;
+  s.data<std::uint8_t>()[1] = 14;
+  s.setLabelMap(true);
+  Volume plain = s;
+  EXPECT_NE(nameBodyPartsByRigConvention(plain, "S.nrrd").find("S.nrrd"), std::string::npos);
+  ASSERT_NE(plain.labels().find(4), nullptr);
+  EXPECT_EQ(plain.labels().find(4)->name, "forearm_left");
+  EXPECT_EQ(plain.labels().find(14)->name, "foot_right");
+  // A value outside the convention: left alone.
+  Volume other = s;
+  other.data<std::uint8_t>()[2] = 15;
+  EXPECT_EQ(nameBodyPartsByRigConvention(other, "S.nrrd"), "");
+  EXPECT_TRUE(other.labels().empty());
+  // A map with its own names: left alone.
+  Volume named = s;
+  Label l;
+  l.value = 4, l.name = "lower arm";
+  named.labels().set(l);
+  EXPECT_EQ(nameBodyPartsByRigConvention(named, "S.nrrd"), "");
+  EXPECT_EQ(named.labels().find(4)->name, "lower arm");
+}

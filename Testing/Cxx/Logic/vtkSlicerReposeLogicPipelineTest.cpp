@@ -27,6 +27,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <set>
 #include <thread>
 
 using namespace repose::test;
@@ -144,6 +146,31 @@ TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
   const std::string sceneDir = files.dir.file("scene");
   ASSERT_TRUE(logic->SaveScene(sceneDir)) << logic->GetLastErrorMessage();
   EXPECT_TRUE(std::filesystem::exists(sceneDir + "/scene.json"));
+  // And a 3D Slicer scene of it (docs/SLICER.md; its conventions: test_slicer_scene.py): every
+  // file it names is in the folder, the input and the posed label maps and both meshes among them.
+  {
+    std::ifstream in(sceneDir + "/scene.mrml");
+    const std::string mrml((std::istreambuf_iterator<char>(in)), {});
+    std::regex file(R"re(fileName="([^"]+)")re");
+    std::set<std::string> named;
+    for (auto it = std::sregex_iterator(mrml.begin(), mrml.end(), file);
+         it != std::sregex_iterator(); ++it) {
+      named.insert((*it)[1]);
+      EXPECT_TRUE(std::filesystem::exists(sceneDir + "/" + (*it)[1].str())) << (*it)[1];
+    }
+    EXPECT_TRUE(named.count(std::string(seg->GetID()) + "_G.nii.gz"));
+    EXPECT_TRUE(named.count(std::string(posed->GetID()) + "_G.nii.gz"));
+    EXPECT_TRUE(named.count(cage->GetFileName()));
+    auto count = [&](const std::string& tag) {
+      std::size_t n = 0;
+      for (std::size_t at = mrml.find(tag); at != std::string::npos; at = mrml.find(tag, at + 1))
+        ++n;
+      return n;
+    };
+    EXPECT_EQ(count("<LabelMapVolume\n"), 2u);  // the input and the posed G
+    EXPECT_EQ(count("<Model\n"), 2u);           // the cage and the transfer mesh
+    EXPECT_EQ(count("<ColorTable\n"), 1u);
+  }
   vtkNew<vtkSlicerReposeLogic> other;
   ASSERT_TRUE(other->LoadScene(sceneDir)) << other->GetLastErrorMessage();
   EXPECT_EQ(other->GetScene()->GetNumberOfNodes(), scene->GetNumberOfNodes());

@@ -16,6 +16,14 @@
 
 namespace repose {
 
+// The files that hold a frame's posed label maps (docs/FORMATS.md): NIfTI with a 3D Slicer colour
+// table beside each (.ctbl: Slicer ignores a NIfTI's own label table and would show grey values),
+// Slicer segmentations (.seg.nrrd: names, colours and terminology open as segments), or both.
+enum class LabelMapFiles { Nifti, SegNrrd, Both };
+// "nii.gz", "seg.nrrd" or "both"; "auto": .seg.nrrd when the input label map is one, else NIfTI.
+// Throws repose::Error naming the choice otherwise.
+LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inputPath);
+
 struct PoseFrameOptions {
   const Volume* image = nullptr;         // on G's grid, posed alongside (trilinear)
   double background = 0;                 // the image's value where no tissue is
@@ -35,6 +43,7 @@ struct PoseFrameOptions {
   std::function<void(const std::string&)> warn;
   // The rig's RigSettings::bonePieces: which labels of G a bone's one piece holds.
   std::map<int, int> bonePieces;
+  LabelMapFiles labelMapFiles = LabelMapFiles::Nifti;  // what writePosedFrame writes
 };
 
 struct PosedFrame {
@@ -44,6 +53,7 @@ struct PosedFrame {
   std::optional<Volume> image;
   std::vector<float> field;  // 3 floats a voxel, RAS mm from the voxel to its rest position
   std::string reportJson;    // the report.json object (the caller may add what it knows)
+  LabelMapFiles labelMapFiles = LabelMapFiles::Nifti;  // its "outputs" name these files
 };
 
 // Bytes a posed frame holds per output voxel (G, S, image, field): budgets check this times the
@@ -55,9 +65,22 @@ double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volum
 PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs,
                      const Volume& parts, const PoseFrameOptions& options = {});
 
-// Writes the frame into `folder` (created; its parent must exist): posed_G.nii.gz,
-// posed_S.nii.gz, posed_image.nii.gz (with an image), transform.nrrd and report.json, each
-// atomically.
-void writePosedFrame(const PosedFrame& frame, const std::string& folder);
+// Writes the frame into `folder` (created; its parent must exist): posed_G and posed_S as
+// frame.labelMapFiles says (posed_G.nii.gz + posed_G.ctbl, posed_G.seg.nrrd, or all three),
+// posed_image.nii.gz (with an image), transform.nrrd and report.json, as one unit: an error or an
+// interrupt leaves the folder as it was. Files of ours an earlier run left there and this frame
+// does not write (another label-map format, an image) are removed, so nothing stale remains.
+std::string writePosedFrame(const PosedFrame& frame, const std::string& folder);
+struct FrameWriteOptions {
+  LabelMapFiles labelMapFiles = LabelMapFiles::Nifti;
+  // With a rig kept in a scene folder: also scene.mrml, a 3D Slicer scene of the input label map,
+  // the posed one, the field, the cage and the transfer mesh (pose/SlicerSceneMrml.h). Absolute
+  // paths of G, the cage and the mesh; empty: no scene.mrml.
+  std::string sceneInputLabels, sceneCage, sceneTransferMesh;
+};
+// The same, with the label maps and the scene as `options` say (not frame.labelMapFiles).
+// Both return report.json's text as written (its "outputs" name the files written).
+std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
+                            const FrameWriteOptions& options);
 
 }  // namespace repose

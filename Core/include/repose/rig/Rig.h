@@ -46,4 +46,10 @@ RigResult rigBody(const Volume& organs, const RigOptions& options = {});
 // parent must exist), all four or none. `input` names G in the files.
 void writeRigFolder(const RigResult& rig, const std::string& folder, const std::string& input);
 
+// The part names `repose rig` and `repose phantom` give S's values (1 head, 2 torso, 3
+// upper_arm_left, ... 14 foot_right). Names S when it carries no label table at all and its values
+// all lie in that range: a plain NRRD or NIfTI without a table, as 3D Slicer hands a CLI module
+// the label map volumes it exports. Returns the warning to give (empty when S was left alone).
+std::string nameBodyPartsByRigConvention(Volume& parts, const std::string& source);
+
 }  // namespace repose

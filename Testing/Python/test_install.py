@@ -1,0 +1,56 @@
+"""`cmake --install` (make install) lays out a folder that works on its own (issue 22): the
+installed `repose` finds its library beside it, runs a pose, and the folder's 3D Slicer CLI module
+answers --xml, after the folder was moved; no installed file names the source or build tree.
+"""
+import json
+import pathlib
+import shutil
+import subprocess
+
+import pytest
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def installed(bin_dir, tmp_path_factory):
+    build = bin_dir.parent
+    root = tmp_path_factory.mktemp("install")
+    r = subprocess.run(["cmake", "--install", str(build), "--prefix", str(root / "prefix")],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    # Moved as a whole: nothing may depend on where it was installed.
+    moved = root / "moved"
+    shutil.move(str(root / "prefix"), str(moved))
+    return moved
+
+
+def test_the_installed_command_runs_a_pose_from_its_folder(installed, tmp_path):
+    repose = installed / "bin" / "repose"
+    run = lambda *a: subprocess.run([str(repose), *map(str, a)], capture_output=True, text=True,
+                                    cwd=tmp_path)
+    r = run("--version")
+    assert r.returncode == 0 and r.stdout.startswith("repose "), r.stderr
+    assert run("phantom", "--voxel", "8", "--out", tmp_path / "ph").returncode == 0
+    r = run("pose", "--input", tmp_path / "ph" / "G.nii.gz", "--parts", tmp_path / "ph" / "S.nii.gz",
+            "--pose", REPO / "bench" / "poses" / "elbow90.pose.json", "--out", tmp_path / "o",
+            "--json")
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["labels_lost"] == 0
+
+
+def test_the_slicer_module_folder_is_where_the_docs_say(installed):
+    modules = list(installed.glob("lib*/repose/cli-modules/ReposePose"))
+    assert len(modules) == 1, list(installed.rglob("*"))
+    r = subprocess.run([str(modules[0]), "--xml"], capture_output=True, text=True, timeout=5)
+    assert r.returncode == 0, r.stderr
+    assert "<category>Segmentation.Repose</category>" in r.stdout
+
+
+def test_no_installed_file_names_the_source_or_build_tree(installed, bin_dir):
+    trees = {str(REPO).encode(), str(bin_dir.parent.resolve()).encode()}
+    for f in installed.rglob("*"):
+        if f.is_file() and not f.is_symlink():
+            data = f.read_bytes()
+            for t in trees:
+                assert t not in data, f"{f} names {t.decode()}"
