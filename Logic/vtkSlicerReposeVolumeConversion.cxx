@@ -110,6 +110,8 @@ void vtkSlicerReposeVolumeConversion::SetLabelTable(vtkImageData* image,
   auto names = vtkSmartPointer<vtkStringArray>::New();
   auto ids = vtkSmartPointer<vtkStringArray>::New();
   auto tags = vtkSmartPointer<vtkStringArray>::New();
+  auto generated = vtkSmartPointer<vtkIntArray>::New();
+  generated->SetName(LabelColorGeneratedArrayName);
   values->SetName(LabelValueArrayName);
   layers->SetName(LabelLayerArrayName);
   colors->SetName(LabelColorArrayName);
@@ -124,9 +126,10 @@ void vtkSlicerReposeVolumeConversion::SetLabelTable(vtkImageData* image,
     names->InsertNextValue(label.name);
     ids->InsertNextValue(label.id);
     tags->InsertNextValue(label.tags);
+    generated->InsertNextValue(label.colorGenerated ? 1 : 0);
   }
   vtkFieldData* fields = image->GetFieldData();
-  vtkAbstractArray* arrays[] = {values, layers, colors, names, ids, tags};
+  vtkAbstractArray* arrays[] = {values, layers, colors, names, ids, tags, generated};
   for (vtkAbstractArray* array : arrays) fields->AddArray(array);  // replaces a same-named one
 }
 
@@ -139,6 +142,8 @@ repose::LabelTable vtkSlicerReposeVolumeConversion::GetLabelTable(vtkImageData* 
   auto* names = vtkStringArray::SafeDownCast(fields->GetAbstractArray(LabelNameArrayName));
   auto* ids = vtkStringArray::SafeDownCast(fields->GetAbstractArray(LabelIDArrayName));
   auto* tags = vtkStringArray::SafeDownCast(fields->GetAbstractArray(LabelTagsArrayName));
+  auto* generated =
+      vtkIntArray::SafeDownCast(fields->GetAbstractArray(LabelColorGeneratedArrayName));
   if (!values || !layers || !colors || !names || !ids || !tags) return table;
   const vtkIdType n = values->GetNumberOfValues();
   if (layers->GetNumberOfValues() != n || colors->GetNumberOfTuples() != n ||
@@ -153,6 +158,8 @@ repose::LabelTable vtkSlicerReposeVolumeConversion::GetLabelTable(vtkImageData* 
     label.name = names->GetValue(i);
     label.id = ids->GetValue(i);
     label.tags = tags->GetValue(i);
+    label.colorGenerated =
+        generated && generated->GetNumberOfValues() == n && generated->GetValue(i) != 0;
     table.set(label);
   }
   return table;

@@ -21,6 +21,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeVolumeConversion {
   static constexpr const char* LabelColorArrayName = "ReposeLabelColor";
   static constexpr const char* LabelIDArrayName = "ReposeLabelID";
   static constexpr const char* LabelTagsArrayName = "ReposeLabelTags";
+  // 1 where the colour was made up (Label::colorGenerated); optional on reading.
+  static constexpr const char* LabelColorGeneratedArrayName = "ReposeLabelColorGenerated";
   static constexpr const char* LabelMapFlagArrayName = "ReposeIsLabelMap";
 
   // A copy of the voxels: layer l of the volume becomes component l of the point scalars.

@@ -7,7 +7,7 @@ against the conventions of Slicer's MRML writer and reader (Slicer/Slicer, Libs/
 - vtkMRMLNode.cxx: references="role:id;...;" with the roles in alphabetical order (a std::map),
   every referenced node present;
 - vtkMRMLStorageNode.cxx: fileName URL-encoded (URLEncodeString) and relative to the folder holding
-  the scene when inside it, resolved against that folder on read;
+  the scene (as Slicer writes it), resolved against that folder on read;
 - vtkMRMLModelStorageNode.cxx: coordinateSystem "RAS" (the files also say SPACE=RAS, which wins);
 - display nodes name their colour table with colorNodeID.
 """
@@ -95,7 +95,7 @@ def test_the_scene_follows_mrml_conventions(scenes, case):
                 assert i in nodes, f"{node.get('id')} references missing {i}"
                 assert TAGS[nodes[i].tag] == role, (node.get("id"), role, nodes[i].tag)
         if TAGS[node.tag] == "storage":
-            # URL-encoded: no raw space; relative inside the scene's folder.
+            # URL-encoded: no raw space.
             assert " " not in node.get("fileName")
             path = file_of(node, folder)
             assert path.is_file(), path
@@ -113,8 +113,11 @@ def test_the_scene_follows_mrml_conventions(scenes, case):
         assert "storage" in refs
         if n.tag in ("LabelMapVolume", "Segmentation", "Model"):
             assert "display" in refs
-    # The frame's own files are named relative to the scene, the inputs absolutely.
+    # Every file named relative to the scene's folder, as Slicer's writer does.
     storage = {urllib.parse.unquote(n.get("fileName")) for n in root if TAGS[n.tag] == "storage"}
+    assert not any(pathlib.Path(f).is_absolute() for f in storage), storage
+    assert "../scene/cage.vtk" in storage and "../scene/tm.vtu" in storage
+    assert ("../G.nii.gz" if case == "nifti" else "../G.seg.nrrd") in storage
     assert "transform.nrrd" in storage
     assert ("posed_G.nii.gz" if case == "nifti" else "posed_G.seg.nrrd") in storage
     if case == "nifti":

@@ -2,10 +2,10 @@
 // its tag (vtkMRML*Node::GetNodeTagName) with id, name and the base attributes
 // (vtkMRMLNode::WriteXML); references="role:id;..." with the roles in alphabetical order
 // (NodeReferences is a std::map); storage nodes carry a URL-encoded fileName
-// (vtkMRMLNode::URLEncodeString), relative to the scene's folder when inside it
-// (vtkMRMLStorageNode::WriteXML); model storage says coordinateSystem="RAS" (the files say
-// SPACE=RAS too, which wins: vtkMRMLModelStorageNode.cxx); display nodes name their colour table by
-// colorNodeID, not by a reference.
+// (vtkMRMLNode::URLEncodeString), relative to the scene's folder (vtkMRMLStorageNode::WriteXML);
+// model storage says coordinateSystem="RAS" (the files say SPACE=RAS too, which wins:
+// vtkMRMLModelStorageNode.cxx); display nodes name their colour table by colorNodeID, not by a
+// reference.
 #include "repose/pose/SlicerSceneMrml.h"
 
 #include "repose/util/XmlText.h"
@@ -66,12 +66,13 @@ class SceneWriter {
  public:
   explicit SceneWriter(fs::path folder) : folder_(fs::absolute(std::move(folder))) {}
 
-  // A file's name as the scene stores it: relative inside the scene's folder, else absolute.
+  // A file's name as the scene stores it: relative to the scene's folder, as Slicer's own writer
+  // stores every file (vtksys::SystemTools::RelativePath from the scene's root directory), so the
+  // results, the scene folder and the input keep working when moved together.
   std::string fileName(const std::string& path) const {
     const fs::path p = fs::absolute(path).lexically_normal();
     const fs::path rel = p.lexically_relative(folder_.lexically_normal());
-    const bool inside = !rel.empty() && *rel.begin() != "..";
-    return urlEncode(inside ? rel.generic_string() : p.generic_string());
+    return urlEncode(rel.empty() ? p.generic_string() : rel.generic_string());
   }
 
   void node(const std::string& tag, const std::string& id, const std::string& name, bool hidden,

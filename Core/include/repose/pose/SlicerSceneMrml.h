@@ -8,8 +8,8 @@
 
 namespace repose {
 
-// The files a scene names. Paths inside the scene's folder are written relative to it (Slicer
-// resolves a relative fileName against the folder holding the .mrml), others absolute.
+// The files a scene names, written relative to the scene's folder as Slicer writes them (it
+// resolves a relative fileName against the folder holding the .mrml).
 struct SlicerSceneFiles {
   std::string inputLabels;   // G: a .seg.nrrd opens as a segmentation, else as a label map volume
   std::string posedLabels;   // posed_G.nii.gz or posed_G.seg.nrrd
