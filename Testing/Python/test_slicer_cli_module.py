@@ -229,13 +229,15 @@ def test_a_bad_run_fails_with_one_line_and_no_output(module, tmp_path):
 
 
 def write_slicer_obj(path, vertices, faces):
-    """A model as Slicer hands it to a CLI module (vtkMRMLModelStorageNode.cxx: vtkOBJExporter
-    with the comment "3D Slicer output. SPACE=LPS"; coordinates in LPS, normals, v//vn faces)."""
-    lines = ["# 3D Slicer output. SPACE=LPS", "", f"mtllib {path.stem}.mtl", "o mesh1"]
+    """A model as Slicer hands it to a CLI module: vtkMRMLModelStorageNode.cxx converts it to LPS
+    and writes it with vtkOBJExporter, comment "3D Slicer output. SPACE=LPS"; the exporter's
+    layout (vtkOBJExporter.cxx WriteData/WriteAnActor): "#  <comment>", a blank line, mtllib,
+    vertices, normals, a group, the material, faces "i//i"."""
+    lines = ["#  3D Slicer output. SPACE=LPS", "", f"mtllib {path.stem}.mtl", ""]
     lines += [f"v {-x!r} {-y!r} {z!r}" for x, y, z in vertices]
     lines += ["vn 0 0 1"] * len(vertices)
-    lines += ["usemtl mtl1"] + [f"f {a + 1}//{a + 1} {b + 1}//{b + 1} {c + 1}//{c + 1}"
-                                for a, b, c in faces]
+    lines += ["", "g grp1", "usemtl mtl1"]
+    lines += [f"f {a + 1}//{a + 1} {b + 1}//{b + 1} {c + 1}//{c + 1} " for a, b, c in faces]
     path.write_text("\n".join(lines) + "\n")
 
 
