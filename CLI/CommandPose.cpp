@@ -45,10 +45,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-}  // namespace
-
-namespace {
-
 // The frame a 3D Slicer CLI module (or a script) takes back as single files, and the report's
 // headline figures as Slicer's return parameters.
 struct FrameOutputs {
