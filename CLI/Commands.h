@@ -17,6 +17,7 @@ int runMesh(const Args& args);
 int runWarp(const Args& args);
 int runPose(const Args& args);
 int runRig(const Args& args);
+int runExportFdtd(const Args& args);
 
 struct Command {
   const char* name;
@@ -35,6 +36,8 @@ inline const Command kCommands[] = {
     {"mesh", "build the transfer mesh and embed it in the cage", runMesh},
     {"warp", "pose a label map (and image) at full resolution from a posed cage", runWarp},
     {"pose", "the whole job: label maps + pose file -> posed maps, transform, report", runPose},
+    {"export-fdtd", "a (posed) label map as an openEMS FDTD model: tissues at a frequency",
+     runExportFdtd},
 };
 
 }  // namespace repose::cli

@@ -6,13 +6,14 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build ccache g++ pkg-config zlib1g-dev
   libeigen3-dev libsuitesparse-dev libcgal-dev
-  libnifti2-dev libteem-dev libgdcm-dev
+  libnifti2-dev libteem-dev libgdcm-dev libhdf5-dev
   libvtk9-dev libvtk9-qt-dev qtbase5-dev
   nlohmann-json3-dev libgtest-dev libbenchmark-dev
   python3-dev pybind11-dev
   python3-numpy python3-nibabel python3-pytest python3-matplotlib python3-jsonschema
   xvfb xauth libxml2-utils
   plastimatch time
+  openems python3-openems libopenems-dev python3-h5py
 )
 
 missing=()

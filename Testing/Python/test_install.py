@@ -7,6 +7,7 @@ import os
 import pathlib
 import shutil
 import subprocess
+import sys
 
 import pytest
 
@@ -67,3 +68,18 @@ def test_no_installed_file_names_the_source_or_build_tree(installed, bin_dir):
                 continue
         for t in trees:
             assert t not in data, f"{f} names {t.decode()}"
+
+
+def test_the_installed_python_package_finds_its_csxcad_fix(installed):
+    """repose.openems preloads libReposeCsxcadFix for openEMS (docs/DOSIMETRY.md): the installed
+    package must find the installed library, not the build tree's."""
+    packages = list(installed.glob("lib*/**/dist-packages"))
+    assert len(packages) == 1, packages
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "REPOSE_CSXCAD_FIX")}
+    env["PYTHONPATH"] = str(packages[0])
+    r = subprocess.run([sys.executable, "-c",
+                        "import repose.openems as oe; print(oe.csxcad_fix_library())"],
+                       capture_output=True, text=True, env=env, cwd=installed)
+    assert r.returncode == 0, r.stderr
+    found = pathlib.Path(r.stdout.strip())
+    assert found.is_file() and installed in found.parents, found

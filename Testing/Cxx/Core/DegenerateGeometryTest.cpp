@@ -35,7 +35,12 @@ struct Scene {
       for (int c = 0; c < 4; ++c) x += body.vertices(body.tets(t, c), 0) / 4;
       body.labels[t] = x < 0 ? 1 : 2;
     }
-    mesh = concatenate(body, tetBox({40, 40, 40}, {50, 50, 50}, {1, 1, 1}, 3));
+    // The outside cube's vertices and faces miss every voxel centre of the grids below (centres
+    // at even millimetres): a centre exactly on a vertex of a tet at rest is decided by rounding
+    // (TetScan.h's tie rule, exact only for vertices on the grid), and whether it is written once
+    // or twice then depends on the last bit of the solve (it did on an AMD EPYC's libm), which is
+    // not what these tests are about.
+    mesh = concatenate(body, tetBox({40.3, 40.7, 41.1}, {50.3, 50.7, 51.1}, {1, 1, 1}, 3));
     const VolumeGeometry g =
         VolumeGeometry::make({36, 36, 36}, {2, 2, 2}, {-20, -20, -20}, Eigen::Matrix3d::Identity());
     labels = Volume(g, ScalarType::UInt8);
