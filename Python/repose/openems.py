@@ -17,9 +17,10 @@ density of 1 W/m^2 (the plane wave's S = |E|^2 / (2 eta0), E the peak phasor).
   equal (`balance`: inflow / absorbed; the physics check of Testing/Python/test_openems_sar.py).
 - Whole-body SAR: absorbed power / body mass (cells with a density).
 - Peak 10 g SAR: the largest mean over cubes of 10 g centred on each tissue cell
-  (cube_averaged_sar; IEEE C95.3's simple cube, not IEC/IEEE 62704-1's face and air rules).
-  openEMS's own 10 g averaging (SAR dump 22) aborts the process on cells this coarse (its cube
-  search divides by a zero mass step: "invalid averaging box size!! EXIT").
+  (cube_averaged_sar; IEEE C95.3's simple cube, not IEC/IEEE 62704-1's face and air rules; on
+  openEMS's own local SAR it matches openEMS's IEEE_C95_3 averaging, Testing/Python). openEMS's
+  10 g averaging (SAR dump 22) itself aborts the process on coarse cells (its cube search divides
+  by a zero mass step: "invalid averaging box size!! EXIT").
 - openEMS's local SAR dump is kept for comparison (`openems_absorbed_w`): it takes the field
   interpolated to cell centres, which under-resolved cells (a few per wavelength in tissue)
   underestimate.
