@@ -54,7 +54,8 @@ int runExportFdtd(const Args& args) {
   if (!p.parse(args)) return 0;
   const double frequency = parseFrequencyHz(p.get("frequency"));
   if (p.has("list-tissues")) {
-    std::cout << "tissue,eps_r,sigma_S_m  (at " << frequency << " Hz)\n";
+    std::cout << "# at " << std::setprecision(6) << frequency / 1e6
+              << " MHz\ntissue,eps_r,sigma_S_m\n";
     for (const ColeColeTissue& t : gabrielTissues()) {
       const DielectricValues v = dielectricAt(t, frequency);
       std::cout << t.name << "," << v.relativePermittivity << "," << v.conductivity << "\n";

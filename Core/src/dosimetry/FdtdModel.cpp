@@ -154,6 +154,10 @@ FdtdModel buildFdtdModel(const Volume& organs, const std::map<int, LabelTissue>&
                 std::to_string(std::llround(options.memoryBytes / (1 << 20))) +
                 " MiB): give a larger --spacing-mm or --memory");
 
+  // Every label of G needs its tissue: one left out would silently become background.
+  for (const LabelCount& c : countLabels(organs))
+    if (!labels.count(c.value))
+      throw Error(source + ": label " + std::to_string(c.value) + " has no tissue");
   // Materials: one per (tissue, density), in the order of the labels; 0 is the background.
   std::vector<int> values;
   for (const auto& [v, l] : labels) values.push_back(v);

@@ -48,9 +48,25 @@ std::string materialName(const FdtdModel& model, std::size_t m) {
   return s.str();
 }
 
+// HDF5 prints its own error stack to stderr by default; our one-line error says it instead.
+// The process's handler is put back afterwards (another HDF5 user may rely on it).
+class QuietHdf5Errors {
+ public:
+  QuietHdf5Errors() {
+    H5Eget_auto2(H5E_DEFAULT, &function_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  ~QuietHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, function_, data_); }
+  QuietHdf5Errors(const QuietHdf5Errors&) = delete;
+  QuietHdf5Errors& operator=(const QuietHdf5Errors&) = delete;
+
+ private:
+  H5E_auto2_t function_ = nullptr;
+  void* data_ = nullptr;
+};
+
 void writeHdf5(const FdtdModel& model, const std::string& path, const std::string& finalPath) {
-  // HDF5 prints its own error stack to stderr by default; our one-line error says it instead.
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const QuietHdf5Errors quiet;
   H5Handle file(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
   check(file.ok(), finalPath, "create");
   const double version = 2.0;

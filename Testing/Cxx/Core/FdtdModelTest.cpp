@@ -133,3 +133,15 @@ TEST(FdtdModel, CellSizesAreParsedPerAxis) {
   for (const char* bad : {"", "0", "-1", "1,2", "a", "1,2,3,4", "2mm"})
     EXPECT_THROW(parseCellSizeMm(bad), Error) << bad;
 }
+
+TEST(FdtdModel, ALabelWithoutATissueIsRefusedNotMadeBackground) {
+  const Volume v = permutedBody();
+  std::map<int, LabelTissue> t = tissues();
+  t.erase(7);
+  try {
+    buildFdtdModel(v, t, {}, "body.nii.gz");
+    FAIL() << "label 7 became background";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "body.nii.gz: label 7 has no tissue");
+  }
+}
