@@ -20,6 +20,14 @@ import repose.openems as oe
 pytest.importorskip("h5py")
 pytest.importorskip("openEMS")
 
+# Under the sanitizer build (make test-asan) the interpreter runs with ASan preloaded; preloading
+# libReposeCsxcadFix (and with it CSXCAD, VTK, boost) beside it deadlocks the child interpreter at
+# start in glibc's setlocale lock. The C++ these tests reach is checked under the sanitizer by
+# CsxcadReadback (the fix, CSXCAD reading our files) and ExportFdtdCommand (the export).
+needs_openems = pytest.mark.skipif(
+    os.environ.get("REPOSE_SANITIZE") == "1",
+    reason="openEMS children with ASan and the CSXCAD fix preloaded deadlock at start")
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 BIN = pathlib.Path(os.environ.get("REPOSE_BIN_DIR", REPO / "build" / "bin"))
 REPOSE = str(BIN / "repose")
@@ -90,6 +98,7 @@ def mie_absorption_cross_section(radius_m, eps_r, sigma, frequency_hz):
     return (q_ext - q_sca) * np.pi * radius_m ** 2
 
 
+@needs_openems
 def test_the_model_reads_back_through_csxcad_in_python(tmp_path):
     """CSXCAD loads MODEL.csx.xml; openEMS's raw SAR dump then samples every cell's conductivity
     and density through CSXCAD's discrete material, which must be the model's at each cell."""
@@ -157,6 +166,7 @@ def test_the_model_reads_back_through_csxcad_in_python(tmp_path):
                     "installed, and docs/DOSIMETRY.md's note on the fix is out of date")
 
 
+@needs_openems
 def test_a_muscle_sphere_balances_its_energy_and_converges_to_mie(tmp_path):
     """The physics check: power absorbed (SAR x mass, summed) equals the net power flowing in
     through a closed box round the sphere within 5 %; and the absorption approaches the Mie
@@ -186,6 +196,7 @@ def test_a_muscle_sphere_balances_its_energy_and_converges_to_mie(tmp_path):
     assert abs(error[2.5]) < 0.12, error             # measured +9.2 % at 2.5 mm
 
 
+@needs_openems
 def test_the_example_runs_small_and_the_phantom_balances_its_energy(tmp_path):
     out = tmp_path / "sar"
     done = subprocess.run([sys.executable, str(REPO / "Python" / "examples" / "sar_per_posture.py"),
@@ -216,6 +227,7 @@ def test_cube_averaging_is_exact_on_uniform_and_single_cell_sar():
     assert avg.max() == avg[4, 4, 4]
 
 
+@needs_openems
 def test_cube_averaging_matches_openems_c95_3_averaging_on_its_own_local_sar(tmp_path):
     """repose.openems.cube_averaged_sar against openEMS's IEEE C95.3 10 g averaging, both applied
     to openEMS's own local SAR of the 4 mm muscle sphere (where openEMS's averaging runs: on the
