@@ -2,12 +2,12 @@
 
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
-#include "repose/volume/LabelStatistics.h"
 
 #include <Eigen/LU>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <type_traits>
@@ -154,10 +154,6 @@ FdtdModel buildFdtdModel(const Volume& organs, const std::map<int, LabelTissue>&
                 std::to_string(std::llround(options.memoryBytes / (1 << 20))) +
                 " MiB): give a larger --spacing-mm or --memory");
 
-  // Every label of G needs its tissue: one left out would silently become background.
-  for (const LabelCount& c : countLabels(organs))
-    if (!labels.count(c.value))
-      throw Error(source + ": label " + std::to_string(c.value) + " has no tissue");
   // Materials: one per (tissue, density), in the order of the labels; 0 is the background.
   std::vector<int> values;
   for (const auto& [v, l] : labels) values.push_back(v);
@@ -201,6 +197,7 @@ FdtdModel buildFdtdModel(const Volume& organs, const std::map<int, LabelTissue>&
   const std::size_t slotCount = values.size() + 1;
   std::vector<std::int64_t> inputCounts(slotCount, 0), outputCounts(slotCount, 0);
   std::int64_t overlaps = 0;
+  std::int64_t untissued = std::numeric_limits<std::int64_t>::max();  // smallest label without one
 
   dispatchScalar(organs.scalarType(), [&](auto* tag) {
     using T = std::remove_pointer_t<decltype(tag)>;
@@ -215,17 +212,25 @@ FdtdModel buildFdtdModel(const Volume& organs, const std::map<int, LabelTissue>&
           in[2], options.threads,
           [&](std::int64_t k0, std::int64_t k1) {
             std::vector<std::int64_t> counts(slotCount, 0);
-            std::int64_t overlap = 0;
+            std::int64_t overlap = 0, missing = std::numeric_limits<std::int64_t>::max();
             for (std::int64_t n = k0 * in[0] * in[1]; n < k1 * in[0] * in[1]; ++n) {
               bool both = false;
               ++counts[std::size_t(slots(flattenedLabel(layers, n, &both)))];
               overlap += both;
+              // Every label of G, in any layer, needs its tissue: one left out would silently
+              // become background.
+              for (const T* layer : layers)
+                if (layer[n] != 0 && slots(std::int64_t(layer[n])) == 0)
+                  missing = std::min(missing, std::int64_t(layer[n]));
             }
             std::lock_guard<std::mutex> lock(merge);
             for (std::size_t s = 0; s < slotCount; ++s) inputCounts[s] += counts[s];
             overlaps += overlap;
+            untissued = std::min(untissued, missing);
           },
           1);
+      if (untissued != std::numeric_limits<std::int64_t>::max())
+        throw Error(source + ": label " + std::to_string(untissued) + " has no tissue");
       // Each cell takes the voxel of G nearest its centre; outside G it is background.
       const std::int64_t block = std::max<std::int64_t>(1, grid.dims[2] / 50);
       for (std::int64_t z0 = 0; z0 < grid.dims[2]; z0 += block) {
