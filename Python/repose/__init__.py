@@ -34,6 +34,7 @@ from ._repose import (  # noqa: F401  (re-exported)
     Skeleton,
     Volume,
     __version__,
+    average_sar,
     make_phantom,
     read_volume,
     rig_body,
@@ -43,8 +44,9 @@ from . import _repose
 
 __all__ = [
     "Cancelled", "Error", "Pose", "PosedFrame", "Rig", "RiggedBody", "Scene", "Skeleton",
-    "Volume", "__version__", "build_rig", "from_nibabel", "load_scene", "make_phantom",
-    "read_volume", "rig_body", "to_nibabel", "volume_from_array", "write_volume",
+    "Volume", "__version__", "average_sar", "build_rig", "from_nibabel", "load_scene",
+    "make_phantom", "read_volume", "rig_body", "to_nibabel", "volume_from_array",
+    "write_volume",
 ]
 
 # Voxel types Repose keeps; others are converted (labels to the smallest integer type that holds

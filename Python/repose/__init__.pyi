@@ -151,6 +151,9 @@ def volume_from_array(array: npt.ArrayLike, affine: npt.ArrayLike,
 def from_nibabel(image: Any, labels: Optional[Labels] = ...,
                  label_map: Optional[bool] = ...) -> Volume: ...
 def to_nibabel(volume: Volume) -> Any: ...
+def average_sar(density: npt.ArrayLike, local_sar: npt.ArrayLike, edges_x: npt.ArrayLike,
+                edges_y: npt.ArrayLike, edges_z: npt.ArrayLike, mass_kg: float = ...,
+                threads: int = ..., progress: Optional[Progress] = ...) -> Dict[str, Any]: ...
 def build_rig(organs: Volume, parts: Volume, pose: Pose, *, body: Optional[RiggedBody] = ...,
               skeleton: Union[Skeleton, str, PathLike, None] = ...,
               tissues: Union[str, PathLike, None] = ..., auto_separate: bool = ...,

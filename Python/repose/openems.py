@@ -16,11 +16,14 @@ density of 1 W/m^2 (the plane wave's S = |E|^2 / (2 eta0), E the peak phasor).
   the FDTD's own dissipation, which the net inflow through a closed box around the body must
   equal (`balance`: inflow / absorbed; the physics check of Testing/Python/test_openems_sar.py).
 - Whole-body SAR: absorbed power / body mass (cells with a density).
-- Peak 10 g SAR: the largest mean over cubes of 10 g centred on each tissue cell
-  (cube_averaged_sar; IEEE C95.3's simple cube, not IEC/IEEE 62704-1's face and air rules; on
-  openEMS's own local SAR it matches openEMS's IEEE_C95_3 averaging, Testing/Python). openEMS's
-  10 g averaging (SAR dump 22) itself aborts the process on coarse cells (its cube search divides
-  by a zero mass step: "invalid averaging box size!! EXIT").
+- Peak 10 g SAR: the peak spatial-average SAR by IEC/IEEE 62704-1's cube rules
+  (repose.average_sar, Core's dosimetry/SarAveraging.h: cubes of 10 g to 1e-6 centred on each
+  tissue cell with at most 10 % air and every face touching tissue; cells no such cube holds get
+  the cube behind one of their faces). Debian 12's openEMS cannot do it: its 10 g averaging (SAR
+  dump 22) aborts the process on body models (its cube search divides by a zero mass step:
+  "invalid averaging box size!! EXIT", fixed upstream in 2025). The simple cube of IEEE C95.3
+  (cube_averaged_sar, which matches openEMS's IEEE_C95_3 averaging, Testing/Python) is kept
+  beside it for comparison.
 - openEMS's local SAR dump is kept for comparison (`openems_absorbed_w`): it takes the field
   interpolated to cell centres, which under-resolved cells (a few per wavelength in tissue)
   underestimate.
@@ -130,8 +133,11 @@ class PlaneWaveResult(NamedTuple):
     inflow_w: float               # per W/m^2 incident, net Poynting flux into a box round the body
     openems_absorbed_w: float     # per W/m^2 incident, openEMS's SAR dump (cell-centre field)
     whole_body_sar_w_kg: float    # per W/m^2 incident
-    peak_10g_sar_w_kg: float      # per W/m^2 incident, cube_averaged_sar's largest 10 g mean
-    peak_10g_ras_mm: list         # the centre of that cube's cell (RAS mm)
+    peak_10g_sar_w_kg: float      # per W/m^2 incident, IEC/IEEE 62704-1 (repose.average_sar)
+    peak_10g_ras_mm: list         # the centre of the cell whose cube that is (RAS mm)
+    peak_10g_rule: str            # how that cell was averaged: centred, covered or face_cube
+    peak_10g_c95_3_w_kg: float    # per W/m^2 incident, the simple cube (cube_averaged_sar)
+    averaging_counts: dict        # tissue cells per averaging rule (repose.average_sar's counts)
     local_sar_w_kg: np.ndarray    # per W/m^2 incident, per model cell [x, y, z] (edge-based)
 
     @property
@@ -193,6 +199,27 @@ def cube_averaged_sar(power_w: np.ndarray, mass_kg: np.ndarray, target_kg: float
     mean[~done] = p_in[~done] / np.maximum(m_in[~done], 1e-300)  # the whole grid holds less
     result[tuple(tissue.T)] = mean
     return result
+
+
+def iec62704_peak(power_w: np.ndarray, density: np.ndarray, spacing_mm, mass_kg: float = 0.010,
+                  threads: int = 0):
+    """The peak spatial-average SAR (W/kg) of per-cell power (W) on a uniform grid of density
+    (kg/m^3), by IEC/IEEE 62704-1's cube rules (repose.average_sar, which counts all beyond the
+    grid as air); the cell whose cube that is; the rule that cell was averaged by ("centred",
+    "covered", "face_cube"); and the tissue cells per rule."""
+    from . import average_sar
+    spacing_m = np.asarray(spacing_mm, float) * 1e-3
+    volume = float(np.prod(spacing_m))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sar = np.where(density > 0, power_w / (density * volume), 0.0)
+    edges = [np.arange(density.shape[a] + 1) * spacing_m[a] for a in range(3)]
+    r = average_sar(density, sar, *edges, mass_kg=mass_kg, threads=threads)
+    if r["peak_cell"] is None:
+        raise ValueError("iec62704_peak: no tissue")
+    counts = {k: int(v) for k, v in r["counts"].items() if k != "background"}
+    cell = tuple(int(v) for v in r["peak_cell"])
+    rule = ["background", "centred", "covered", "face_cube", "none"][int(r["kind"][cell])]
+    return float(r["peak"]), cell, rule, counts
 
 
 def _direction(text: str) -> np.ndarray:
@@ -304,15 +331,16 @@ def plane_wave_sar(model_h5: str, *, propagation: str = "-y", polarization: str 
 
     with h5py.File(sim / "SAR_local.h5", "r") as f:
         openems_absorbed = float(f["/FieldData/FD/f0"].attrs["power"][0]) / s_inc
-    averaged = cube_averaged_sar(power, density * volume_m3, 0.010)
-    peak_cell = np.unravel_index(int(np.argmax(averaged)), averaged.shape)
-    peak10 = float(averaged[peak_cell])
+    peak10, peak_cell, rule, counts = iec62704_peak(power, density, model.spacing_mm, 0.010,
+                                                    threads)
     peak_at = [float(model.corner_mm[a] + (first[a] + peak_cell[a] + 0.5) * model.spacing_mm[a])
                for a in range(3)]
+    peak_c95 = float(cube_averaged_sar(power, density * volume_m3, 0.010).max())
     inflow = -float(flux.CalcNF2FF(str(sim), f0, [90.0], [0.0]).Prad[0]) / s_inc
     if not keep and sim_path is None:
         import shutil
         shutil.rmtree(sim, ignore_errors=True)
     total_cells = int(np.prod([hi[a] - lo[a] + 2 * outer for a in range(3)]))
     return PlaneWaveResult(f0, propagation, polarization, total_cells, seconds, mass, absorbed,
-                           inflow, openems_absorbed, absorbed / mass, peak10, peak_at, local)
+                           inflow, openems_absorbed, absorbed / mass, peak10, peak_at, rule,
+                           peak_c95, counts, local)

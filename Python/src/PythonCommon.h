@@ -31,5 +31,6 @@ class PythonProgress {
 void bindVolumes(py::module_& m);
 void bindPoses(py::module_& m);
 void bindRigs(py::module_& m);
+void bindDosimetry(py::module_& m);
 
 }  // namespace repose::python

@@ -64,4 +64,5 @@ PYBIND11_MODULE(_repose, m) {
   bindVolumes(m);
   bindRigs(m);
   bindPoses(m);
+  bindDosimetry(m);
 }

@@ -210,6 +210,8 @@ def test_the_example_runs_small_and_the_phantom_balances_its_energy(tmp_path):
         assert abs(r["energy_balance"] - 1) < 0.05, r
         assert r["whole_body_sar_mw_kg_per_w_m2"] > 0
         assert r["peak_10g_sar_mw_kg_per_w_m2"] > r["whole_body_sar_mw_kg_per_w_m2"]
+        assert r["peak_10g_rule"] in ("centred", "covered", "face_cube")
+        assert r["peak_10g_c95_3_mw_kg_per_w_m2"] > r["whole_body_sar_mw_kg_per_w_m2"]
     assert (out / "sar_per_posture.png").stat().st_size > 10000
     assert (out / "sar_per_posture.csv").read_text().startswith("posture,")
 
