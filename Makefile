@@ -71,7 +71,7 @@ ASAN_OPTIONS_TEST := detect_leaks=1:abort_on_error=1:strict_string_checks=1:chec
 clean:
 	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(FUZZ_DIR)
 
-.PHONY: bench bench-large bench-micro
+.PHONY: bench bench-large bench-micro bench-sweep
 # Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).
 # `make bench`: every figure against its baseline at three sizes (< 15 min); results and plot in
 # $(BUILD_DIR)/bench. `make bench-large` adds the seed's scales (~120M, ~260M, ~860M out of core).
@@ -80,6 +80,10 @@ bench: build
 
 bench-large: build
 	/usr/bin/python3 bench/run_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench --large
+
+# Posture-sweep throughput in one process and on 2 MPI ranks (docs/PERFORMANCE.md).
+bench-sweep: build
+	/usr/bin/python3 bench/sweep_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench-sweep
 
 # The component benchmarks one by one (Google Benchmark tables).
 bench-micro: build

@@ -18,6 +18,7 @@ int runWarp(const Args& args);
 int runPose(const Args& args);
 int runRig(const Args& args);
 int runExportFdtd(const Args& args);
+int runSweep(const Args& args);
 
 struct Command {
   const char* name;
@@ -36,6 +37,7 @@ inline const Command kCommands[] = {
     {"mesh", "build the transfer mesh and embed it in the cage", runMesh},
     {"warp", "pose a label map (and image) at full resolution from a posed cage", runWarp},
     {"pose", "the whole job: label maps + pose file -> posed maps, transform, report", runPose},
+    {"sweep", "many subjects in many poses, in one process or over MPI ranks", runSweep},
     {"export-fdtd", "a (posed) label map as an openEMS FDTD model: tissues at a frequency",
      runExportFdtd},
 };

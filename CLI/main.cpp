@@ -8,6 +8,7 @@
 
 #include <csignal>
 
+#include <algorithm>
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -17,8 +18,11 @@ namespace {
 void printUsage() {
   std::cout << "usage: repose <command> [options]   (repose <command> --help for details)\n\n"
                "Re-poses segmented whole-body volumes with a cage.\n\ncommands:\n";
+  std::size_t width = 0;
+  for (const auto& c : repose::cli::kCommands) width = std::max(width, std::strlen(c.name));
   for (const auto& c : repose::cli::kCommands)
-    std::cout << "  " << c.name << std::string(10 - std::strlen(c.name), ' ') << c.summary << "\n";
+    std::cout << "  " << c.name << std::string(width + 2 - std::strlen(c.name), ' ') << c.summary
+              << "\n";
 }
 
 // SIGINT / SIGTERM: ask Core to stop at its next progress point; the command then unwinds like a

@@ -14,6 +14,7 @@ PACKAGES=(
   xvfb xauth libxml2-utils
   plastimatch time
   openems python3-openems libopenems-dev python3-h5py
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

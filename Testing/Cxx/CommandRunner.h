@@ -30,8 +30,9 @@ inline std::string shellQuote(const std::string& s) {
   return q + "'";
 }
 
-// `args` is appended verbatim (quote paths with shellQuote). With measureMemory the command runs
-// under /usr/bin/time and peakRssKb receives its peak resident set.
+// `exe`: a program of the build's bin folder, or an absolute path (a system program). `args` is
+// appended verbatim (quote paths with shellQuote). With measureMemory the command runs under
+// /usr/bin/time and peakRssKb receives its peak resident set.
 inline CommandResult runCommand(const std::string& exe, const std::string& args,
                                 bool measureMemory = false) {
   ScratchDir io("run");  // its own folder: the calling test's ScratchDir must survive
@@ -39,8 +40,9 @@ inline CommandResult runCommand(const std::string& exe, const std::string& args,
                     rssFile = io.file("rss");
   const std::string prefix =
       measureMemory ? "/usr/bin/time -f %M -o " + shellQuote(rssFile) + " " : std::string();
-  const std::string cmd = prefix + shellQuote(binPath(exe)) + " " + args + " >" +
-                          shellQuote(outFile) + " 2>" + shellQuote(errFile) + " </dev/null";
+  const std::string program = exe.rfind('/', 0) == 0 ? exe : binPath(exe);
+  const std::string cmd = prefix + shellQuote(program) + " " + args + " >" + shellQuote(outFile) +
+                          " 2>" + shellQuote(errFile) + " </dev/null";
   const int status = std::system(cmd.c_str());
   CommandResult r;
   r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -74,7 +74,9 @@ TEST(MeshCommand, ProxyKeepsCageAndMeshUnderTheBudget) {
                                      true);
   ASSERT_EQ(c.exitCode, 0) << c.err;
   EXPECT_GT(nlohmann::json::parse(c.out)["proxy_factor"].get<int>(), 1);
-  if (kPeakRssIsMeaningful) EXPECT_LT(c.peakRssKb, inCore.peakRssKb);
+  if (kPeakRssIsMeaningful) {
+    EXPECT_LT(c.peakRssKb, inCore.peakRssKb);
+  }
   const CommandResult m = runCommand("repose",
                                      "mesh --parts " + parts + " --cage " + cage + " --out " +
                                          shellQuote(dir.file("tm.vtu")) + " --memory " +
@@ -83,6 +85,8 @@ TEST(MeshCommand, ProxyKeepsCageAndMeshUnderTheBudget) {
   ASSERT_EQ(m.exitCode, 0) << m.err;
   const int factor = nlohmann::json::parse(m.out)["proxy_factor"].get<int>();
   EXPECT_GT(factor, 1);
-  if (kPeakRssIsMeaningful) EXPECT_LT(m.peakRssKb, meshBudgetKb);
+  if (kPeakRssIsMeaningful) {
+    EXPECT_LT(m.peakRssKb, meshBudgetKb);
+  }
   EXPECT_DOUBLE_EQ(readTransferMesh(dir.file("tm.vtu")).sourceSpacingMm, 2.0 * factor);
 }
