@@ -71,7 +71,7 @@ ASAN_OPTIONS_TEST := detect_leaks=1:abort_on_error=1:strict_string_checks=1:chec
 clean:
 	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(FUZZ_DIR)
 
-.PHONY: bench bench-large bench-micro bench-sweep
+.PHONY: bench bench-large bench-micro bench-sweep bench-warp-mpi
 # Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).
 # `make bench`: every figure against its baseline at three sizes (< 15 min); results and plot in
 # $(BUILD_DIR)/bench. `make bench-large` adds the seed's scales (~120M, ~260M, ~860M out of core).
@@ -84,6 +84,10 @@ bench-large: build
 # Posture-sweep throughput in one process and on 2 MPI ranks (docs/PERFORMANCE.md).
 bench-sweep: build
 	/usr/bin/python3 bench/sweep_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench-sweep
+
+# `repose warp --mpi`: one ~860M-voxel grid out of core in one process and over 1 and 2 ranks.
+bench-warp-mpi: build
+	/usr/bin/python3 bench/warp_mpi_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench-warp-mpi
 
 # The component benchmarks one by one (Google Benchmark tables).
 bench-micro: build

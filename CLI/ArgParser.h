@@ -37,6 +37,12 @@ class ArgParser {
   std::map<std::string, std::string> values_;
 };
 
+// Thrown where another process reports the failure (the ranks other than 0 of `warp --mpi`):
+// main exits with `code` and prints nothing.
+struct QuietExit {
+  int code = 1;
+};
+
 struct UsageError {
   std::string message;
 };

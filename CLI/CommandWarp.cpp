@@ -7,6 +7,7 @@
 #include "MemoryBudget.h"
 #include "SlicerModuleXml.h"
 #include "TerminalProgress.h"
+#include "WarpSummary.h"
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/MeshIO.h"
@@ -34,9 +35,7 @@
 #include <sstream>
 
 namespace repose::cli {
-namespace {
 
-// Voxels per non-zero label of a file read through a slice cache, as mm3.
 std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
   const NiftiLayout& l = cache.layout();
   const std::int64_t n = l.geometry.dims[0] * l.geometry.dims[1];
@@ -55,7 +54,64 @@ std::map<int, double> streamedLabelVolumes(SliceCache& cache) {
   return mm3;
 }
 
-}  // namespace
+void printWarpSummary(const WarpSummary& s, bool json) {
+  const auto& volumes = s.volumes;
+  const auto& report = s.report;
+  const auto& grid = s.grid;
+  // Per-label volumes before and after (layer 0 and others alike).
+  nlohmann::json perLabel = nlohmann::json::array();
+  int lost = 0;
+  std::vector<int> unnamed;  // labels with voxels that a label table present does not name
+  for (const auto& [key, v] : volumes) {
+    const Label* l = s.labels.find(key.second, key.first);
+    perLabel.push_back({{"layer", key.first},
+                        {"value", key.second},
+                        {"name", l ? l->name : ""},
+                        {"input_mm3", v.first},
+                        {"output_mm3", v.second},
+                        {"change_percent", v.first > 0 ? 100 * (v.second / v.first - 1) : 0.0}});
+    lost += v.first > 0 && v.second == 0;
+    if (!l && !s.labels.empty() && v.first > 0 && key.second != 0) unnamed.push_back(key.second);
+  }
+  warnUnnamedLabels(unnamed, s.input, "warp");
+  nlohmann::json j = {{"output", s.out},
+                      {"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}},
+                      {"spacing_mm", {grid.spacing()[0], grid.spacing()[1], grid.spacing()[2]}},
+                      {"voxels", grid.numVoxels()},
+                      {"out_of_core", s.outOfCore},
+                      {"memory_budget_bytes", s.budget},
+                      {"memory_in_use_before_volumes_bytes", s.usedBefore},
+                      {"memory_volumes_need_in_core_bytes", s.inCoreNeed},
+                      {"peak_resident_bytes", peakResidentBytes()},
+                      {"voxels_inside_tets", report.voxelWrites},
+                      {"voxels_in_shell", report.shellVoxels},
+                      {"inverted_tets", report.invertedTets},
+                      {"flat_tets", report.flatTets},
+                      {"unreachable_vertices_left_at_rest", s.unreachable},
+                      {"labels_lost", lost},
+                      {"labels_unnamed", unnamed},
+                      {"labels", perLabel},
+                      {"seconds", s.seconds}};
+  if (s.slabs > 0)
+    j["mpi"] = {{"ranks", s.ranks}, {"slabs", s.slabs}, {"stage_seconds", s.stageSeconds}};
+  if (json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::cout << "wrote " << s.out << ": " << grid.dims[0] << " x " << grid.dims[1] << " x "
+              << grid.dims[2] << " voxels\n";
+    for (const auto& l : perLabel)
+      std::cout << "  label " << l["value"].get<int>() << " " << l["name"].get<std::string>()
+                << ": " << l["input_mm3"].get<double>() / 1000 << " -> "
+                << l["output_mm3"].get<double>() / 1000 << " cm3\n";
+    if (report.invertedTets > 0)
+      std::cout << "warning: " << report.invertedTets
+                << " tets turned inside out (the pose folds the body there)\n";
+    if (lost > 0) std::cout << "warning: " << lost << " labels vanished from the output\n";
+    if (s.unreachable > 0)
+      std::cout << "warning: " << s.unreachable
+                << " mesh vertices in parts with no vertex inside the cage were left at rest\n";
+  }
+}
 
 int runWarp(const Args& args) {
   if (printSlicerModuleXml(args, "warp")) return 0;  // 3D Slicer asking for the description
@@ -84,9 +140,13 @@ int runWarp(const Args& args) {
       .flag("json", "print a JSON summary on stdout")
       .flag("slicer-progress",
             "progress as the <filter-progress> lines 3D Slicer's CLI modules print on stdout "
-            "(the installed ReposeWarp module sets it)");
+            "(the installed ReposeWarp module sets it)")
+      .flag("mpi",
+            "under mpirun: rasterize the output grid in slabs over the ranks and write one NIfTI "
+            "with MPI-IO (out of core on every rank; --memory is per rank; NIfTI in and out)");
   declareMemoryOption(p, "above it the posed volume is made out of core (NIfTI in and out)");
   if (!p.parse(args)) return 0;
+  if (p.has("mpi")) return runWarpOverRanks(p);
   if (p.has("slicer-progress")) startSlicerProgress("repose warp", "warping " + p.get("input"));
   for (const char* required : {"input", "mesh", "cage", "posed-cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
@@ -214,62 +274,20 @@ int runWarp(const Args& args) {
   }
   commitTogether(
       {&outFile, imageFile ? &*imageFile : nullptr, transformFile ? &*transformFile : nullptr});
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-
-  // Per-label volumes before and after (layer 0 and others alike).
-  nlohmann::json perLabel = nlohmann::json::array();
-  int lost = 0;
-  std::vector<int> unnamed;  // labels with voxels that a label table present does not name
-  for (const auto& [key, v] : volumes) {
-    const Label* l = layout.labels.find(key.second, key.first);
-    perLabel.push_back({{"layer", key.first},
-                        {"value", key.second},
-                        {"name", l ? l->name : ""},
-                        {"input_mm3", v.first},
-                        {"output_mm3", v.second},
-                        {"change_percent", v.first > 0 ? 100 * (v.second / v.first - 1) : 0.0}});
-    lost += v.first > 0 && v.second == 0;
-    if (!l && !layout.labels.empty() && v.first > 0 && key.second != 0)
-      unnamed.push_back(key.second);
-  }
-  warnUnnamedLabels(unnamed, input, "warp");
-  const nlohmann::json j = {
-      {"output", out},
-      {"dims", {grid.dims[0], grid.dims[1], grid.dims[2]}},
-      {"spacing_mm", {grid.spacing()[0], grid.spacing()[1], grid.spacing()[2]}},
-      {"voxels", grid.numVoxels()},
-      {"out_of_core", !inCore},
-      {"memory_budget_bytes", budget},
-      {"memory_in_use_before_volumes_bytes", used},
-      {"memory_volumes_need_in_core_bytes", inCoreNeed},
-      {"peak_resident_bytes", peakResidentBytes()},
-      {"voxels_inside_tets", report.voxelWrites},
-      {"voxels_in_shell", report.shellVoxels},
-      {"inverted_tets", report.invertedTets},
-      {"flat_tets", report.flatTets},
-      {"unreachable_vertices_left_at_rest", deformation.solver().unconstrainedVertices()},
-      {"labels_lost", lost},
-      {"labels_unnamed", unnamed},
-      {"labels", perLabel},
-      {"seconds", seconds}};
-  if (p.has("json")) {
-    std::cout << j.dump(2) << "\n";
-  } else {
-    std::cout << "wrote " << out << ": " << grid.dims[0] << " x " << grid.dims[1] << " x "
-              << grid.dims[2] << " voxels\n";
-    for (const auto& l : perLabel)
-      std::cout << "  label " << l["value"].get<int>() << " " << l["name"].get<std::string>()
-                << ": " << l["input_mm3"].get<double>() / 1000 << " -> "
-                << l["output_mm3"].get<double>() / 1000 << " cm3\n";
-    if (report.invertedTets > 0)
-      std::cout << "warning: " << report.invertedTets
-                << " tets turned inside out (the pose folds the body there)\n";
-    if (lost > 0) std::cout << "warning: " << lost << " labels vanished from the output\n";
-    if (deformation.solver().unconstrainedVertices() > 0)
-      std::cout << "warning: " << deformation.solver().unconstrainedVertices()
-                << " mesh vertices in parts with no vertex inside the cage were left at rest\n";
-  }
+  WarpSummary summary;
+  summary.input = input;
+  summary.out = out;
+  summary.labels = layout.labels;
+  summary.grid = grid;
+  summary.outOfCore = !inCore;
+  summary.budget = budget;
+  summary.usedBefore = used;
+  summary.inCoreNeed = inCoreNeed;
+  summary.report = report;
+  summary.unreachable = deformation.solver().unconstrainedVertices();
+  summary.volumes = volumes;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  printWarpSummary(summary, p.has("json"));
   endSlicerProgress("repose warp");
   return 0;
 }

@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
     if (name != command.name) continue;
     try {
       return command.run(args);
+    } catch (const repose::cli::QuietExit& e) {
+      return e.code;  // a rank of `warp --mpi` whose failure rank 0 reports
     } catch (const repose::cli::UsageError& e) {
       std::cerr << "repose " << name << ": " << e.message << " (see repose " << name
                 << " --help)\n";

@@ -5,12 +5,15 @@
 #include "NiftiLabelExtension.h"
 #include "ReaderCommon.h"
 #include "repose/io/AtomicOutput.h"
+#include "repose/io/GzipPieces.h"
+#include "repose/util/Parallel.h"
 
 #include <nifti2_io.h>
 
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -365,14 +368,54 @@ std::vector<char> headerBytes(const nifti_image& nim) {
 
 }  // namespace
 
+std::vector<char> niftiHeaderBytes(const VolumeGeometry& geometry, ScalarType type,
+                                   const LabelTable& labels, bool labelMap, int niftiVersion) {
+  geometry.validate("NIfTI header");
+  return headerBytes(*makeHeader("header.nii", geometry, type, labels, labelMap, niftiVersion));
+}
+
+std::int64_t niftiGzipPieceSlices(const VolumeGeometry& geometry, ScalarType type) {
+  const std::int64_t sliceBytes =
+      geometry.dims[0] * geometry.dims[1] * static_cast<std::int64_t>(scalarSize(type));
+  return std::max<std::int64_t>(1, kNiftiGzipPieceBytes / std::max<std::int64_t>(1, sliceBytes));
+}
+
 struct NiftiSlabWriter::Impl {
   AtomicOutput output;
-  NiftiPtr nim;
-  znzFile file = nullptr;
+  std::FILE* file = nullptr;
+  bool gz = false;
   std::int64_t sliceBytes = 0, slicesWritten = 0, slicesTotal = 0;
+  // .nii.gz: the voxels go in pieces of pieceSlices whole slices (GzipPieces.h); `pending` holds
+  // the slices of an unfinished piece, crc and rawBytes what the trailer needs.
+  std::int64_t pieceSlices = 1;
+  std::vector<char> pending;
+  std::uint32_t crc = 0;
+  std::uint64_t rawBytes = 0;
   explicit Impl(const std::string& path) : output(path) {}
   ~Impl() {
-    if (file) znzclose(file);
+    if (file) std::fclose(file);
+  }
+  void put(const void* bytes, std::size_t n) {
+    if (n > 0 && std::fwrite(bytes, 1, n, file) != n)
+      throwFileError(output.finalPath(), "write failed (disk full?)");
+  }
+  // Whole pieces compressed in parallel (the pieces are independent), written in order.
+  void putPieces(const char* bytes, std::int64_t pieces, std::int64_t pieceBytes) {
+    std::vector<std::string> packed(static_cast<std::size_t>(pieces));
+    parallelFor(
+        pieces, 0,
+        [&](std::int64_t p0, std::int64_t p1) {
+          for (std::int64_t p = p0; p < p1; ++p)
+            packed[std::size_t(p)] =
+                deflatePiece(bytes + p * pieceBytes, static_cast<std::size_t>(pieceBytes));
+        },
+        1);
+    for (std::int64_t p = 0; p < pieces; ++p) {
+      crc = crc32Concat(crc, crc32Of(bytes + p * pieceBytes, std::size_t(pieceBytes)),
+                        std::uint64_t(pieceBytes));
+      put(packed[std::size_t(p)].data(), packed[std::size_t(p)].size());
+    }
+    rawBytes += std::uint64_t(pieces * pieceBytes);
   }
 };
 
@@ -382,45 +425,79 @@ NiftiSlabWriter::NiftiSlabWriter(const std::string& path, const VolumeGeometry& 
     : impl_(std::make_unique<Impl>(path)) {
   geometry.validate(path);
   const std::string& temp = impl_->output.tempPath();
-  impl_->nim = makeHeader(temp, geometry, type, labels, labelMap, niftiVersion);
+  const NiftiPtr nim = makeHeader(temp, geometry, type, labels, labelMap, niftiVersion);
   impl_->sliceBytes =
       geometry.dims[0] * geometry.dims[1] * static_cast<std::int64_t>(scalarSize(type));
   impl_->slicesTotal = geometry.dims[2];
-  const bool gz = temp.size() > 3 && temp.compare(temp.size() - 3, 3, ".gz") == 0;
-  // Level 1: label maps compress nearly as well as at level 6, several times faster.
-  impl_->file = znzopen(temp.c_str(), gz ? "wb1" : "wb", gz ? 1 : 0);
-  if (znz_isnull(impl_->file)) throwFileError(path, "cannot create the output file");
-  const std::vector<char> header = headerBytes(*impl_->nim);
-  if (znzwrite(header.data(), 1, header.size(), impl_->file) != header.size())
-    throwFileError(path, "cannot write the NIfTI header");
+  impl_->gz = temp.size() > 3 && temp.compare(temp.size() - 3, 3, ".gz") == 0;
+  impl_->pieceSlices = niftiGzipPieceSlices(geometry, type);
+  impl_->file = std::fopen(temp.c_str(), "wb");
+  if (!impl_->file) throwFileError(path, "cannot create the output file");
+  const std::vector<char> header = headerBytes(*nim);
+  if (impl_->gz) {
+    // The header is a piece of its own, so the voxels' pieces start at slice 0.
+    const std::string head = gzipHeaderBytes() + deflatePiece(header.data(), header.size());
+    impl_->put(head.data(), head.size());
+    impl_->crc = crc32Of(header.data(), header.size());
+    impl_->rawBytes = header.size();
+  } else {
+    impl_->put(header.data(), header.size());
+  }
 }
 
 NiftiSlabWriter::~NiftiSlabWriter() = default;
 
 void NiftiSlabWriter::writeSlices(const void* data, std::int64_t slices) {
-  if (!impl_->file) throw Error(impl_->output.finalPath() + ": writer already finished");
-  if (impl_->slicesWritten + slices > impl_->slicesTotal)
-    throw Error(impl_->output.finalPath() + ": more slices written than the volume has");
-  // zlib takes 32-bit lengths: write large slabs in pieces.
+  Impl& w = *impl_;
+  if (!w.file) throw Error(w.output.finalPath() + ": writer already finished");
+  if (w.slicesWritten + slices > w.slicesTotal)
+    throw Error(w.output.finalPath() + ": more slices written than the volume has");
   const auto* bytes = static_cast<const char*>(data);
-  for (std::int64_t left = slices * impl_->sliceBytes; left > 0;) {
-    const std::size_t n = static_cast<std::size_t>(std::min<std::int64_t>(left, 1 << 28));
-    if (znzwrite(bytes, 1, n, impl_->file) != n)
-      throwFileError(impl_->output.finalPath(), "write failed (disk full?)");
-    bytes += n;
-    left -= static_cast<std::int64_t>(n);
+  w.slicesWritten += slices;
+  if (!w.gz) {
+    w.put(bytes, static_cast<std::size_t>(slices * w.sliceBytes));
+    return;
   }
-  impl_->slicesWritten += slices;
+  const std::int64_t pieceBytes = w.pieceSlices * w.sliceBytes;
+  std::int64_t left = slices * w.sliceBytes;
+  if (!w.pending.empty()) {  // complete the piece begun by the previous call
+    const std::int64_t n =
+        std::min<std::int64_t>(left, pieceBytes - static_cast<std::int64_t>(w.pending.size()));
+    w.pending.insert(w.pending.end(), bytes, bytes + n);
+    bytes += n;
+    left -= n;
+    if (static_cast<std::int64_t>(w.pending.size()) < pieceBytes) return;
+    w.putPieces(w.pending.data(), 1, pieceBytes);
+    w.pending.clear();
+  }
+  // Whole pieces straight from the caller's slab, 16 at a time (bounded extra memory).
+  for (std::int64_t whole = left / pieceBytes; whole > 0;) {
+    const std::int64_t n = std::min<std::int64_t>(whole, 16);
+    w.putPieces(bytes, n, pieceBytes);
+    bytes += n * pieceBytes;
+    left -= n * pieceBytes;
+    whole -= n;
+  }
+  w.pending.assign(bytes, bytes + left);
 }
 
 void NiftiSlabWriter::finish() {
-  if (impl_->slicesWritten != impl_->slicesTotal)
-    throw Error(impl_->output.finalPath() + ": only " + std::to_string(impl_->slicesWritten) +
-                " of " + std::to_string(impl_->slicesTotal) + " slices were written");
-  const int rc = znzclose(impl_->file);
-  impl_->file = nullptr;
-  if (rc != 0) throwFileError(impl_->output.finalPath(), "closing the file failed (disk full?)");
-  impl_->output.commit();
+  Impl& w = *impl_;
+  if (w.slicesWritten != w.slicesTotal)
+    throw Error(w.output.finalPath() + ": only " + std::to_string(w.slicesWritten) + " of " +
+                std::to_string(w.slicesTotal) + " slices were written");
+  if (w.gz) {
+    if (!w.pending.empty()) {  // the last piece, shorter than the others
+      w.putPieces(w.pending.data(), 1, static_cast<std::int64_t>(w.pending.size()));
+      w.pending.clear();
+    }
+    const std::string tail = gzipTrailerBytes(w.crc, w.rawBytes);
+    w.put(tail.data(), tail.size());
+  }
+  const int rc = std::fclose(w.file);
+  w.file = nullptr;
+  if (rc != 0) throwFileError(w.output.finalPath(), "closing the file failed (disk full?)");
+  w.output.commit();
 }
 
 void writeNifti(const Volume& volume, const std::string& path, const WriteOptions& options) {

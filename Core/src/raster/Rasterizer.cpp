@@ -678,6 +678,76 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
   return out;
 }
 
+struct LabelSlabRasterizer::Impl {
+  SliceCache& input;
+  VolumeGeometry output;
+  RasterOptions options;
+  raster::ScanInput in;
+  Shell shell;
+  Impl(SliceCache& cache, const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+       const VolumeGeometry& grid, const RasterOptions& o)
+      : input(cache),
+        output(grid),
+        options(o),
+        in(raster::makeScanInput(mesh, deformed, cache.layout().geometry, grid)),
+        shell(makeShell(mesh, cache.layout().geometry, grid, o)) {
+    options.threads = 1;  // the slice cache is not shared between threads
+  }
+};
+
+LabelSlabRasterizer::LabelSlabRasterizer(SliceCache& input, const TransferMesh& mesh,
+                                         const Eigen::MatrixX3d& deformed,
+                                         const VolumeGeometry& output,
+                                         const RasterOptions& options) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  impl_ = std::make_unique<Impl>(input, mesh, deformed, output, options);
+}
+
+LabelSlabRasterizer::~LabelSlabRasterizer() = default;
+
+std::int64_t LabelSlabRasterizer::sliceBytes() const {
+  return impl_->output.dims[0] * impl_->output.dims[1] *
+         static_cast<std::int64_t>(scalarSize(impl_->input.layout().type));
+}
+
+void LabelSlabRasterizer::rasterize(std::int64_t k0, std::int64_t k1, void* slab,
+                                    RasterReport& report, const ProgressFn& progress) {
+  Impl& r = *impl_;
+  if (k0 < 0 || k1 > r.output.dims[2] || k0 >= k1)
+    throw Error("rasterizer: slab [" + std::to_string(k0) + ", " + std::to_string(k1) +
+                ") is not within the output's " + std::to_string(r.output.dims[2]) + " slices");
+  const NiftiLayout& layout = r.input.layout();
+  const auto d = layout.geometry.dims;
+  const std::int64_t nx = r.output.dims[0], plane = nx * r.output.dims[1];
+  RasterOptions one = r.options;
+  one.progress = progress;
+  dispatchScalar(layout.type, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    T* buffer = static_cast<T*>(slab);
+    std::fill(buffer, buffer + plane * (k1 - k0), T(0));
+    RasterReport part;
+    runScan(
+        r.in, r.shell, one, "rasterize labels (out of core)", &part, frameSign(r.output),
+        [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
+            const Eigen::Vector3d& step, std::int32_t) {
+          T* row = buffer + (k - k0) * plane + j * nx;
+          for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+            const std::int64_t at = nearestVoxel(p, d), inPlane = d[0] * d[1];
+            row[i] =
+                at >= 0 ? static_cast<const T*>(r.input.slice(at / inPlane))[at % inPlane] : T(0);
+          }
+        },
+        k0, k1);
+    report.voxelWrites += part.voxelWrites;
+    report.shellVoxels += part.shellVoxels;
+    report.invertedTets = part.invertedTets;
+    report.flatTets = part.flatTets;
+    for (std::int64_t v = 0; v < plane * (k1 - k0); ++v)
+      if (buffer[v] != T(0)) ++report.labelVoxels[static_cast<int>(buffer[v])];
+  });
+}
+
 void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
                            const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
                            const std::string& path, std::size_t slabBytes,
@@ -685,48 +755,21 @@ void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
   checkDeformation(mesh, deformed);
   output.validate(path);
   const NiftiLayout& layout = input.layout();
-  const ScanInput in = raster::makeScanInput(mesh, deformed, layout.geometry, output);
-  const Shell shell = makeShell(mesh, layout.geometry, output, options);
-  const auto d = layout.geometry.dims;
-  const std::int64_t nx = output.dims[0], plane = nx * output.dims[1];
-  const std::int64_t slab = std::max<std::int64_t>(
-      1, std::int64_t(slabBytes / (std::size_t(plane) * scalarSize(layout.type))));
+  LabelSlabRasterizer slabs(input, mesh, deformed, output, options);
+  const std::int64_t slab =
+      std::max<std::int64_t>(1, static_cast<std::int64_t>(slabBytes) / slabs.sliceBytes());
   NiftiSlabWriter writer(path, output, layout.type, layout.labels, true);
-  RasterOptions one = options;
-  one.threads = 1;
   RasterReport total;
-  dispatchScalar(layout.type, [&](auto* tag) {
-    using T = std::remove_pointer_t<decltype(tag)>;
-    std::vector<T> buffer;
-    for (std::int64_t k0 = 0; k0 < output.dims[2]; k0 += slab) {
-      const std::int64_t k1 = std::min(output.dims[2], k0 + slab);
-      buffer.assign(static_cast<std::size_t>(plane * (k1 - k0)), T(0));
-      one.progress = [&](double f, const std::string& stage) {
-        return !options.progress ||
-               options.progress((double(k0) + f * double(k1 - k0)) / double(output.dims[2]), stage);
-      };
-      RasterReport part;
-      runScan(
-          in, shell, one, "rasterize labels (out of core)", &part, frameSign(output),
-          [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
-              const Eigen::Vector3d& step, std::int32_t) {
-            T* row = buffer.data() + (k - k0) * plane + j * nx;
-            for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-              const std::int64_t at = nearestVoxel(p, d), inPlane = d[0] * d[1];
-              row[i] =
-                  at >= 0 ? static_cast<const T*>(input.slice(at / inPlane))[at % inPlane] : T(0);
-            }
-          },
-          k0, k1);
-      total.voxelWrites += part.voxelWrites;
-      total.shellVoxels += part.shellVoxels;
-      total.invertedTets = part.invertedTets;
-      total.flatTets = part.flatTets;
-      for (const T v : buffer)
-        if (v != T(0)) ++total.labelVoxels[static_cast<int>(v)];
-      writer.writeSlices(buffer.data(), k1 - k0);
-    }
-  });
+  std::vector<char> buffer;
+  for (std::int64_t k0 = 0; k0 < output.dims[2]; k0 += slab) {
+    const std::int64_t k1 = std::min(output.dims[2], k0 + slab);
+    buffer.resize(static_cast<std::size_t>((k1 - k0) * slabs.sliceBytes()));
+    slabs.rasterize(k0, k1, buffer.data(), total, [&](double f, const std::string& stage) {
+      return !options.progress ||
+             options.progress((double(k0) + f * double(k1 - k0)) / double(output.dims[2]), stage);
+    });
+    writer.writeSlices(buffer.data(), k1 - k0);
+  }
   writer.finish();
   if (report) *report = total;
 }

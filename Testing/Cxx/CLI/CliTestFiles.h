@@ -1,6 +1,10 @@
-// Files the CLI tests share: the standard pose suite's pose files and JSON outputs.
+// Files the CLI tests share: the standard pose suite's pose files, JSON outputs, and a phantom
+// with its cage and transfer mesh made by the commands.
 #pragma once
 
+#include "CommandRunner.h"
+
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <fstream>
@@ -16,6 +20,24 @@ inline std::string suitePoseFile(const std::string& name) {
 inline nlohmann::json readJsonFile(const std::string& path) {
   std::ifstream f(path);
   return nlohmann::json::parse(f);
+}
+
+// `repose phantom`, `cage` and `mesh` into `dir`: G.nii.gz, S.nii.gz, skeleton.json, then
+// `cage` and `mesh` (paths) from S with the default settings.
+inline void makePhantomRig(const std::string& dir, double voxelMm, const std::string& cage,
+                           const std::string& mesh) {
+  const std::string parts = dir + "/S.nii.gz";
+  EXPECT_EQ(runCommand("repose",
+                       "phantom --voxel " + std::to_string(voxelMm) + " --out " + shellQuote(dir))
+                .exitCode,
+            0);
+  EXPECT_EQ(runCommand("repose", "cage --parts " + shellQuote(parts) + " --out " + shellQuote(cage))
+                .exitCode,
+            0);
+  EXPECT_EQ(runCommand("repose", "mesh --parts " + shellQuote(parts) + " --cage " +
+                                     shellQuote(cage) + " --out " + shellQuote(mesh))
+                .exitCode,
+            0);
 }
 
 }  // namespace repose::test

@@ -1,6 +1,7 @@
 // `repose warp` as a user runs it: phantom -> cage -> mesh -> a posed cage -> the posed label map
 // and image. A whole-voxel translation of the cage must give the input shifted, voxel for voxel;
 // bad requests fail with one line naming the problem and write nothing.
+#include "CliTestFiles.h"
 #include "CommandRunner.h"
 #include "TestPaths.h"
 
@@ -23,20 +24,9 @@ struct Prepared {
   ScratchDir dir{"warp"};
   std::string organs, parts, cage, mesh;
   explicit Prepared(double voxelMm = 4) {
-    const std::string d = shellQuote(dir.path().string());
     organs = dir.file("G.nii.gz"), parts = dir.file("S.nii.gz");
     cage = dir.file("cage.obj"), mesh = dir.file("tm.vtu");
-    EXPECT_EQ(
-        runCommand("repose", "phantom --voxel " + std::to_string(voxelMm) + " --out " + d).exitCode,
-        0);
-    EXPECT_EQ(
-        runCommand("repose", "cage --parts " + shellQuote(parts) + " --out " + shellQuote(cage))
-            .exitCode,
-        0);
-    EXPECT_EQ(runCommand("repose", "mesh --parts " + shellQuote(parts) + " --cage " +
-                                       shellQuote(cage) + " --out " + shellQuote(mesh))
-                  .exitCode,
-              0);
+    makePhantomRig(dir.path().string(), voxelMm, cage, mesh);
   }
   std::string common(const std::string& posed) const {
     return "warp --input " + shellQuote(organs) + " --mesh " + shellQuote(mesh) + " --cage " +

@@ -5,7 +5,9 @@
 
 #include "repose/io/VolumeIO.h"
 
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 namespace repose {
 
@@ -26,8 +28,21 @@ struct NiftiLayout {
 };
 NiftiLayout readNiftiLayout(const std::string& path);
 
+// The bytes a NIfTI file holds before its voxels (header, label-table extension, padding to the
+// voxel offset), exactly as NiftiSlabWriter writes them.
+std::vector<char> niftiHeaderBytes(const VolumeGeometry& geometry, ScalarType type,
+                                   const LabelTable& labels, bool labelMap, int niftiVersion = 1);
+
+// A .nii.gz is written as independent gzip pieces (GzipPieces.h): the header bytes, then the
+// voxels in pieces of this many whole k-slices (about kNiftiGzipPieceBytes each; the last may be
+// shorter). A fixed function of the grid and type, so a writer on several threads or MPI ranks
+// that cuts the same pieces writes the same bytes.
+constexpr std::int64_t kNiftiGzipPieceBytes = std::int64_t(4) << 20;
+std::int64_t niftiGzipPieceSlices(const VolumeGeometry& geometry, ScalarType type);
+
 // Writes a single-layer NIfTI slice by slice (k slabs in order) so a volume larger than memory
-// can be produced with bounded memory. Atomic: nothing appears at path until finish().
+// can be produced with bounded memory; a .nii.gz's pieces are compressed on all cores. Atomic:
+// nothing appears at path until finish().
 class NiftiSlabWriter {
  public:
   NiftiSlabWriter(const std::string& path, const VolumeGeometry& geometry, ScalarType type,

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,30 @@ void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
                            const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
                            const std::string& path, std::size_t slabBytes,
                            const RasterOptions& options = {}, RasterReport* report = nullptr);
+
+// The out-of-core path's step on its own: output slices [k0, k1) of the same labels into a
+// caller's buffer. Slabs are independent, so callers can write them in any order: the file
+// writer above in order, `repose warp --mpi` a rank's share of them. Set-up (the deformed tets'
+// scan input and the shell) is done once; each slab costs one pass over the tets whose boxes
+// meet it. The scan runs on one thread (the cache is not shared).
+class LabelSlabRasterizer {
+ public:
+  LabelSlabRasterizer(SliceCache& input, const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                      const VolumeGeometry& output, const RasterOptions& options = {});
+  ~LabelSlabRasterizer();
+  LabelSlabRasterizer(const LabelSlabRasterizer&) = delete;
+  LabelSlabRasterizer& operator=(const LabelSlabRasterizer&) = delete;
+
+  std::int64_t sliceBytes() const;  // one output slice of the input's scalar type
+  // Fills `slab` ((k1 - k0) * sliceBytes() bytes) and adds its counts, labelVoxels included, to
+  // `report`. `progress` gets the fraction of this slab; false cancels.
+  void rasterize(std::int64_t k0, std::int64_t k1, void* slab, RasterReport& report,
+                 const ProgressFn& progress = {});
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // Intensities (CT, MR): trilinear interpolation at the rest position, `background` where no tet
 // covers the voxel or the rest position is outside the input. Integer types are rounded and
