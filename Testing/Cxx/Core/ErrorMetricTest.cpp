@@ -82,3 +82,73 @@ TEST(ErrorMetric, SizingUpdateShrinksOnlyWhereErrorExceedsTheMean) {
   EXPECT_FLOAT_EQ(F.sizeMm[2], static_cast<float>(10 * std::cbrt(0.4)));
   EXPECT_FLOAT_EQ(F.sizeMm[3], 10);
 }
+
+// Eq. 5-6 and e^G against values worked out by hand (issue 29, item 2). Five tets in a closed fan
+// around the edge a = (0,0,0), b = (0,0,6) through the ring p0..p4; a tet (a, b, p, q) has volume
+// |p x q| (6 * |p x q| / 2 / 3): 2, 6, 3, 2, 2. With B_t = s_t I, s = 1..5, eq. 1 gives
+// e_t = sqrt(3) |s_t - (V_{t-1} s_{t-1} + V_{t+1} s_{t+1}) / (V_{t-1} + V_{t+1})|:
+//   t0: |1 - (2*5 + 6*2) / 8| = 1.75      t1: |2 - (2*1 + 3*3) / 5| = 0.2
+//   t2: |3 - (6*2 + 2*4) / 8| = 0.5       t3: |4 - (3*3 + 2*5) / 5| = 0.2
+//   t4: |5 - (2*4 + 2*1) / 4| = 2.5
+// and eq. 6 e_v = sum V_t e_t / sum V_t over the tets at v:
+//   a, b: (2*1.75 + 6*0.2 + 3*0.5 + 2*0.2 + 2*2.5) / 15 = 11.6 / 15
+//   p0: (2*1.75 + 2*2.5) / 4 = 2.125    p1: (2*1.75 + 6*0.2) / 8 = 0.5875
+//   p2: (6*0.2 + 3*0.5) / 9 = 0.3       p3: (3*0.5 + 2*0.2) / 5 = 0.38    p4: (2*0.2 + 2*2.5) / 4
+//   = 1.35
+// (all times sqrt 3). e^G at (0.25, 0.5, 1.5), barycentric (1/4, 1/4, 1/4, 1/4) in t0 = (a, b, p0,
+// p1): (2 * 11.6/15 + 2.125 + 0.5875) / 4.
+TEST(ErrorMetric, HandComputedValuesOnAFiveTetFanAndTwoTets) {
+  TransferMesh fan;
+  fan.vertices.resize(7, 3);
+  fan.vertices << 0, 0, 0, 0, 0, 6, 1, 0, 0, 0, 2, 0, -3, 0, 0, 0, -1, 0, 2, -2, 0;
+  fan.tets.resize(5, 4);
+  for (int k = 0; k < 5; ++k) {
+    fan.tets.row(k) << 0, 1, 2 + k, 2 + (k + 1) % 5;
+    if (tetVolume(fan.vertices, fan.tets.row(k)) < 0) std::swap(fan.tets(k, 0), fan.tets(k, 1));
+  }
+  fan.labels = Eigen::VectorXi::Ones(5);
+  const double volumes[5] = {2, 6, 3, 2, 2};
+  for (int k = 0; k < 5; ++k)
+    ASSERT_NEAR(tetVolume(fan.vertices, fan.tets.row(k)), volumes[k], 1e-12) << k;
+  std::vector<Eigen::Matrix3d> B;
+  for (int k = 0; k < 5; ++k) B.push_back((k + 1.0) * Eigen::Matrix3d::Identity());
+  const double r3 = std::sqrt(3.0);
+  const Eigen::VectorXd et = tetErrors(fan, B);
+  const double expectedT[5] = {1.75, 0.2, 0.5, 0.2, 2.5};
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(et[k], expectedT[k] * r3, 1e-12) << "e_t of tet " << k;
+  const Eigen::VectorXd ev = vertexErrors(fan, et);
+  const double expectedV[7] = {11.6 / 15, 11.6 / 15, 2.125, 0.5875, 0.3, 0.38, 1.35};
+  for (int v = 0; v < 7; ++v) EXPECT_NEAR(ev[v], expectedV[v] * r3, 1e-12) << "e_v of vertex " << v;
+  // e^G on a 0.25 mm grid with a voxel centre at (0.25, 0.5, 1.5).
+  const VolumeGeometry grid = VolumeGeometry::make({21, 17, 25}, {0.25, 0.25, 0.25}, {-3, -2, 0});
+  std::vector<char> covered;
+  const std::vector<float> eG = rasterizeVertexField(fan, ev, grid, &covered);
+  const std::size_t at = std::size_t(13 + 21 * (10 + 17 * 6));
+  ASSERT_TRUE(grid.voxelToRas(13, 10, 6).isApprox(Eigen::Vector3d(0.25, 0.5, 1.5)));
+  EXPECT_TRUE(covered[at]);
+  EXPECT_NEAR(eG[at], (2 * 11.6 / 15 + 2.125 + 0.5875) / 4 * r3, 1e-5);  // float grid
+
+  // Two tets sharing a face, a shear between them, and a vertex no tet uses: e_t = |B0 - B1| = 1
+  // for both (the only neighbour's mean is its B), e_v = 1 at all five used vertices, 0 unused.
+  TransferMesh two;
+  two.vertices.resize(6, 3);
+  two.vertices << 0, 0, 0, 4, 0, 0, 0, 4, 0, 0, 0, 4, 3, 3, 3, 50, 50, 50;
+  two.tets.resize(2, 4);
+  two.tets << 0, 1, 2, 3, 1, 2, 3, 4;
+  for (int k = 0; k < 2; ++k)
+    if (tetVolume(two.vertices, two.tets.row(k)) < 0) std::swap(two.tets(k, 0), two.tets(k, 1));
+  two.labels = Eigen::VectorXi::Ones(2);
+  Eigen::Matrix3d shear = Eigen::Matrix3d::Identity();
+  shear(0, 1) = 1;
+  const Eigen::VectorXd e2 = tetErrors(two, {Eigen::Matrix3d::Identity(), shear});
+  EXPECT_NEAR(e2[0], 1, 1e-12);
+  EXPECT_NEAR(e2[1], 1, 1e-12);
+  const Eigen::VectorXd v2 = vertexErrors(two, e2);
+  for (int v = 0; v < 5; ++v) EXPECT_NEAR(v2[v], 1, 1e-12) << v;
+  EXPECT_EQ(v2[5], 0);
+  // A tet with no face neighbour has no error (eq. 1's mean is empty).
+  TransferMesh one = two;
+  one.tets.conservativeResize(1, 4);
+  one.labels.conservativeResize(1);
+  EXPECT_EQ(tetErrors(one, {shear})[0], 0);
+}

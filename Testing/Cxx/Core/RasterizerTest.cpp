@@ -107,6 +107,48 @@ TEST(Rasterizer, EveryCentreOnSharedFacesEdgesAndVerticesIsWrittenOnce) {
   expectHalfOpenBox(coverage, {2, 2, 2}, {14, 12, 10});
 }
 
+// The ownership rule where faces, edges and vertices pass through many centres at other scales
+// and offsets: boxes of Kuhn-split cells of 0.5 to 3 voxels (anisotropic too), shifted by whole,
+// half and quarter voxels, so diagonal faces cut the grid through rows of centres. Every centre
+// is claimed by exactly one tet inside, by none outside, and the outer boundary follows the tie
+// rule: the half-open box [lo, hi) on every axis.
+TEST(Rasterizer, EveryCentreHasOneOwnerOnScaledAndShiftedMeshes) {
+  struct Case {
+    Eigen::Vector3d cell, shift;
+  };
+  int cases = 0;
+  for (const Case& c : {Case{{3, 3, 3}, {1, 2, 3}}, Case{{0.5, 0.5, 0.5}, {0.5, 0.25, 0}},
+                        Case{{1.5, 2, 0.75}, {0.25, 0.5, 1}}, Case{{2, 1, 3}, {-0.5, 0, 0.5}},
+                        Case{{1, 1, 1}, {0.75, 0.75, 0.25}}}) {
+    const std::array<int, 3> n{5, 4, 3};
+    const Eigen::Vector3d lo = Eigen::Vector3d(3, 3, 3) + c.shift;
+    const Eigen::Vector3d hi = lo + c.cell.cwiseProduct(Eigen::Vector3d(n[0], n[1], n[2]));
+    const TransferMesh box = tetBox(lo, hi, n);
+    const VolumeGeometry grid =
+        unitGrid({std::int64_t(hi.x()) + 3, std::int64_t(hi.y()) + 3, std::int64_t(hi.z()) + 3});
+    const Volume coverage = rasterizeCoverage(box, box.vertices, grid);
+    const std::uint8_t* count = coverage.data<std::uint8_t>();
+    std::int64_t wrong = 0, inside = 0, onAFace = 0;
+    for (std::int64_t k = 0; k < grid.dims[2]; ++k)
+      for (std::int64_t j = 0; j < grid.dims[1]; ++j)
+        for (std::int64_t i = 0; i < grid.dims[0]; ++i) {
+          const Eigen::Vector3d p{double(i), double(j), double(k)};
+          const bool in = (p.array() >= lo.array()).all() && (p.array() < hi.array()).all();
+          inside += in;
+          wrong += count[coverage.index(i, j, k)] != (in ? 1 : 0);
+          // Centres on a cell's face plane (axis-aligned) or on its diagonal planes.
+          const Eigen::Vector3d u = (p - lo).cwiseQuotient(c.cell);
+          const Eigen::Vector3d f = u - u.array().floor().matrix();
+          onAFace +=
+              in && ((f.array() == 0).any() || f.x() == f.y() || f.y() == f.z() || f.x() == f.z());
+        }
+    EXPECT_EQ(wrong, 0) << "cell " << c.cell.transpose() << ", shift " << c.shift.transpose();
+    EXPECT_GT(onAFace, inside / 10) << "the case must put many centres on faces";
+    ++cases;
+  }
+  EXPECT_EQ(cases, 5);
+}
+
 // Interior vertices in general position: no crack and no double write across any shared face.
 // (The grid is offset by a fraction of a voxel so no centre lies exactly on a face or edge through
 // a moved vertex: there the plane value is rounding noise, see TetScan.h.)
