@@ -10,6 +10,8 @@
 
 #include <Eigen/Geometry>
 
+#include <random>
+
 using namespace repose;
 using namespace repose::test;
 
@@ -151,4 +153,46 @@ TEST(ErrorMetric, HandComputedValuesOnAFiveTetFanAndTwoTets) {
   one.tets.conservativeResize(1, 4);
   one.labels.conservativeResize(1);
   EXPECT_EQ(tetErrors(one, {shear})[0], 0);
+}
+
+// Eq. 7 on a synthetic error field (issue 29, item 2): a smooth bump of error over a 12 x 9 x 7
+// grid, a random third of it not covered by the mesh, random sizes. Every covered voxel's new
+// size is its old one times cbrt(e_mean / max(e^G, e_mean)) with e_mean the mean over covered
+// voxels only (computed here in long double); uncovered voxels and voxels at or below the mean
+// keep their size; sizes never grow; the largest error shrinks most.
+TEST(ErrorMetric, SizingUpdateFollowsEquationSevenOnASyntheticField) {
+  SizingField F;
+  F.grid = VolumeGeometry::make({12, 9, 7}, {2, 2, 2}, {0, 0, 0});
+  const std::size_t n = 12 * 9 * 7;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<float> error(n), before(n);
+  std::vector<char> covered(n);
+  F.sizeMm.resize(n);
+  std::size_t peak = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const double i = double(v % 12), j = double((v / 12) % 9), k = double(v / 108);
+    error[v] = float(
+        0.05 + 2 * std::exp(-((i - 8) * (i - 8) + (j - 3) * (j - 3) + (k - 4) * (k - 4)) / 6));
+    covered[v] = u(rng) > 1.0 / 3;
+    before[v] = F.sizeMm[v] = float(5 + 10 * u(rng));
+    if (covered[v] && (!covered[peak] || error[v] > error[peak])) peak = v;
+  }
+  long double sum = 0;
+  std::size_t count = 0;
+  for (std::size_t v = 0; v < n; ++v)
+    if (covered[v]) sum += error[v], ++count;
+  const double mean = double(sum / count);
+  EXPECT_NEAR(updateSizingField(F, error, covered), mean, 1e-12 * mean);
+  std::size_t shrunk = 0;
+  double smallestFactor = 1;
+  for (std::size_t v = 0; v < n; ++v) {
+    const double factor = covered[v] ? std::cbrt(mean / std::max<double>(error[v], mean)) : 1.0;
+    EXPECT_FLOAT_EQ(F.sizeMm[v], float(before[v] * factor)) << v;
+    EXPECT_LE(F.sizeMm[v], before[v]) << v;
+    shrunk += F.sizeMm[v] < before[v];
+    smallestFactor = std::min(smallestFactor, double(F.sizeMm[v]) / before[v]);
+  }
+  EXPECT_GT(shrunk, 10u);
+  EXPECT_NEAR(double(F.sizeMm[peak]) / before[peak], smallestFactor, 1e-6);
 }
