@@ -28,7 +28,8 @@ int runMesh(const Args& args) {
       "Build the transfer mesh: a tetrahedral mesh of the body parts of PARTS (CGAL Mesh_3,\n"
       "one label per tet), embed it in the cage (vertices inside it get Green coordinates;\n"
       "the others, the outliers, follow through the rigidity solver) and write it as a VTK\n"
-      "unstructured grid (.vtu, RAS mm, cell array 'label').");
+      "unstructured grid (.vtu, RAS mm, cell array 'label'). The Green coordinates are\n"
+      "written beside it (tm.vtu -> tm.green) for `repose warp` to reuse.");
   p.option("parts", "FILE", "body-part map S (or any label map)")
       .option("cage", "FILE", "cage from `repose cage` (.obj or .vtk)")
       .option("out", "FILE", "output transfer mesh (.vtu)")
@@ -43,6 +44,8 @@ int runMesh(const Args& args) {
   const std::optional<LimbSeparation> separation = parseSeparationOptions(p);
   const std::string out = p.get("out");
   refuseOverwritingInput(p.get("parts"), out);
+  refuseOverwritingInput(p.get("parts"), greenCoordinatesFileFor(out));
+  refuseOverwritingInput(p.get("cage"), greenCoordinatesFileFor(out));
   AtomicOutput probe(out);  // an unwritable output fails before the work
   const auto start = std::chrono::steady_clock::now();
   // Mesh_3 holds S, a padded 16-bit copy and its triangulation: about 8 bytes per voxel of S.
@@ -62,14 +65,23 @@ int runMesh(const Args& args) {
   if (separation)
     added = separateLabels(mesh, separation->labelA, separation->labelB, separation->region);
   const int threads = static_cast<int>(p.getInt("threads"));
-  const Embedding embedding = embedInCage(mesh, cage, threads);
-  const RigiditySolver solver(mesh, embedding.cageVertices, embedding.cageTets);
+  // The embedding, its Green coordinates and the solver's factorization: what every later
+  // deformation of this mesh needs. The coordinates are kept beside the mesh (tm.vtu ->
+  // tm.green) so that `repose warp` reads them instead of computing them again.
+  const CageDeformation deformation(mesh, cage, threads);
+  const Embedding& embedding = deformation.embedding();
+  const RigiditySolver& solver = deformation.solver();
+  const std::string coordinates = greenCoordinatesFileFor(out);
+  deformation.saveCoordinates(coordinates);
   writeTransferMesh(mesh, out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   nlohmann::json labels = nlohmann::json::object();
   for (const auto& [label, count] : report.tetsPerLabel) labels[std::to_string(label)] = count;
   const nlohmann::json j = {{"mesh", out},
+                            {"green_coordinates", coordinates},
+                            {"green_coordinates_bytes", deformation.coefficientBytes()},
+                            {"unreproduced_vertices", deformation.unreproducedVertices()},
                             {"vertices", mesh.vertices.rows()},
                             {"tets", mesh.tets.rows()},
                             {"tets_per_label", labels},
@@ -87,6 +99,7 @@ int runMesh(const Args& args) {
   } else {
     std::cout << "wrote " << out << ": " << mesh.vertices.rows() << " vertices, "
               << mesh.tets.rows() << " tets\n"
+              << "wrote " << coordinates << ": the Green coordinates of the vertices in the cage\n"
               << "inside the cage: " << embedding.cageVertices.size() << " vertices, "
               << embedding.cageTets.size()
               << " tets; outliers (moved by the rigidity solver): " << embedding.outliers() << "\n";

@@ -254,8 +254,10 @@ int runPose(const Args& args) {
   if (p.has("scene")) fromScene = readSceneRig(p.get("scene"), key);
   const bool reused = fromScene.has_value();
   RigGeometry geometry;
+  std::string rigCoordinates;
   if (reused) {
     geometry = std::move(*fromScene);
+    rigCoordinates = geometry.coordinatesFile;
     say("reusing the cage and transfer mesh of " + p.get("scene"));
   } else {
     say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
@@ -268,6 +270,14 @@ int runPose(const Args& args) {
     writeSceneFolder(p.get("scene"), rig, key,
                      {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""},
                      job.settings());
+  if (reused && rig.deformation().coordinatesRead()) {
+    say("Green coordinates read from " + rigCoordinates);
+  } else if (reused) {
+    // A scene of an older version, or one whose file does not belong to its mesh and cage:
+    // computed here, and saved so that the next run reads them.
+    say("Green coordinates computed again: " + rig.deformation().coordinatesNote());
+    rig.deformation().saveCoordinates(rigCoordinates);
+  }
   const bool oneFrame = rig.frameCount() == 1;
   if (single.frame >= rig.frameCount())
     throw Error(p.get("pose") + ": has " + std::to_string(rig.frameCount()) +
@@ -301,7 +311,7 @@ int runPose(const Args& args) {
       std::cerr << "repose pose: warning: frame " << frameName << ": " << line << std::endl;
     };
     PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
-    posed.reportJson = job.completeReport(posed.reportJson, reused);
+    posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
     FrameWriteOptions wo;
     wo.labelMapFiles = labelMapFiles;

@@ -240,7 +240,7 @@ void runJob(Worker& worker, std::int64_t t, std::size_t f, const TaskPlan& plan,
                   gib(peakResidentBytes()) + " in use, more than the budget of " + gib(budget));
   };
   PosedFrame posed = poseFrame(rig, f, worker.organs(), worker.parts(), fo);
-  posed.reportJson = job.completeReport(posed.reportJson, reused);
+  posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
   FrameWriteOptions wo;
   wo.labelMapFiles = fo.labelMapFiles;
   const fs::path scene = fs::absolute(worker.sceneFolder(t));

@@ -92,6 +92,8 @@ void printWarpSummary(const WarpSummary& s, bool json) {
                       {"labels_unnamed", unnamed},
                       {"labels", perLabel},
                       {"seconds", s.seconds}};
+  j["green_coordinates"] = {{"read", s.coordinatesRead}, {"note", s.coordinatesNote}};
+  j["deformation_seconds"] = s.deformationSeconds;
   if (s.slabs > 0)
     j["mpi"] = {{"ranks", s.ranks}, {"slabs", s.slabs}, {"stage_seconds", s.stageSeconds}};
   if (json) {
@@ -113,6 +115,21 @@ void printWarpSummary(const WarpSummary& s, bool json) {
   }
 }
 
+std::string warpCoordinatesFile(const ArgParser& p) {
+  return p.has("coordinates") ? p.get("coordinates") : greenCoordinatesFileFor(p.get("mesh"));
+}
+
+void noteWarpCoordinates(const CageDeformation& deformation, WarpSummary& summary) {
+  summary.coordinatesRead = deformation.coordinatesRead();
+  summary.coordinatesNote = deformation.coordinatesNote();
+  const std::string& note = summary.coordinatesNote;
+  const std::string absent = ": no such file";
+  const bool missing = note.size() >= absent.size() &&
+                       note.compare(note.size() - absent.size(), absent.size(), absent) == 0;
+  if (!summary.coordinatesRead && !note.empty() && !missing)
+    std::cerr << "repose warp: note: Green coordinates computed again: " << note << "\n";
+}
+
 int runWarp(const Args& args) {
   if (printSlicerModuleXml(args, "warp")) return 0;  // 3D Slicer asking for the description
   ArgParser p(
@@ -125,6 +142,10 @@ int runWarp(const Args& args) {
       .option("mesh", "FILE", "transfer mesh from `repose mesh` (.vtu)")
       .option("cage", "FILE", "the cage the mesh was built with (.obj or .vtk)")
       .option("posed-cage", "FILE", "the same cage, posed (same vertices and faces)")
+      .option("coordinates", "FILE",
+              "the mesh's Green coordinates (default: beside --mesh, tm.vtu -> tm.green, as "
+              "`repose mesh` and scene folders write them); computed when absent or not for "
+              "this mesh and cage")
       .option("out", "FILE", "posed label map")
       .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
       .option("image-out", "FILE", "posed image (with --image)")
@@ -200,8 +221,11 @@ int runWarp(const Args& args) {
     throw Error(p.get("posed-cage") + ": not a pose of " + p.get("cage") +
                 " (vertices or faces differ)");
   const int threads = static_cast<int>(p.getInt("threads"));
-  const CageDeformation deformation(mesh, cage, threads);
+  const auto deformStart = std::chrono::steady_clock::now();
+  const CageDeformation deformation(mesh, cage, threads, warpCoordinatesFile(p));
   const Eigen::MatrixX3d deformed = deformation.deform(posed.vertices);
+  const double deformationSeconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
   const VolumeGeometry grid = deformedGrid(layout.geometry, deformed, spacing);
 
   // What the volumes need against what the budget leaves after the mesh and cage (the process's
@@ -285,6 +309,8 @@ int runWarp(const Args& args) {
   summary.inCoreNeed = inCoreNeed;
   summary.report = report;
   summary.unreachable = deformation.solver().unconstrainedVertices();
+  noteWarpCoordinates(deformation, summary);
+  summary.deformationSeconds = deformationSeconds;
   summary.volumes = volumes;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   printWarpSummary(summary, p.has("json"));

@@ -48,6 +48,7 @@ int runWarpOverRanks(const ArgParser& p) {
   std::optional<AtomicOutput> outFile;
   Eigen::MatrixX3d deformed;
   int unreachable = 0;
+  WarpSummary summary;  // filled on rank 0
   // Every rank checks the request and reads the mesh; rank 0 alone creates the output (so an
   // unwritable one fails before the work) and computes the deformation.
   ranks->together([&] {
@@ -81,9 +82,14 @@ int runWarpOverRanks(const ArgParser& p) {
     if (posed.vertices.rows() != cage.vertices.rows() || posed.faces != cage.faces)
       throw Error(p.get("posed-cage") + ": not a pose of " + p.get("cage") +
                   " (vertices or faces differ)");
-    const CageDeformation deformation(mesh, cage, static_cast<int>(p.getInt("threads")));
+    const auto deformStart = std::chrono::steady_clock::now();
+    const CageDeformation deformation(mesh, cage, static_cast<int>(p.getInt("threads")),
+                                      warpCoordinatesFile(p));
     deformed = deformation.deform(posed.vertices);
     unreachable = deformation.solver().unconstrainedVertices();
+    noteWarpCoordinates(deformation, summary);
+    summary.deformationSeconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
   });
   // One deformation for all: the ranks' outputs agree to the bit whatever their hardware.
   ranks->broadcast(deformed);
@@ -124,7 +130,6 @@ int runWarpOverRanks(const ArgParser& p) {
   if (!root) return 0;
 
   const auto countStart = std::chrono::steady_clock::now();
-  WarpSummary summary;
   for (const auto& [value, mm3] : streamedLabelVolumes(*cache))
     summary.volumes[{0, value}].first = mm3;
   const auto end = std::chrono::steady_clock::now();

@@ -5,6 +5,7 @@
 #include "ArgParser.h"
 
 #include "repose/io/SliceCache.h"
+#include "repose/mesh/RigiditySolver.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/volume/Volume.h"
 
@@ -29,7 +30,19 @@ struct WarpSummary {
   // --mpi, on rank 0: setup (MPI, reading, the deformation and its broadcast, the slab
   // rasterizer), slabs (rasterized and written by all ranks), input_volumes (G counted).
   std::map<std::string, double> stageSeconds;
+  // The mesh's Green coordinates: read from their file, or computed (and why), and the seconds
+  // from reading the mesh to the deformed vertices.
+  bool coordinatesRead = false;
+  std::string coordinatesNote;
+  double deformationSeconds = 0;
 };
+
+// --coordinates, else the file beside --mesh (tm.vtu -> tm.green), which `repose mesh` and scene
+// folders write.
+std::string warpCoordinatesFile(const ArgParser& p);
+// The deformation's coordinate source into the summary; a file that was there but not used (for
+// another mesh or cage, damaged) is said on stderr.
+void noteWarpCoordinates(const CageDeformation& deformation, WarpSummary& summary);
 
 void printWarpSummary(const WarpSummary& summary, bool json);
 

@@ -213,6 +213,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   ~vtkSlicerReposeLogic() override;
   void OnParameterNodeModified();
   void OnLivePoseModified();
+  // The live frame of this pose (the live pose node's, parsed once per change).
+  bool SolveLiveFrame(const repose::Pose& pose);
   void ReleaseLivePose();  // StopLivePose without the ModifiedEvent
   // The pose job of a segmentation (Core's policy, as `repose pose` and Python use it): its
   // tissue table, skeleton and joints, separations, the rig's settings from the parameter node.

@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 using Conversion = vtkSlicerReposeVolumeConversion;
 
@@ -116,7 +117,8 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           Conversion::FromImageData(nodes.Segmentation->GetImage()));
     repose::RigGeometry geometry{
         vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()),
-        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(nodes.TransferMesh->GetMesh())};
+        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(nodes.TransferMesh->GetMesh()),
+        nodes.TransferMesh->GetCoordinatesFile()};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     // The joints bend live as they do in the export and in `repose pose` (Core's pose job).
     auto S = std::make_shared<const repose::Volume>(
@@ -163,10 +165,10 @@ void vtkSlicerReposeLogic::OnLivePoseModified() {
   if (!this->Live) return;
   // New or changed handle groups (a group made from a selection, or its undo) need the rig
   // prepared again: a job, after which the frame is solved. Until then the last frame stays.
+  std::optional<repose::Pose> pose;
   try {
-    const repose::Pose pose =
-        repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName());
-    if (!repose::sameHandleGroups(pose, this->Live->Rig->pose())) {
+    pose = repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName());
+    if (!repose::sameHandleGroups(*pose, this->Live->Rig->pose())) {
       if (!this->StartLivePose(this->Live->Pose)) this->Modified();
       return;
     }
@@ -175,7 +177,7 @@ void vtkSlicerReposeLogic::OnLivePoseModified() {
     this->Modified();
     return;
   }
-  this->UpdateLiveFrame();
+  this->SolveLiveFrame(*pose);  // the pose parsed once per change
 }
 
 void vtkSlicerReposeLogic::ReleaseLivePose() {
@@ -195,15 +197,25 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::GetLivePose() const {
 
 bool vtkSlicerReposeLogic::UpdateLiveFrame() {
   if (!this->Live) return false;
+  try {
+    return this->SolveLiveFrame(
+        repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName()));
+  } catch (const std::exception& e) {
+    this->LastErrorMessage = e.what();
+    this->Modified();
+    return false;
+  }
+}
+
+bool vtkSlicerReposeLogic::SolveLiveFrame(const repose::Pose& pose) {
   LiveSession& live = *this->Live;
   try {
     const auto start = std::chrono::steady_clock::now();
-    const repose::Pose pose = repose::parsePose(live.Pose->GetPoseJSON(), live.Pose->GetName());
     const std::size_t frames = pose.frames().size();
     const std::size_t index =
         std::min<std::size_t>(std::size_t(live.Pose->GetCurrentFrame()), frames - 1);
     const repose::PoseRig::Frame frame =
-        live.Rig->frame(pose, index, repose::GreenPrecision::Preview);
+        live.Rig->frame(pose, index, repose::GreenPrecision::Preview, repose::FrameMaps::Without);
     live.Deformed = frame.deformed;
     setPoints(live.Cage, frame.cage);
     setPoints(live.Body, frame.deformed);

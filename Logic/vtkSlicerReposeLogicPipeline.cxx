@@ -349,7 +349,8 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
       I = std::make_shared<repose::Volume>(Conversion::FromImageData(seg->GetImage()));
     repose::RigGeometry geometry{
         vtkSlicerReposeMeshConversion::FromPolyData(cageNode->GetMesh()),
-        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh())};
+        vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh()),
+        meshNode->GetCoordinatesFile()};
     const repose::Pose pose = repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName());
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
     // Tissues, skeleton and the joints' bends as `repose pose` has them.
@@ -397,7 +398,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           };
           auto f = std::make_shared<repose::PosedFrame>(
               repose::poseFrame(*rig, std::min(frame, rig->frameCount() - 1), *G, *S, fo));
-          f->reportJson = job->completeReport(f->reportJson, true);  // the scene's nodes' rig
+          f->reportJson = job->completeReport(f->reportJson, true, *rig);  // the scene's nodes' rig
           // Written here, on the worker: past the rasterization nothing can cancel the job, and
           // the files are atomic, so a cancelled export still leaves the folder as it was.
           if (!outputFolder.empty()) repose::writePosedFrame(*f, outputFolder);
@@ -506,6 +507,21 @@ bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
         repose::writeTransferMesh(
             vtkSlicerReposeMeshConversion::FromUnstructuredGrid(tm->GetMesh()),
             (dir / tm->GetFileName()).string());
+        // Its Green coordinates go along (whether they still fit the mesh and its cage is
+        // checked where they are read).
+        const std::string coordinates =
+            repose::greenCoordinatesFileFor((dir / tm->GetFileName()).string());
+        const std::string from = tm->GetCoordinatesFile();
+        std::error_code ec;
+        if (!from.empty() && fs::is_regular_file(from, ec) &&
+            !fs::equivalent(from, coordinates, ec)) {
+          repose::AtomicOutput copy(coordinates);
+          fs::copy_file(from, copy.tempPath(), fs::copy_options::overwrite_existing);
+          copy.commit();
+          tm->SetCoordinatesFile(coordinates);
+        } else if (from.empty() || !fs::is_regular_file(from, ec)) {
+          tm->SetCoordinatesFile("");
+        }
       } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
         pose->SetFileName(id + ".pose.json");
         repose::writeTextFileAtomically((dir / pose->GetFileName()).string(), pose->GetPoseJSON());
@@ -575,8 +591,10 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
         cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(
             repose::readTriangleMesh(need(cage->GetFileName(), cage))));
       } else if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node)) {
-        tm->SetMesh(vtkSlicerReposeMeshConversion::ToUnstructuredGrid(
-            repose::readTransferMesh(need(tm->GetFileName(), tm))));
+        const std::string meshFile = need(tm->GetFileName(), tm);
+        tm->SetMesh(
+            vtkSlicerReposeMeshConversion::ToUnstructuredGrid(repose::readTransferMesh(meshFile)));
+        tm->SetCoordinatesFile(repose::greenCoordinatesFileFor(meshFile));
       } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
         const std::string path = need(pose->GetFileName(), pose);
         pose->SetPoseJSON(repose::poseToJson(repose::readPoseFile(path)));

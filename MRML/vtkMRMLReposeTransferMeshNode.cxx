@@ -26,6 +26,7 @@ void vtkMRMLReposeTransferMeshNode::CopyContent(vtkMRMLReposeNode* other) {
   auto* o = static_cast<vtkMRMLReposeTransferMeshNode*>(other);
   this->SetFileName(o->FileName);
   this->SetSizeMm(o->SizeMm);
+  this->CoordinatesFile = o->CoordinatesFile;
   vtkSmartPointer<vtkUnstructuredGrid> mesh;
   if (o->Mesh) {
     mesh = vtkSmartPointer<vtkUnstructuredGrid>::New();

@@ -19,6 +19,11 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeTransferMeshNode
 
   const std::string& GetFileName() const { return this->FileName; }
   void SetFileName(const std::string& name) { this->SetField(this->FileName, name); }
+  // Where this mesh's Green coordinates are saved (a scene's tm.green, beside FileName), set when
+  // a scene is loaded or saved; "" when none. Not part of scene.json: the file is found beside
+  // the mesh's, and it is used only if written for this mesh and its cage (CageDeformation).
+  const std::string& GetCoordinatesFile() const { return this->CoordinatesFile; }
+  void SetCoordinatesFile(const std::string& path) { this->CoordinatesFile = path; }
   double GetSizeMm() const { return this->SizeMm; }  // 0: the automatic size
   void SetSizeMm(double mm) { this->SetField(this->SizeMm, mm); }
 
@@ -30,6 +35,6 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeTransferMeshNode
 
  private:
   vtkSmartPointer<vtkUnstructuredGrid> Mesh;
-  std::string FileName;
+  std::string FileName, CoordinatesFile;
   double SizeMm = 0;
 };

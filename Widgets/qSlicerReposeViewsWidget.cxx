@@ -28,6 +28,8 @@
 #include <QGridLayout>
 #include <QPainter>
 
+#include <array>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -215,6 +217,7 @@ void qSlicerReposeViewsWidget::refresh() {
           vtkSlicerReposeVolumeConversion::GetLabelTable(seg->GetLabelMap()));
   }
   const std::array<double, 3> centre = d->Logic->GetLiveRestCenter();
+  std::array<double, 3> sliceMs{};
   for (int o = 0; o < 3; ++o) {
     const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;  // axial: S, coronal: A, sagittal: R
     if (std::isnan(d->Positions[o])) d->Positions[o] = centre[std::size_t(axis)];
@@ -222,6 +225,7 @@ void qSlicerReposeViewsWidget::refresh() {
     vtkSmartPointer<vtkImageData> slice =
         d->Logic->ComputeLiveSlice(o, d->Positions[o], d->Pixels, &ms);
     d->SliceMilliseconds += ms;
+    sliceMs[std::size_t(o)] = ms;
     vtkSmartPointer<vtkImageData> image =
         d->Logic->ComputeLiveImageSlice(o, d->Positions[o], d->Pixels);
     double window = 0, level = 0;
@@ -232,10 +236,14 @@ void qSlicerReposeViewsWidget::refresh() {
       d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());
     d->Slices[o]->setSlice(slice, d->Lookup, image);
   }
-  // What a drag costs: the frame's solve (ARAP + Green + rigidity) and the three slices.
-  d->Timing->SetInput(QString("live frame %1 ms + slices %2 ms")
+  // What a drag costs, by the stages ReposeLiveBench reports (docs/PERFORMANCE.md): the frame's
+  // solve (posed cage, Green coordinates, rigidity) and each slice's labels.
+  d->Timing->SetInput(QString("live frame %1 ms + slices %2 ms (axial %3, coronal %4, sagittal %5)")
                           .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
                           .arg(d->SliceMilliseconds, 0, 'f', 1)
+                          .arg(sliceMs[0], 0, 'f', 1)
+                          .arg(sliceMs[1], 0, 'f', 1)
+                          .arg(sliceMs[2], 0, 'f', 1)
                           .toUtf8()
                           .constData());
   d->Timing->VisibilityOn();

@@ -342,7 +342,7 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
             PosedFrame f = withProgress(progress, [&](const ProgressFn& fn) {
               o.progress = fn;
               PosedFrame posed = poseFrame(*r.rig, index, organs, parts, o);
-              posed.reportJson = r.job->completeReport(posed.reportJson, r.sceneReused);
+              posed.reportJson = r.job->completeReport(posed.reportJson, r.sceneReused, *r.rig);
               return posed;
             });
             issueWarnings(f.name, warnings);

@@ -2,6 +2,8 @@
 // its main diagonal (a conforming Kuhn triangulation), all positively oriented.
 #pragma once
 
+#include "TestMeshes.h"
+
 #include "repose/mesh/TransferMesh.h"
 
 #include <Eigen/LU>
@@ -54,6 +56,15 @@ inline TransferMesh concatenate(const TransferMesh& a, const TransferMesh& b) {
   m.labels.resize(a.labels.size() + b.labels.size());
   m.labels << a.labels, b.labels;
   return m;
+}
+
+// A 300 mm limb along x and a cage covering x in [-15, 215]: its last 85 mm stick out of the
+// cage (outliers, which the rigidity solver moves), as real meshes have at the crown and soles.
+inline TransferMesh cagedLimb() {
+  return tetBox({0, -20, -20}, {300, 20, 20}, {30, 4, 4});
+}
+inline TriangleMesh cagedLimbCage() {
+  return boxMesh({-15, -35, -35}, {215, 35, 35}, 4);
 }
 
 }  // namespace repose::test

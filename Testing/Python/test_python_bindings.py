@@ -139,6 +139,8 @@ def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose, phan
     report = frame.report
     assert report["quality"]["all_met"] and report["tissue_table"] == "phantom default"
     assert report["body"]["mass_before_kg"] > 20
+    # The Green coordinates came from the scene's tm.green, not computed again.
+    assert report["green_coordinates"]["read"], report["green_coordinates"]
     field = frame.field
     assert field.shape == frame.organs.shape + (3,) and np.isfinite(field).all()
 

@@ -3,9 +3,13 @@
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 
+#include <zlib.h>
+
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <istream>
+#include <ostream>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <cpuid.h>
@@ -214,6 +218,66 @@ Eigen::MatrixX3d CompactGreenMatrix::multiplyRows(const Eigen::MatrixX3d& x, boo
   Eigen::VectorXd inverseScale(n);
   for (std::int64_t o = 0; o < n; ++o) inverseScale[o] = 1.0 / rowScale_[list ? list[o] : o];
   return inverseScale.asDiagonal() * out;
+}
+
+}  // namespace repose
+
+namespace repose {
+
+void CompactGreenMatrix::writeTo(std::ostream& out) const {
+  const std::int64_t sizes[4] = {rows_, cols_, vertexCols_, stride_};
+  out.write(reinterpret_cast<const char*>(sizes), sizeof(sizes));
+  out.write(reinterpret_cast<const char*>(rowScale_.data()),
+            static_cast<std::streamsize>(rowScale_.size() * sizeof(double)));
+  for (const auto* halves : {&high_, &low_})
+    out.write(reinterpret_cast<const char*>(halves->data()),
+              static_cast<std::streamsize>(halves->size() * sizeof(std::uint16_t)));
+}
+
+bool CompactGreenMatrix::readFrom(std::istream& in, Eigen::Index rows, Eigen::Index vertexCols,
+                                  Eigen::Index faceCols) {
+  CompactGreenMatrix m(rows, vertexCols, faceCols);
+  std::int64_t sizes[4] = {};
+  if (!in.read(reinterpret_cast<char*>(sizes), sizeof(sizes))) return false;
+  if (sizes[0] != m.rows_ || sizes[1] != m.cols_ || sizes[2] != m.vertexCols_ ||
+      sizes[3] != m.stride_)
+    return false;
+  in.read(reinterpret_cast<char*>(m.rowScale_.data()),
+          static_cast<std::streamsize>(m.rowScale_.size() * sizeof(double)));
+  for (auto* halves : {&m.high_, &m.low_})
+    in.read(reinterpret_cast<char*>(halves->data()),
+            static_cast<std::streamsize>(halves->size() * sizeof(std::uint16_t)));
+  if (!in) return false;
+  if (!m.rowScale_.allFinite() || (m.rowScale_.array() <= 0).any()) return false;
+  *this = std::move(m);
+  return true;
+}
+
+std::uint32_t CompactGreenMatrix::checksum(int threads) const {
+  // Pieces of 8 MiB checked in parallel and combined in order (crc32_combine), so the CRC is that
+  // of the arrays end to end whatever the thread count.
+  std::vector<std::pair<const unsigned char*, std::size_t>> spans;
+  constexpr std::size_t kPiece = std::size_t(8) << 20;
+  const auto add = [&](const void* data, std::size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t at = 0; at < bytes; at += kPiece)
+      spans.emplace_back(p + at, std::min(kPiece, bytes - at));
+  };
+  add(rowScale_.data(), rowScale_.size() * sizeof(double));
+  add(high_.data(), high_.size() * sizeof(std::uint16_t));
+  add(low_.data(), low_.size() * sizeof(std::uint16_t));
+  std::vector<uLong> crcs(spans.size());
+  parallelFor(
+      static_cast<std::int64_t>(spans.size()), threads,
+      [&](std::int64_t begin, std::int64_t end) {
+        for (std::int64_t i = begin; i < end; ++i)
+          crcs[i] = crc32(crc32(0L, Z_NULL, 0), spans[i].first, static_cast<uInt>(spans[i].second));
+      },
+      1);
+  uLong crc = crc32(0L, Z_NULL, 0);
+  for (std::size_t i = 0; i < spans.size(); ++i)
+    crc = crc32_combine(crc, crcs[i], static_cast<z_off_t>(spans[i].second));
+  return static_cast<std::uint32_t>(crc);
 }
 
 }  // namespace repose

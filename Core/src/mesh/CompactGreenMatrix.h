@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <iosfwd>
 #include <vector>
 
 namespace repose {
@@ -27,6 +28,7 @@ class CompactGreenMatrix {
 
   Eigen::Index rows() const { return rows_; }
   Eigen::Index cols() const { return cols_; }
+  Eigen::Index vertexCols() const { return vertexCols_; }
   std::size_t bytes() const {
     return 2 * high_.size() * sizeof(std::uint16_t) + rowScale_.size() * sizeof(double);
   }
@@ -37,6 +39,15 @@ class CompactGreenMatrix {
   // bit-identical to multiply's.
   Eigen::MatrixX3d multiplyRows(const Eigen::MatrixX3d& x, bool preview, int threads,
                                 const std::vector<std::int64_t>* rows) const;
+
+  // The stored form, byte for byte (host byte order; GreenCoordinatesFile.h frames it): sizes,
+  // row scales, high halves, low halves. readFrom returns false when the stream ends early or the
+  // sizes are not those expected (the cage's vertex and face counts), leaving *this unchanged.
+  void writeTo(std::ostream& out) const;
+  bool readFrom(std::istream& in, Eigen::Index rows, Eigen::Index vertexCols,
+                Eigen::Index faceCols);
+  // CRC-32 of the stored arrays (zlib's), computed in pieces on `threads`.
+  std::uint32_t checksum(int threads) const;
 
  private:
   Eigen::Index rows_ = 0, cols_ = 0, vertexCols_ = 0, stride_ = 0;  // stride_: cols_ padded to 16

@@ -121,6 +121,22 @@ Eigen::Isometry3d blendMotions(const Eigen::Ref<const Eigen::VectorXd>& weights,
   return out;
 }
 
+GroupMotions::GroupMotions(const std::vector<RigidHandle>& handles) : handles_(handles) {
+  for (std::size_t g = 0; g < handles.size(); ++g)
+    alone_.push_back(blendMotions(
+        Eigen::VectorXd::Unit(Eigen::Index(handles.size()), Eigen::Index(g)), handles));
+}
+
+Eigen::Isometry3d GroupMotions::of(const Eigen::Ref<const Eigen::RowVectorXd>& membership) const {
+  Eigen::Index only = -1;
+  for (Eigen::Index g = 0; g < membership.size(); ++g) {
+    if (membership[g] == 0) continue;
+    if (only >= 0 || membership[g] != 1) return blendMotions(membership.transpose(), handles_);
+    only = g;
+  }
+  return only >= 0 ? alone_[std::size_t(only)] : blendMotions(membership.transpose(), handles_);
+}
+
 double handleBlendWeight(double membership) {
   const double t = std::clamp(
       (membership - HandleInfluence::kNone) / (HandleInfluence::kFull - HandleInfluence::kNone),

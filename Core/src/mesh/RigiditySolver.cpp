@@ -4,6 +4,7 @@
 #include "repose/mesh/RigiditySolver.h"
 
 #include "CompactGreenMatrix.h"
+#include "GreenCoordinatesFile.h"
 #include "TetAdjacency.h"
 #include "numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
@@ -13,7 +14,9 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
+#include <filesystem>
 #include <numeric>
+#include <optional>
 #include <sstream>
 
 namespace repose {
@@ -62,7 +65,13 @@ struct RigiditySolver::Impl {
   // Step 1: rows  sqrt|t| (B_t - sum_n a_tn B_n) = 0  for t outside T_c; a_tn = |n| / sum |n|.
   Eigen::SparseMatrix<double> A1u;  // rows x unknown tets
   Eigen::SparseMatrix<double> A1k;  // rows x constrained tets (their B are known)
-  Eigen::MatrixXd reg1;             // A1^T b from identity rows of unconstrained components
+  // The constrained tets step 1 reads (A1k's nonzero columns, in order: the product sums in the
+  // same order as with A1k) and A1k restricted to them; and every tet of T_c a solve reads (those
+  // and the ones around step 2's edges). A frame that does not ask for B computes only these.
+  std::vector<int> step1Known;
+  Eigen::SparseMatrix<double> A1kUsed;
+  std::vector<int> readTets;
+  Eigen::MatrixXd reg1;  // A1^T b from identity rows of unconstrained components
   SparseCholesky llt1;
   // Step 2: rows  sqrt(W_e) (v_i - v_j) = g_e / sqrt(W_e)  for edges touching an unknown vertex.
   std::vector<std::array<int, 2>> edges;
@@ -231,6 +240,29 @@ RigiditySolver::RigiditySolver(const TransferMesh& mesh,
   if (no > 0)
     m.llt2.factorize(Eigen::SparseMatrix<double>(m.A2u.transpose() * m.A2u),
                      "rigidity solver step 2");
+
+  // What a frame reads of T_c's maps.
+  std::vector<int> usedColumn(constrainedTets.size(), -1);
+  for (Eigen::Index k = 0; k < m.A1k.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(m.A1k, k); it; ++it)
+      if (usedColumn[k] < 0) {
+        usedColumn[k] = static_cast<int>(m.step1Known.size());
+        m.step1Known.push_back(static_cast<int>(k));
+      }
+  std::vector<Eigen::Triplet<double>> used;
+  for (Eigen::Index k = 0; k < m.A1k.outerSize(); ++k)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(m.A1k, k); it; ++it)
+      used.emplace_back(static_cast<int>(it.row()), usedColumn[k], it.value());
+  m.A1kUsed.resize(m.A1k.rows(), static_cast<Eigen::Index>(m.step1Known.size()));
+  m.A1kUsed.setFromTriplets(used.begin(), used.end());
+  std::vector<char> read(nt, 0);
+  for (const int k : m.step1Known) read[constrainedTets[k]] = 1;
+  for (const auto& around : m.edgeTets)
+    for (const auto& [t, vol] : around)
+      if (m.tetSlot[t] < 0) read[t] = 1;
+  for (int t = 0; t < nt; ++t)
+    if (read[t]) m.readTets.push_back(t);
+  m.A1k = Eigen::SparseMatrix<double>();  // A1kUsed holds what is needed
 }
 
 RigiditySolver::~RigiditySolver() = default;
@@ -253,19 +285,24 @@ Eigen::MatrixX3d RigiditySolver::solve(const Eigen::MatrixX3d& targets,
   for (std::size_t i = 0; i < m.constrainedVertices.size(); ++i)
     positions.row(m.constrainedVertices[i]) = targets.row(i);
 
-  // Step 1: B of T_c from the targets, then the others.
+  // Step 1: B of T_c from the targets (all of them when asked for, else those the solves read),
+  // then the others.
   std::vector<Eigen::Matrix3d> B(static_cast<std::size_t>(mesh.tets.rows()));
-  Eigen::MatrixXd known(m.constrainedTets.size(), 9);
-  for (std::size_t k = 0; k < m.constrainedTets.size(); ++k) {
-    const int t = m.constrainedTets[k];
+  const auto mapOf = [&](int t) {
     Eigen::Matrix3d D;
     for (int c = 0; c < 3; ++c)
       D.col(c) = (positions.row(mesh.tets(t, c + 1)) - positions.row(mesh.tets(t, 0))).transpose();
     B[t] = D * m.restInverse[t];
-    known.row(k) = flatten(B[t]);
-  }
+  };
+  if (Bout)
+    for (const int t : m.constrainedTets) mapOf(t);
+  else
+    for (const int t : m.readTets) mapOf(t);
+  Eigen::MatrixXd known(m.step1Known.size(), 9);
+  for (std::size_t j = 0; j < m.step1Known.size(); ++j)
+    known.row(static_cast<Eigen::Index>(j)) = flatten(B[m.constrainedTets[m.step1Known[j]]]);
   if (!m.unknownTets.empty()) {
-    const Eigen::MatrixXd rhs = m.reg1 - Eigen::MatrixXd(m.A1u.transpose() * (m.A1k * known));
+    const Eigen::MatrixXd rhs = m.reg1 - Eigen::MatrixXd(m.A1u.transpose() * (m.A1kUsed * known));
     const Eigen::MatrixXd x = m.llt1.solve(rhs);
     for (std::size_t r = 0; r < m.unknownTets.size(); ++r)
       B[m.unknownTets[r]] = unflatten(x.row(r));
@@ -308,13 +345,45 @@ Eigen::MatrixX3d greenCageValues(const TriangleMesh& rest, const Eigen::MatrixX3
 
 }  // namespace
 
-CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads)
-    : cage_(cage), embedding_(embedInCage(mesh, cage, threads, false)), threads_(threads) {
+CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads,
+                                 const std::string& coordinatesFile)
+    : cage_(cage), threads_(threads) {
+  restCageValues_ = greenCageValues(cage_, cage_.vertices);
+  key_ = greenCoordinatesKey(mesh, cage_);
+  meshVertices_ = mesh.vertices.rows();
+  std::optional<SavedGreenCoordinates> saved;
+  if (!coordinatesFile.empty())
+    saved = readGreenCoordinatesFile(coordinatesFile, key_, meshVertices_, cage_, threads,
+                                     &coordinatesNote_);
+  if (saved) {
+    // V_c as the run that saved it found it (winding numbers, then the unreproduced dropped).
+    embedding_.inside.assign(static_cast<std::size_t>(meshVertices_), 0);
+    for (const int v : saved->cageVertices) embedding_.inside[v] = 1;
+    embedding_.cageVertices = std::move(saved->cageVertices);
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      bool all = true;
+      for (int c = 0; c < 4; ++c) all &= embedding_.inside[mesh.tets(t, c)] != 0;
+      if (all) embedding_.cageTets.push_back(static_cast<int>(t));
+    }
+    unreproduced_ = saved->unreproduced;
+    restPositions_ = std::move(saved->restPositions);
+    restVertices_.resize(restPositions_.rows(), 3);
+    for (Eigen::Index r = 0; r < restVertices_.rows(); ++r)
+      restVertices_.row(r) = mesh.vertices.row(embedding_.cageVertices[r]);
+    coefficients_ = std::make_unique<CompactGreenMatrix>(std::move(saved->coefficients));
+    coordinatesRead_ = true;
+  } else {
+    computeCoordinates(mesh, threads);
+  }
+  solver_ = std::make_unique<RigiditySolver>(mesh, embedding_.cageVertices, embedding_.cageTets);
+}
+
+void CageDeformation::computeCoordinates(const TransferMesh& mesh, int threads) {
+  embedding_ = embedInCage(mesh, cage_, threads, false);
   // Green coordinates of V_c in blocks of rows, each compacted at once, so the double matrix
   // (12 bytes more per coefficient) never exists for the whole mesh: at the seed's sizes it would
   // be ~430 MB, more than the rest of a posing job.
   constexpr Eigen::Index kBlock = 1024;
-  restCageValues_ = greenCageValues(cage_, cage_.vertices);
   // Green coordinates reproduce every point inside the cage; a vertex they miss by more than
   // this (1e-5 of the cage's size; good vertices are within ~1e-6 mm) is treated as outside.
   const double tolerance =
@@ -358,7 +427,16 @@ CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& c
     }
     embedding_.cageTets = std::move(tets);
   }
-  solver_ = std::make_unique<RigiditySolver>(mesh, embedding_.cageVertices, embedding_.cageTets);
+}
+
+void CageDeformation::saveCoordinates(const std::string& path) const {
+  writeGreenCoordinatesFile(path, key_, meshVertices_, embedding_.cageVertices, unreproduced_,
+                            restPositions_, *coefficients_, threads_);
+}
+
+std::string greenCoordinatesFileFor(const std::string& meshPath) {
+  std::filesystem::path p(meshPath);
+  return p.replace_extension(".green").string();
 }
 
 CageDeformation::~CageDeformation() = default;
@@ -428,6 +506,7 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
   const Eigen::MatrixX3d green = coefficients_->multiplyRows(
       delta, precision == GreenPrecision::Preview, threads_, &greenRows);
   Eigen::MatrixX3d targets(n, 3);
+  const GroupMotions motions(handles);
   std::vector<std::int64_t> greenIndex(n, -1);
   for (std::size_t k = 0; k < greenRows.size(); ++k) greenIndex[greenRows[k]] = std::int64_t(k);
   parallelFor(n, threads_, [&](std::int64_t begin, std::int64_t end) {
@@ -441,8 +520,7 @@ Eigen::MatrixX3d CageDeformation::deform(const Eigen::MatrixX3d& deformedCage,
         continue;
       }
       const Eigen::RowVector3d carried =
-          (blendMotions(influence.membership.row(v).transpose(), handles) *
-           Eigen::Vector3d(restVertices_.row(r)))
+          (motions.of(influence.membership.row(v)) * Eigen::Vector3d(restVertices_.row(r)))
               .transpose();
       targets.row(r) = w == 1 ? carried : (g + w * (carried - g)).eval();
     }

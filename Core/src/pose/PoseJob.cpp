@@ -227,10 +227,15 @@ PoseFrameOptions PoseJob::frameOptions() const {
   return o;
 }
 
-std::string PoseJob::completeReport(const std::string& reportJson, bool sceneReused) const {
+std::string PoseJob::completeReport(const std::string& reportJson, bool sceneReused,
+                                    const PoseRig& rig) const {
   nlohmann::json report = nlohmann::json::parse(reportJson);
   report["input"] = request_.organsName;
   report["scene_reused"] = sceneReused;
+  const CageDeformation& d = rig.deformation();
+  report["green_coordinates"] = {{"read", d.coordinatesRead()},
+                                 {"note", d.coordinatesNote()},
+                                 {"bytes", d.coefficientBytes()}};
   report["joint_rings"] = jointRings_;
   report["separations"] = nlohmann::json::parse(separations_.reportJson());
   report["skeleton"] = skeleton_ ? nlohmann::json(skeleton_->source) : nlohmann::json();

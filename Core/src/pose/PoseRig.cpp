@@ -235,7 +235,8 @@ TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
 PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads,
                  int jointRings, const std::vector<BendJoint>& bends)
     : geometry_(std::move(geometry)), pose_(pose) {
-  deformation_ = std::make_unique<CageDeformation>(geometry_.mesh, geometry_.cage, threads);
+  deformation_ = std::make_unique<CageDeformation>(geometry_.mesh, geometry_.cage, threads,
+                                                   geometry_.coordinatesFile);
   handles_ = resolveHandles(pose_, geometry_.cage, geometry_.mesh, partLabels);
   influence_ = computeHandleInfluence(geometry_.mesh, geometry_.cage, handles_, threads,
                                       jointRings >= 0 ? jointRings : pose_.jointRings);
@@ -245,33 +246,35 @@ PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partL
 
 PoseRig::~PoseRig() = default;
 
-PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision) const {
+PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision,
+                              FrameMaps tetMaps) const {
   if (index >= frames_.size())
     throw Error("pose " + pose_.name + " has " + std::to_string(frames_.size()) + " frames, not " +
                 std::to_string(index + 1));
-  return solveFrame(frames_[index].first, frames_[index].second, precision);
+  return solveFrame(frames_[index].first, frames_[index].second, precision, tetMaps);
 }
 
-PoseRig::Frame PoseRig::frame(const Pose& edited, std::size_t index,
-                              GreenPrecision precision) const {
+PoseRig::Frame PoseRig::frame(const Pose& edited, std::size_t index, GreenPrecision precision,
+                              FrameMaps tetMaps) const {
   if (!sameHandleGroups(edited, pose_))
     throw Error("pose " + edited.name + ": its groups are not those the rig was prepared for");
   const auto frames = edited.frames();
   if (index >= frames.size())
     throw Error("pose " + edited.name + " has " + std::to_string(frames.size()) + " frames, not " +
                 std::to_string(index + 1));
-  return solveFrame(frames[index].first, frames[index].second, precision);
+  return solveFrame(frames[index].first, frames[index].second, precision, tetMaps);
 }
 
 PoseRig::Frame PoseRig::solveFrame(const std::string& name,
                                    const std::vector<Eigen::Isometry3d>& motions,
-                                   GreenPrecision precision) const {
+                                   GreenPrecision precision, FrameMaps tetMaps) const {
   Frame f;
   f.name = name;
   f.handles = handles_;
   setMotions(f.handles, motions);
   f.cage = poseCage(geometry_.cage, f.handles);
-  f.deformed = deformation_->deform(f.cage, influence_, f.handles, &f.tetMaps, precision);
+  f.deformed = deformation_->deform(f.cage, influence_, f.handles,
+                                    tetMaps == FrameMaps::With ? &f.tetMaps : nullptr, precision);
   // Tissue a group carries alone moves with it exactly, also where the cage misses it (the crotch
   // beside a cut between the thighs): the rigidity solver would drag it along with its moving
   // neighbours otherwise.
@@ -279,17 +282,18 @@ PoseRig::Frame PoseRig::solveFrame(const std::string& name,
   {
     const TransferMesh& m = geometry_.mesh;
     const std::vector<char>& inside = deformation_->embedding().inside;
+    const GroupMotions motions(f.handles);
     for (Eigen::Index v = 0; v < m.vertices.rows(); ++v) {
       if (inside[std::size_t(v)] || influence_.weight[std::size_t(v)] < 1) continue;
-      f.deformed.row(v) = (blendMotions(influence_.membership.row(v).transpose(), f.handles) *
-                           Eigen::Vector3d(m.vertices.row(v)))
-                              .transpose();
+      f.deformed.row(v) =
+          (motions.of(influence_.membership.row(v)) * Eigen::Vector3d(m.vertices.row(v)))
+              .transpose();
       ++carriedOutside;
     }
   }
   const JointBendReport bent = bends_.apply(geometry_.mesh, f.handles, f.deformed);
   // The bends and the carried vertices moved vertices after the solver: their tets' maps follow.
-  if (bent.vertices > 0 || carriedOutside > 0) {
+  if (tetMaps == FrameMaps::With && (bent.vertices > 0 || carriedOutside > 0)) {
     const TransferMesh& m = geometry_.mesh;
     for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
       Eigen::Matrix3d D, E;

@@ -56,6 +56,8 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
   fs::create_directories(scene);
   writeTriangleMesh(rig.cage(), (scene / "cage.vtk").string());
   writeTransferMesh(rig.mesh(), (scene / "tm.vtu").string());
+  // The coordinates, so that a later run reads them instead of computing them (most of its time).
+  rig.deformation().saveCoordinates(greenCoordinatesFileFor((scene / "tm.vtu").string()));
   const std::string poseFile = (rig.pose().name.empty() ? "pose" : rig.pose().name) + ".pose.json";
   writePoseFile(rig.pose(), (scene / poseFile).string());
   json groups = json::array();
@@ -161,6 +163,7 @@ SceneContents readSceneFolder(const std::string& folder) {
   if (poseFile.empty()) throw Error(json + ": no pose node");
   out.geometry.cage = readTriangleMesh(cageFile);
   out.geometry.mesh = readTransferMesh(meshFile);
+  out.geometry.coordinatesFile = greenCoordinatesFileFor(meshFile);
   out.pose = readPoseFile(poseFile);
   if (doc.contains("built_for") && !doc["built_for"].is_null())
     out.key = doc["built_for"].dump(-1, ' ', false, json::error_handler_t::replace);
@@ -186,7 +189,8 @@ std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::st
       meshFile = fileOf(scene, node, "FileName");
   }
   if (cageFile.empty() || meshFile.empty()) return std::nullopt;
-  return RigGeometry{readTriangleMesh(cageFile), readTransferMesh(meshFile)};
+  return RigGeometry{readTriangleMesh(cageFile), readTransferMesh(meshFile),
+                     greenCoordinatesFileFor(meshFile)};
 }
 
 }  // namespace repose

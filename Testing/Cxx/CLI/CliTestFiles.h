@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace repose::test {
@@ -24,6 +25,12 @@ inline nlohmann::json readJsonFile(const std::string& path) {
 
 // `repose phantom`, `cage` and `mesh` into `dir`: G.nii.gz, S.nii.gz, skeleton.json, then
 // `cage` and `mesh` (paths) from S with the default settings.
+// A file's bytes ("" when it cannot be read).
+inline std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 inline void makePhantomRig(const std::string& dir, double voxelMm, const std::string& cage,
                            const std::string& mesh) {
   const std::string parts = dir + "/S.nii.gz";

@@ -36,6 +36,8 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   for (const char* f : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd"})
     EXPECT_TRUE(std::filesystem::exists(dir.file(std::string("a/") + f))) << f;
   EXPECT_FALSE(report["scene_reused"].get<bool>());
+  EXPECT_FALSE(report["green_coordinates"]["read"].get<bool>());
+  EXPECT_TRUE(std::filesystem::exists(dir.file("scene/tm.green")));
   EXPECT_EQ(report["labels_lost"], 0);
   EXPECT_EQ(report["joint_rings"], 0);
   // The forearm bones follow the forearm.
@@ -59,12 +61,48 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
       runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) +
                                " --joint-rings 0 --out " + shellQuote(dir.file("b")) + " --json");
   ASSERT_EQ(second.exitCode, 0) << second.err;
-  EXPECT_TRUE(nlohmann::json::parse(second.out)["scene_reused"].get<bool>());
+  const nlohmann::json secondReport = nlohmann::json::parse(second.out);
+  EXPECT_TRUE(secondReport["scene_reused"].get<bool>());
+  // The Green coordinates were read from the scene, not computed.
+  EXPECT_TRUE(secondReport["green_coordinates"]["read"].get<bool>())
+      << secondReport["green_coordinates"];
   const Volume a = readVolume(dir.file("a/posed_G.nii.gz")),
                b = readVolume(dir.file("b/posed_G.nii.gz"));
   ASSERT_EQ(a.dims(), b.dims());
   EXPECT_EQ(
       0, std::memcmp(a.data<std::uint8_t>(), b.data<std::uint8_t>(), std::size_t(a.numVoxels())));
+  // A scene whose coordinates are gone (written by an older version) or belong to another mesh:
+  // computed again, the same map, and saved for the next run.
+  for (const bool stale : {false, true}) {
+    SCOPED_TRACE(stale ? "stale" : "missing");
+    if (stale) {
+      std::ofstream(dir.file("scene/tm.green"), std::ios::binary | std::ios::in | std::ios::out)
+          .seekp(20)
+          .put('\x5a');  // inside the key
+    } else {
+      std::filesystem::remove(dir.file("scene/tm.green"));
+    }
+    const std::string out = stale ? "green_stale" : "green_missing";
+    const CommandResult again =
+        runCommand("repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) +
+                                 " --joint-rings 0 --out " + shellQuote(dir.file(out)) + " --json");
+    ASSERT_EQ(again.exitCode, 0) << again.err;
+    const nlohmann::json g = nlohmann::json::parse(again.out)["green_coordinates"];
+    EXPECT_FALSE(g["read"].get<bool>());
+    EXPECT_NE(
+        g["note"].get<std::string>().find(stale ? "another transfer mesh or cage" : "no such file"),
+        std::string::npos)
+        << g;
+    const Volume c = readVolume(dir.file(out + "/posed_G.nii.gz"));
+    ASSERT_EQ(a.dims(), c.dims());
+    EXPECT_EQ(
+        0, std::memcmp(a.data<std::uint8_t>(), c.data<std::uint8_t>(), std::size_t(a.numVoxels())));
+    const CommandResult next = runCommand(
+        "repose", common + " --pose " + shellQuote(suitePoseFile("elbow90")) +
+                      " --joint-rings 0 --out " + shellQuote(dir.file(out + "2")) + " --json");
+    ASSERT_EQ(next.exitCode, 0) << next.err;
+    EXPECT_TRUE(nlohmann::json::parse(next.out)["green_coordinates"]["read"].get<bool>());
+  }
 
   // An image posed alongside: on the posed grid, its values those of the image at rest
   // (a ramp along x, so a wrong mapping shows), background outside the body.

@@ -28,6 +28,16 @@ struct Prepared {
     cage = dir.file("cage.obj"), mesh = dir.file("tm.vtu");
     makePhantomRig(dir.path().string(), voxelMm, cage, mesh);
   }
+  // The cage with the left elbow flexed by `degrees`, written beside the mesh; its path.
+  std::string elbowFlexed(double voxelMm, double degrees) const {
+    PhantomOptions po;
+    po.voxelMm = voxelMm;
+    TriangleMesh posed = readTriangleMesh(cage);
+    posed.vertices = phantomElbowFlexion(Phantom(po), posed, degrees);
+    const std::string path = dir.file("posed.obj");
+    writeTriangleMesh(posed, path);
+    return path;
+  }
   std::string common(const std::string& posed) const {
     return "warp --input " + shellQuote(organs) + " --mesh " + shellQuote(mesh) + " --cage " +
            shellQuote(cage) + " --posed-cage " + shellQuote(posed);
@@ -107,12 +117,7 @@ TEST(WarpCommand, RefusesBadRequestsWithOneLineAndNoOutput) {
 // under the budget (measured by /usr/bin/time), and the JSON says which path ran.
 TEST(WarpCommand, OutOfCoreStaysUnderTheBudgetAndEqualsInCore) {
   Prepared p(2);
-  PhantomOptions po;
-  po.voxelMm = 2;
-  TriangleMesh cage = readTriangleMesh(p.cage);
-  cage.vertices = phantomElbowFlexion(Phantom(po), cage, 60);
-  const std::string posed = p.dir.file("posed.obj");
-  writeTriangleMesh(cage, posed);
+  const std::string posed = p.elbowFlexed(2, 60);
   const std::string inCoreOut = p.dir.file("in.nii.gz"), outOfCoreOut = p.dir.file("out.nii.gz");
   const CommandResult inCore = runCommand(
       "repose", p.common(posed) + " --out " + shellQuote(inCoreOut) + " --memory 4G --json", true);
@@ -141,4 +146,48 @@ TEST(WarpCommand, OutOfCoreStaysUnderTheBudgetAndEqualsInCore) {
   }
   EXPECT_EQ(readVolume(inCoreOut).bytes(), readVolume(outOfCoreOut).bytes());
   EXPECT_EQ(j["labels"], nlohmann::json::parse(inCore.out)["labels"]);
+}
+
+// `repose mesh` writes the Green coordinates beside the mesh (tm.vtu -> tm.green) and `repose warp`
+// reads them: the same posed map, byte for byte, as when they are computed; coordinates of
+// another mesh are not used, with a note on stderr, and give the same map too.
+TEST(WarpCommand, ReadsTheMeshsSavedGreenCoordinatesAndRecomputesStaleOnes) {
+  Prepared p;
+  const std::string coordinates = p.dir.file("tm.green");
+  ASSERT_TRUE(std::filesystem::exists(coordinates));
+  const std::string posed = p.elbowFlexed(4, 60);
+  const auto warp = [&](const std::string& out, const std::string& extra) {
+    const CommandResult r = runCommand(
+        "repose", p.common(posed) + " --out " + shellQuote(p.dir.file(out)) + extra + " --json");
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    return r;
+  };
+  const CommandResult read = warp("read.nii.gz", "");
+  const auto readJson = nlohmann::json::parse(read.out);
+  EXPECT_TRUE(readJson["green_coordinates"]["read"].get<bool>()) << readJson["green_coordinates"];
+  const CommandResult computed =
+      warp("computed.nii.gz", " --coordinates " + shellQuote(p.dir.file("none.green")));
+  const auto computedJson = nlohmann::json::parse(computed.out);
+  EXPECT_FALSE(computedJson["green_coordinates"]["read"].get<bool>());
+  EXPECT_EQ(computed.err.find("note:"), std::string::npos) << "no file is not worth a note";
+  EXPECT_EQ(fileBytes(p.dir.file("read.nii.gz")), fileBytes(p.dir.file("computed.nii.gz")));
+  EXPECT_LT(readJson["deformation_seconds"].get<double>(),
+            computedJson["deformation_seconds"].get<double>());
+
+  // Coordinates of another mesh (a finer one, meshed from the same S and cage) beside this one.
+  ASSERT_EQ(
+      runCommand("repose", "mesh --parts " + shellQuote(p.parts) + " --cage " + shellQuote(p.cage) +
+                               " --size-mm 30 --out " + shellQuote(p.dir.file("other.vtu")))
+          .exitCode,
+      0);
+  std::filesystem::copy_file(p.dir.file("other.green"), coordinates,
+                             std::filesystem::copy_options::overwrite_existing);
+  const CommandResult stale = warp("stale.nii.gz", "");
+  const auto staleJson = nlohmann::json::parse(stale.out);
+  EXPECT_FALSE(staleJson["green_coordinates"]["read"].get<bool>());
+  EXPECT_NE(stale.err.find("note: Green coordinates computed again: " + coordinates +
+                           ": written for another transfer mesh or cage"),
+            std::string::npos)
+      << stale.err;
+  EXPECT_EQ(fileBytes(p.dir.file("read.nii.gz")), fileBytes(p.dir.file("stale.nii.gz")));
 }

@@ -159,6 +159,17 @@ TEST(PoseRig, EveryPieceMovesExactlyWithOneGroupInEveryFrame) {
   }
   for (std::size_t f = 0; f < rig.frameCount(); f += 3) {
     const PoseRig::Frame frame = rig.frame(f);
+    ASSERT_EQ(frame.tetMaps.size(), std::size_t(rig.mesh().tets.rows()));
+    // The live view's frame (no tet maps: the solver computes only the maps it reads) puts every
+    // vertex where the full frame does, bit for bit, in both precisions.
+    for (const GreenPrecision precision : {GreenPrecision::Exact, GreenPrecision::Preview}) {
+      const PoseRig::Frame live = rig.frame(f, precision, FrameMaps::Without);
+      EXPECT_TRUE(live.tetMaps.empty());
+      const Eigen::MatrixX3d full =
+          precision == GreenPrecision::Exact ? frame.deformed : rig.frame(f, precision).deformed;
+      ASSERT_EQ((live.deformed - full).cwiseAbs().maxCoeff(), 0.0) << "frame " << f;
+      ASSERT_EQ(live.cage, frame.cage);
+    }
     std::map<int, std::set<int>> groupsOfLabel;
     const std::vector<char>& inCage = rig.deformation().embedding().inside;
     std::int64_t pieces = 0, checked = 0;

@@ -17,14 +17,6 @@ using namespace repose::test;
 
 namespace {
 
-// A 300 mm limb along x; the cage covers x in [-15, 215]: the last 85 mm stick out.
-TransferMesh limb() {
-  return tetBox({0, -20, -20}, {300, 20, 20}, {30, 4, 4});
-}
-TriangleMesh limbCage() {
-  return boxMesh({-15, -35, -35}, {215, 35, 35}, 4);
-}
-
 double meshSize(const TransferMesh& m) {
   return (m.vertices.colwise().maxCoeff() - m.vertices.colwise().minCoeff()).norm();
 }
@@ -32,8 +24,8 @@ double meshSize(const TransferMesh& m) {
 }  // namespace
 
 TEST(RigiditySolver, IdentityCageLeavesEveryVertexInPlace) {
-  const TransferMesh mesh = limb();
-  const TriangleMesh cage = limbCage();
+  const TransferMesh mesh = cagedLimb();
+  const TriangleMesh cage = cagedLimbCage();
   const CageDeformation d(mesh, cage);
   EXPECT_GT(d.embedding().outliers(), 0);
   const Eigen::MatrixX3d out = d.deform(cage.vertices);
@@ -41,8 +33,8 @@ TEST(RigiditySolver, IdentityCageLeavesEveryVertexInPlace) {
 }
 
 TEST(RigiditySolver, RigidCageMotionMovesOutsideVerticesRigidly) {
-  const TransferMesh mesh = limb();
-  const TriangleMesh cage = limbCage();
+  const TransferMesh mesh = cagedLimb();
+  const TriangleMesh cage = cagedLimbCage();
   const CageDeformation d(mesh, cage);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.9, Eigen::Vector3d(0.3, -1, 2).normalized()).toRotationMatrix();
@@ -56,8 +48,8 @@ TEST(RigiditySolver, RigidCageMotionMovesOutsideVerticesRigidly) {
 }
 
 TEST(RigiditySolver, BentLimbTipOutsideTheCageFollowsAndKeepsItsShape) {
-  const TransferMesh mesh = limb();
-  const TriangleMesh cage = limbCage();
+  const TransferMesh mesh = cagedLimb();
+  const TriangleMesh cage = cagedLimbCage();
   const CageDeformation d(mesh, cage);
   // Bend: cage vertices beyond x = 120 turn 40 degrees about z around (120, 0, 0).
   const Eigen::Matrix3d R =
@@ -95,8 +87,8 @@ TEST(RigiditySolver, BentLimbTipOutsideTheCageFollowsAndKeepsItsShape) {
 }
 
 TEST(RigiditySolver, PreviewFramesStayWithinAThousandthOfTheCageDisplacement) {
-  const TransferMesh mesh = limb();
-  const TriangleMesh cage = limbCage();
+  const TransferMesh mesh = cagedLimb();
+  const TriangleMesh cage = cagedLimbCage();
   const CageDeformation d(mesh, cage);
   // Undeformed: both precisions give the exact rest image.
   EXPECT_EQ(d.deform(cage.vertices, nullptr, GreenPrecision::Preview),
@@ -121,34 +113,34 @@ TEST(RigiditySolver, PreviewFramesStayWithinAThousandthOfTheCageDisplacement) {
 
 TEST(RigiditySolver, PartsTheCageCannotReachStayAtRest) {
   // A separate block far from the cage: no vertex inside, no edge to one.
-  const TransferMesh mesh = concatenate(limb(), tetBox({500, 0, 0}, {540, 40, 40}, {2, 2, 2}, 2));
-  const TriangleMesh cage = limbCage();
+  const TransferMesh mesh = concatenate(cagedLimb(), tetBox({500, 0, 0}, {540, 40, 40}, {2, 2, 2}, 2));
+  const TriangleMesh cage = cagedLimbCage();
   const CageDeformation d(mesh, cage);
   EXPECT_EQ(d.solver().unconstrainedVertices(), 27);
   const Eigen::MatrixX3d moved = cage.vertices.rowwise() + Eigen::RowVector3d(0, 0, 50);
   const Eigen::MatrixX3d out = d.deform(moved);
   ASSERT_TRUE(out.allFinite());
-  for (Eigen::Index v = limb().vertices.rows(); v < mesh.vertices.rows(); ++v)
+  for (Eigen::Index v = cagedLimb().vertices.rows(); v < mesh.vertices.rows(); ++v)
     EXPECT_LT((out.row(v) - mesh.vertices.row(v)).norm(), 1e-9);
   EXPECT_NEAR(out(0, 2) - mesh.vertices(0, 2), 50, 1e-6);  // the limb moved with the cage
 }
 
 TEST(RigiditySolver, RefusesACageAroundNothingAndBadTargets) {
-  const TransferMesh mesh = limb();
+  const TransferMesh mesh = cagedLimb();
   EXPECT_THROW(CageDeformation(mesh, boxMesh({1000, 1000, 1000}, {1100, 1100, 1100}, 1)), Error);
-  const CageDeformation d(mesh, limbCage());
+  const CageDeformation d(mesh, cagedLimbCage());
   EXPECT_THROW(d.deform(Eigen::MatrixX3d::Zero(3, 3)), Error);
-  Eigen::MatrixX3d nan = limbCage().vertices;
+  Eigen::MatrixX3d nan = cagedLimbCage().vertices;
   nan(0, 0) = std::nan("");
   EXPECT_THROW(d.deform(nan), Error);
 }
 
 TEST(RigiditySolver, RefusesAFlatTetNamingIt) {
-  TransferMesh mesh = limb();
+  TransferMesh mesh = cagedLimb();
   const Eigen::Index t = 5;
   mesh.vertices.row(mesh.tets(t, 3)) = mesh.vertices.row(mesh.tets(t, 0));  // collapse one tet
   try {
-    const CageDeformation d(mesh, limbCage());
+    const CageDeformation d(mesh, cagedLimbCage());
     FAIL() << "a flat tet was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("degenerate or inverted"), std::string::npos) << e.what();

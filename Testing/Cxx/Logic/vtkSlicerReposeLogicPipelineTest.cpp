@@ -233,6 +233,27 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
   for (const char* key : {"labels", "body", "distortion", "tet_volume_change", "mesh",
                           "rigid_tissues", "holes", "quality"})
     EXPECT_EQ(a[key], b[key]) << key;
+  // The Logic read the Green coordinates the command line saved in the scene (tm.green), and
+  // saving the scene elsewhere takes them along.
+  EXPECT_TRUE(b["green_coordinates"]["read"].get<bool>()) << b["green_coordinates"];
+  const std::string saved = files.dir.file("saved");
+  ASSERT_TRUE(logic->SaveScene(saved)) << logic->GetLastErrorMessage();
+  auto* mesh = vtkMRMLReposeTransferMeshNode::SafeDownCast(
+      logic->GetScene()->GetNodesByClass("vtkMRMLReposeTransferMeshNode").at(0));
+  EXPECT_EQ(mesh->GetCoordinatesFile(),
+            saved + "/" + std::filesystem::path(mesh->GetFileName()).stem().string() + ".green");
+  EXPECT_TRUE(std::filesystem::exists(mesh->GetCoordinatesFile()));
+  vtkNew<vtkSlicerReposeLogic> reloaded;
+  ASSERT_TRUE(reloaded->LoadScene(saved)) << reloaded->GetLastErrorMessage();
+  const std::string reloadedOut = files.dir.file("reloaded");
+  ASSERT_TRUE(reloaded->StartApplyPose(
+      vtkMRMLReposePoseNode::SafeDownCast(
+          reloaded->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode").at(0)),
+      reloadedOut));
+  ASSERT_EQ(reloaded->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << reloaded->GetLastErrorMessage();
+  std::ifstream reloadedReport(reloadedOut + "/report.json");
+  EXPECT_TRUE(nlohmann::json::parse(reloadedReport)["green_coordinates"]["read"].get<bool>());
 }
 
 // Output > Memory budget: an export whose posed volumes would not fit is refused before any work,

@@ -60,6 +60,19 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
                                        const std::vector<RigidHandle>& handles, int threads = 0,
                                        int jointRings = 0);
 
+// blendMotions for the rows of a HandleInfluence's membership, with the motion of each group
+// taken alone computed once: most vertices belong to one group wholly, and their motion is then
+// that group's blendMotions (the same value, bit for bit) without a blend per vertex.
+class GroupMotions {
+ public:
+  explicit GroupMotions(const std::vector<RigidHandle>& handles);
+  Eigen::Isometry3d of(const Eigen::Ref<const Eigen::RowVectorXd>& membership) const;
+
+ private:
+  const std::vector<RigidHandle>& handles_;
+  std::vector<Eigen::Isometry3d> alone_;  // blendMotions of e_g
+};
+
 // Blend weight of a total membership: 0 below kNone, 1 above kFull, C1-smooth in between.
 double handleBlendWeight(double membership);
 

@@ -7,7 +7,9 @@
 #include "repose/mesh/RigidHandles.h"
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace repose {
@@ -52,9 +54,14 @@ enum class GreenPrecision { Exact, Preview };
 // bound, so it is kept once, compactly (CompactGreenMatrix: two half-float arrays), and applied
 // to the cage's displacement from rest on all cores; the double coordinates are computed in
 // blocks of rows and never held for the whole mesh.
+//
+// The coordinates can be kept between runs (saveCoordinates; docs/FORMATS.md, "Green-coordinate
+// files"): constructed with such a file, V_c and the coefficients are read from it when it was
+// written for this very mesh and cage, and computed otherwise, with coordinatesNote() saying why.
 class CageDeformation {
  public:
-  CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0);
+  CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0,
+                  const std::string& coordinatesFile = "");
   ~CageDeformation();
   CageDeformation(CageDeformation&&) noexcept;
   CageDeformation& operator=(CageDeformation&&) noexcept;
@@ -66,6 +73,12 @@ class CageDeformation {
   // They are left out of V_c, to the rigidity solver like the vertices outside the cage.
   int unreproducedVertices() const { return unreproduced_; }
   std::size_t coefficientBytes() const;
+  // Writes V_c and the coefficients to `path` (atomically), for this mesh and cage only.
+  void saveCoordinates(const std::string& path) const;
+  // True when the constructor read the coordinates from its file.
+  bool coordinatesRead() const { return coordinatesRead_; }
+  // Why a file given to the constructor was not used ("" when it was, or none was given).
+  const std::string& coordinatesNote() const { return coordinatesNote_; }
   // Positions of V_c (rows follow embedding().cageVertices) for a deformed cage.
   Eigen::MatrixX3d greenPositions(const Eigen::MatrixX3d& deformedCage,
                                   GreenPrecision precision = GreenPrecision::Exact) const;
@@ -83,6 +96,8 @@ class CageDeformation {
                           GreenPrecision precision = GreenPrecision::Exact) const;
 
  private:
+  // embedInCage without coordinates, then V_c's coordinates block by block.
+  void computeCoordinates(const TransferMesh& mesh, int threads);
   // Throws repose::Error for a wrong vertex count, a non-finite vertex, or a vertex more than
   // 1000 cage sizes from the rest cage (a handle moved too far).
   void checkPosedCage(const Eigen::MatrixX3d& deformedCage) const;
@@ -95,6 +110,14 @@ class CageDeformation {
   Eigen::MatrixX3d restVertices_;    // the TM's own rest positions of V_c (rigid motions act on)
   int threads_ = 0;
   int unreproduced_ = 0;
+  std::uint64_t key_ = 0;  // of the mesh and cage (greenCoordinatesKey)
+  Eigen::Index meshVertices_ = 0;
+  bool coordinatesRead_ = false;
+  std::string coordinatesNote_;
 };
+
+// Where a transfer mesh's Green coordinates are kept: beside it, its name ending in .green
+// instead of .vtu (a scene's tm.vtu -> tm.green).
+std::string greenCoordinatesFileFor(const std::string& meshPath);
 
 }  // namespace repose

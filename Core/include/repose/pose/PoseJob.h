@@ -112,8 +112,10 @@ class PoseJob {
   // spacing, image, progress and warnings.
   PoseFrameOptions frameOptions() const;
   // report.json completed with what the job knows: the input, whether the rig came from a scene,
-  // the joint rings, the separations and the skeleton.
-  std::string completeReport(const std::string& reportJson, bool sceneReused) const;
+  // the joint rings, the separations, the skeleton, and whether the rig's Green coordinates were
+  // read from a file (CageDeformation::coordinatesRead) or computed, and why.
+  std::string completeReport(const std::string& reportJson, bool sceneReused,
+                             const PoseRig& rig) const;
 
  private:
   const Volume* organs_;

@@ -66,6 +66,9 @@ std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
 struct RigGeometry {
   TriangleMesh cage;
   TransferMesh mesh;
+  // The Green coordinates saved with them (a scene's tm.green; CageDeformation); "" when none.
+  // Used only if written for this very cage and mesh, else computed again.
+  std::string coordinatesFile;
 };
 
 // settings.bonePieces for a tissue table: each bone's rigid labels -> the bone's smallest label.
@@ -100,6 +103,10 @@ TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
                            const ProgressFn& progress = {}, const Volume* organs = nullptr,
                            std::vector<RefinementStep>* steps = nullptr);
 
+// Whether a frame computes every tet's linear map B_t (exports and reports need them; the live
+// view shows positions only, and skipping them spares most of a frame's time at 200K tets).
+enum class FrameMaps { With, Without };
+
 class PoseRig {
  public:
   // Embeds the mesh in the cage and resolves the pose's groups (part names through partLabels).
@@ -115,16 +122,18 @@ class PoseRig {
     std::vector<RigidHandle> handles;      // with this frame's motions
     Eigen::MatrixX3d cage;                 // posed cage vertices
     Eigen::MatrixX3d deformed;             // posed TM vertices
-    std::vector<Eigen::Matrix3d> tetMaps;  // B_t of every tet
+    std::vector<Eigen::Matrix3d> tetMaps;  // B_t of every tet (empty with FrameMaps::Without)
   };
   std::size_t frameCount() const { return frames_.size(); }
   const std::string& frameName(std::size_t index) const { return frames_.at(index).first; }
-  Frame frame(std::size_t index, GreenPrecision precision = GreenPrecision::Exact) const;
+  Frame frame(std::size_t index, GreenPrecision precision = GreenPrecision::Exact,
+              FrameMaps tetMaps = FrameMaps::With) const;
   // A frame of an edited copy of the pose (the same groups, other transforms or keyframes): what
   // an interactive edit re-solves. Throws repose::Error when the groups differ or the index is out
   // of range.
   Frame frame(const Pose& edited, std::size_t index,
-              GreenPrecision precision = GreenPrecision::Exact) const;
+              GreenPrecision precision = GreenPrecision::Exact,
+              FrameMaps tetMaps = FrameMaps::With) const;
 
   const TriangleMesh& cage() const { return geometry_.cage; }
   const TransferMesh& mesh() const { return geometry_.mesh; }
@@ -135,7 +144,7 @@ class PoseRig {
 
  private:
   Frame solveFrame(const std::string& name, const std::vector<Eigen::Isometry3d>& motions,
-                   GreenPrecision precision) const;
+                   GreenPrecision precision, FrameMaps tetMaps) const;
   RigGeometry geometry_;
   Pose pose_;
   std::unique_ptr<CageDeformation> deformation_;
