@@ -21,41 +21,67 @@ double sign(double x) {
   return x > 0 ? 1.0 : (x < 0 ? -1.0 : 0.0);
 }
 
-// Cosine of the angle between a and b (1 when either is zero, i.e. the angle is taken as 0).
-double cosAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const double d = a.norm() * b.norm();
-  return d > 0 ? std::clamp(a.dot(b) / d, -1.0, 1.0) : 1.0;
+// Integral over the triangle (p, v1, v2) of the Green function gradient term, eta at origin
+// (Lipman et al.'s GCTriInt), for its two angles theta = pi - alpha (alpha at v1) and
+// pi - alpha - beta (beta at p), which is the angle at v2. S = sin(theta), C = cos(theta),
+// oneMinusC = 1 - C; lambda: the squared distance from p to the edge's line; c = |p|^2.
+double gcTriIntTerm(double S, double C, double oneMinusC, double lambda, double c) {
+  const double sqrtC = std::sqrt(c), sqrtL = std::sqrt(lambda);
+  const double denom = oneMinusC * oneMinusC;
+  double logTerm = 0;
+  // lambda -> 0 (eta on the edge's line) makes sqrt(lambda)*log(...) -> 0.
+  if (sqrtL > 1e-12 && denom > 1e-300) {
+    // The paper's 1 - 2cC / (c(1 + C) + lambda + R), R = sqrt(lambda^2 + lambda c S^2), written
+    // as one quotient: for a small angle the subtraction would leave no significant digit.
+    const double R = std::sqrt(lambda * lambda + lambda * c * S * S);
+    const double arg =
+        2 * sqrtL * S * S / denom * (c * oneMinusC + lambda + R) / (c * (1 + C) + lambda + R);
+    if (arg > 0) logTerm = sqrtL * std::log(arg);
+  }
+  const double atanTerm =
+      sqrtC > 0 ? 2 * sqrtC * std::atan(sqrtC * C / std::sqrt(lambda + S * S * c)) : 0;
+  return -sign(S) / 2 * (atanTerm + logTerm);
 }
 
-// Integral over the triangle (p, v1, v2) of the Green function gradient term, eta at origin.
-// The sines and cosines of theta = pi - alpha and pi - alpha - beta come from dot products and
-// the angle-sum identities: only beta itself needs an inverse trigonometric call.
+// Above this |cos| an angle's sine taken as sqrt(1 - cos^2), or 1 - cos by subtraction, keeps too
+// few digits (at 1e-7 mm from an edge's line only about 8, which the log and atan terms
+// amplify): the angles are then taken from unit vectors instead.
+constexpr double kNearlyFlat = 1 - 1e-6;
+
 double gcTriInt(const Eigen::Vector3d& p, const Eigen::Vector3d& v1, const Eigen::Vector3d& v2) {
-  const double cosA = cosAngle(v2 - v1, p - v1), sinA = std::sqrt(std::max(0.0, 1 - cosA * cosA));
-  const double cosB = cosAngle(v1 - p, v2 - p), sinB = std::sqrt(std::max(0.0, 1 - cosB * cosB));
-  const double beta = std::atan2(sinB, cosB);
-  const double lambda = (p - v1).squaredNorm() * sinA * sinA;
+  const Eigen::Vector3d d = v2 - v1, r = p - v1, a = v1 - p, b = v2 - p;
+  const double nd = d.norm(), nr = r.norm(), nb = b.norm();
   const double c = p.squaredNorm();
-  const double sqrtC = std::sqrt(c), sqrtL = std::sqrt(lambda);
-  auto integral = [&](double S, double C) {
-    const double denom = (1 - C) * (1 - C);
-    double logTerm = 0;
-    // lambda -> 0 (eta on the edge's line) makes sqrt(lambda)*log(...) -> 0.
-    if (sqrtL > 1e-12 && denom > 1e-300) {
-      const double arg =
-          2 * sqrtL * S * S / denom *
-          (1 -
-           2 * c * C / (c * (1 + C) + lambda + std::sqrt(lambda * lambda + lambda * c * S * S)));
-      if (arg > 0) logTerm = sqrtL * std::log(arg);
+  if (nd > 0 && nr > 0 && nb > 0) {
+    // Most sub-triangles: the angle-sum identities, one inverse trigonometric call (beta).
+    const double cosA = std::clamp(d.dot(r) / (nd * nr), -1.0, 1.0);
+    const double cosB = std::clamp(a.dot(b) / (nr * nb), -1.0, 1.0);
+    const double sinA = std::sqrt(std::max(0.0, 1 - cosA * cosA));
+    const double sinB = std::sqrt(std::max(0.0, 1 - cosB * cosB));
+    const double C2 = -(cosA * cosB - sinA * sinB);
+    if (std::fabs(cosA) < kNearlyFlat && std::fabs(cosB) < kNearlyFlat &&
+        std::fabs(C2) < kNearlyFlat) {
+      const double lambda = r.squaredNorm() * sinA * sinA;
+      const double I1 = gcTriIntTerm(sinA, -cosA, 1 + cosA, lambda, c);
+      const double I2 = gcTriIntTerm(sinA * cosB + cosA * sinB, C2, 1 - C2, lambda, c);
+      return -1 / (4 * kPi) * std::fabs(I1 - I2 - std::sqrt(c) * std::atan2(sinB, cosB));
     }
-    const double atanTerm =
-        sqrtC > 0 ? 2 * sqrtC * std::atan(sqrtC * C / std::sqrt(lambda + S * S * c)) : 0;
-    return -sign(S) / 2 * (atanTerm + logTerm);
+  }
+  // A nearly flat sub-triangle (p close to the edge's line): every sine, cosine and 1 - cos from
+  // the unit vectors of its angle (|u x w|, u . w, |u -+ w|^2 / 2), beta from atan2.
+  const auto unit = [](const Eigen::Vector3d& x) {
+    const double n = x.norm();
+    return n > 0 ? Eigen::Vector3d(x / n) : Eigen::Vector3d::Zero();
   };
-  // theta1 = pi - alpha; theta2 = pi - (alpha + beta).
-  const double I1 = integral(sinA, -cosA);
-  const double I2 = integral(sinA * cosB + cosA * sinB, -(cosA * cosB - sinA * sinB));
-  return -1 / (4 * kPi) * std::fabs(I1 - I2 - sqrtC * beta);
+  const Eigen::Vector3d e1 = unit(d), q1 = unit(r);    // alpha's sides, at v1
+  const Eigen::Vector3d e2 = unit(-d), q2 = unit(-b);  // the angle at v2
+  const double beta = std::atan2(a.cross(b).norm(), a.dot(b));
+  const double lambda = nd > 0 ? d.cross(r).squaredNorm() / (nd * nd) : 0.0;
+  const double I1 =
+      gcTriIntTerm(e1.cross(q1).norm(), -e1.dot(q1), (e1 + q1).squaredNorm() / 2, lambda, c);
+  const double I2 =
+      gcTriIntTerm(e2.cross(q2).norm(), e2.dot(q2), (e2 - q2).squaredNorm() / 2, lambda, c);
+  return -1 / (4 * kPi) * std::fabs(I1 - I2 - std::sqrt(c) * beta);
 }
 
 }  // namespace
@@ -120,8 +146,16 @@ GreenCoordinates computeGreenCoordinates(const TriangleMesh& cage, const Eigen::
             for (int l = 0; l < 3; ++l) {
               const Eigen::Vector3d& a = v[l];
               const Eigen::Vector3d& b = v[(l + 1) % 3];
-              s[l] = sign((a - p).cross(b - p).dot(n));
-              I[l] = gcTriInt(p, a, b);
+              // The sub-triangle (p, a, b) of eta's projection p: when p lies on the edge's
+              // line (eta right above a cage edge, or above its extension: common where the
+              // cage's triangles are long and thin) it has no area and adds nothing, but its
+              // closed form divides rounding noise by rounding noise (sin(alpha) ~ 0 in
+              // gcTriInt) and, with a sign picked from that noise, threw points tens of
+              // millimetres off. Below 1e-10 of the edge's length from the line it is skipped.
+              const double twiceArea = (a - p).cross(b - p).dot(n);
+              const bool onLine = std::fabs(twiceArea) <= 1e-10 * (b - a).squaredNorm();
+              s[l] = onLine ? 0.0 : sign(twiceArea);
+              I[l] = onLine ? 0.0 : gcTriInt(p, a, b);
               II[l] = gcTriInt(Eigen::Vector3d::Zero(), b, a);
               const Eigen::Vector3d q = b.cross(a);
               const double qn = q.norm();

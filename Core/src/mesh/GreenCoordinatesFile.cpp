@@ -17,7 +17,9 @@ namespace {
 // rest positions (double, column-major), CRC-32 of those two arrays, the compact matrix
 // (CompactGreenMatrix::writeTo), its CRC-32.
 constexpr char kMagic[8] = {'R', 'E', 'P', 'O', 'S', 'E', 'G', 'C'};
-constexpr std::uint32_t kVersion = 1;
+// 2: coordinates of the closed forms made stable above a cage edge's line (GreenCoordinates.cpp);
+// files of version 1 hold the earlier ones and are computed again.
+constexpr std::uint32_t kVersion = 2;
 constexpr std::uint32_t kByteOrder = 0x01020304;
 
 struct Header {

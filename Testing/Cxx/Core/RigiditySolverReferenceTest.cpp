@@ -3,10 +3,12 @@
 // least-squares systems (the constraints of T_c and V_c eliminated: their B and positions are
 // known) and solves them with a dense QR of the rectangular system (no normal equations). The
 // production solver (sparse, normal equations, CHOLMOD) must give the same B_t and positions to
-// 1e-9 relative on hand-made tets of unequal volumes, jittered random meshes with random inside
-// sets, and a part of the phantom's transfer mesh, for rigid, affine and random motions of V_c.
-// Eq. 1-2 are computed directly: the solution makes the eq. 3 energy stationary (no perturbation
-// of the free B_t lowers it) and ErrorMetric's e_t (eq. 5) is |ΔB_t| of eq. 1.
+// 1e-9 relative on hand-made tets of unequal volumes, jittered random meshes and random Delaunay
+// meshes (CGAL) with random inside sets, and a part of the phantom's transfer mesh, for rigid,
+// affine and random motions of V_c. Eq. 1-2 are computed directly: the solution makes the eq. 3
+// energy stationary (no perturbation of the free B_t lowers it) and ErrorMetric's e_t (eq. 5) is
+// |ΔB_t| of eq. 1.
+#include "TestDelaunay.h"
 #include "TestTetMeshes.h"
 
 #include "repose/mesh/ErrorMetric.h"
@@ -20,7 +22,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -246,6 +250,31 @@ Problem jittered(unsigned seed) {
   return p;
 }
 
+// The Delaunay tetrahedralization (CGAL) of random points in a 40 x 30 x 30 mm box, kept at least
+// 3 mm apart, its corners included so the hull is the box; V_c a random 60 % of the vertices.
+// Unlike the Kuhn boxes, vertex valences and tet shapes are irregular (slivers included), as a
+// Mesh_3 mesh's are. Nothing when the random V_c leaves a free part undriven.
+std::optional<Problem> delaunay(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> x(0, 40), y(0, 30), z(0, 30);
+  std::vector<Eigen::Vector3d> points;
+  for (int c = 0; c < 8; ++c) points.emplace_back(c & 1 ? 40 : 0, c & 2 ? 30 : 0, c & 4 ? 30 : 0);
+  for (int tries = 0; points.size() < 70 && tries < 20000; ++tries) {
+    const Eigen::Vector3d p(x(rng), y(rng), z(rng));
+    bool apart = true;
+    for (const Eigen::Vector3d& q : points) apart &= (p - q).norm() >= 3;
+    if (apart) points.push_back(p);
+  }
+  Problem p;
+  p.mesh = delaunayMesh(points);
+  for (int v = 0; v < int(p.mesh.vertices.rows()); ++v)
+    if (std::uniform_real_distribution<double>(0, 1)(rng) < 0.6) p.Vc.push_back(v);
+  p.Tc = insideTets(p.mesh, p.Vc);
+  if (p.Tc.empty() || RigiditySolver(p.mesh, p.Vc, p.Tc).unconstrainedVertices() > 0)
+    return std::nullopt;
+  return p;
+}
+
 // The 4 mm phantom's transfer mesh around the left elbow: the largest face-connected piece of
 // the tets whose centroids lie in a box about the elbow, reindexed; V_c is its upper half (the
 // cage covers the upper arm, the forearm is recovered by the solver).
@@ -403,6 +432,22 @@ TEST(RigiditySolverReference, HandMadeTetsOfUnequalVolumes) {
 TEST(RigiditySolverReference, JitteredMeshesWithRandomInsideSets) {
   for (unsigned seed : {1u, 2u, 3u})
     checkAgainstReference(jittered(seed), "jittered " + std::to_string(seed));
+}
+
+TEST(RigiditySolverReference, RandomDelaunayMeshesWithRandomInsideSets) {
+  int tested = 0;
+  for (unsigned seed = 1; seed <= 40 && tested < 4; ++seed) {  // the first four usable seeds
+    const std::optional<Problem> p = delaunay(seed);
+    if (!p) continue;
+    ++tested;
+    double lo = 1e300, hi = 0;
+    for (int t = 0; t < int(p->mesh.tets.rows()); ++t)
+      lo = std::min(lo, volumeOf(p->mesh, t)), hi = std::max(hi, volumeOf(p->mesh, t));
+    EXPECT_GT(hi / lo, 100) << "seed " << seed << ": tets of very unequal volumes";
+    checkAgainstReference(*p, "Delaunay " + std::to_string(seed) + " (" +
+                                  std::to_string(p->mesh.tets.rows()) + " tets)");
+  }
+  EXPECT_EQ(tested, 4) << "too few of 40 seeds gave an inside set that drives every part";
 }
 
 TEST(RigiditySolverReference, ThePhantomsTransferMeshAroundTheElbow) {
