@@ -119,15 +119,14 @@ std::string warpCoordinatesFile(const ArgParser& p) {
   return p.has("coordinates") ? p.get("coordinates") : greenCoordinatesFileFor(p.get("mesh"));
 }
 
-void noteWarpCoordinates(const CageDeformation& deformation, WarpSummary& summary) {
+void noteWarpCoordinates(const CageDeformation& deformation, const std::string& coordinatesFile,
+                         WarpSummary& summary) {
   summary.coordinatesRead = deformation.coordinatesRead();
   summary.coordinatesNote = deformation.coordinatesNote();
-  const std::string& note = summary.coordinatesNote;
-  const std::string absent = ": no such file";
-  const bool missing = note.size() >= absent.size() &&
-                       note.compare(note.size() - absent.size(), absent.size(), absent) == 0;
-  if (!summary.coordinatesRead && !note.empty() && !missing)
-    std::cerr << "repose warp: note: Green coordinates computed again: " << note << "\n";
+  std::error_code ec;
+  if (!summary.coordinatesRead && std::filesystem::exists(coordinatesFile, ec))
+    std::cerr << "repose warp: note: Green coordinates computed again: " << summary.coordinatesNote
+              << "\n";
 }
 
 int runWarp(const Args& args) {
@@ -222,7 +221,8 @@ int runWarp(const Args& args) {
                 " (vertices or faces differ)");
   const int threads = static_cast<int>(p.getInt("threads"));
   const auto deformStart = std::chrono::steady_clock::now();
-  const CageDeformation deformation(mesh, cage, threads, warpCoordinatesFile(p));
+  const std::string coordinatesFile = warpCoordinatesFile(p);
+  const CageDeformation deformation(mesh, cage, threads, coordinatesFile);
   const Eigen::MatrixX3d deformed = deformation.deform(posed.vertices);
   const double deformationSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
@@ -309,7 +309,7 @@ int runWarp(const Args& args) {
   summary.inCoreNeed = inCoreNeed;
   summary.report = report;
   summary.unreachable = deformation.solver().unconstrainedVertices();
-  noteWarpCoordinates(deformation, summary);
+  noteWarpCoordinates(deformation, coordinatesFile, summary);
   summary.deformationSeconds = deformationSeconds;
   summary.volumes = volumes;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

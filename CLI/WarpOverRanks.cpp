@@ -83,11 +83,12 @@ int runWarpOverRanks(const ArgParser& p) {
       throw Error(p.get("posed-cage") + ": not a pose of " + p.get("cage") +
                   " (vertices or faces differ)");
     const auto deformStart = std::chrono::steady_clock::now();
+    const std::string coordinatesFile = warpCoordinatesFile(p);
     const CageDeformation deformation(mesh, cage, static_cast<int>(p.getInt("threads")),
-                                      warpCoordinatesFile(p));
+                                      coordinatesFile);
     deformed = deformation.deform(posed.vertices);
     unreachable = deformation.solver().unconstrainedVertices();
-    noteWarpCoordinates(deformation, summary);
+    noteWarpCoordinates(deformation, coordinatesFile, summary);
     summary.deformationSeconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();
   });

@@ -42,7 +42,8 @@ struct WarpSummary {
 std::string warpCoordinatesFile(const ArgParser& p);
 // The deformation's coordinate source into the summary; a file that was there but not used (for
 // another mesh or cage, damaged) is said on stderr.
-void noteWarpCoordinates(const CageDeformation& deformation, WarpSummary& summary);
+void noteWarpCoordinates(const CageDeformation& deformation, const std::string& coordinatesFile,
+                         WarpSummary& summary);
 
 void printWarpSummary(const WarpSummary& summary, bool json);
 

@@ -113,7 +113,8 @@ TEST(RigiditySolver, PreviewFramesStayWithinAThousandthOfTheCageDisplacement) {
 
 TEST(RigiditySolver, PartsTheCageCannotReachStayAtRest) {
   // A separate block far from the cage: no vertex inside, no edge to one.
-  const TransferMesh mesh = concatenate(cagedLimb(), tetBox({500, 0, 0}, {540, 40, 40}, {2, 2, 2}, 2));
+  const TransferMesh mesh =
+      concatenate(cagedLimb(), tetBox({500, 0, 0}, {540, 40, 40}, {2, 2, 2}, 2));
   const TriangleMesh cage = cagedLimbCage();
   const CageDeformation d(mesh, cage);
   EXPECT_EQ(d.solver().unconstrainedVertices(), 27);
