@@ -145,6 +145,11 @@ int runPose(const Args& args) {
       .flag("no-auto-separate",
             "do not cut apart the body parts that move with different groups where they touch "
             "(by default they are, except across their own joint: docs/POSES.md)")
+      .option("label-volumes", "MODE",
+              "preserve: round each soft label of G to the volume the deformation gives it "
+              "(label borders relabelled; docs/QUALITY.md); nearest: plain nearest-neighbour "
+              "sampling",
+              "preserve")
       .flag("keep-pockets",
             "keep the background pockets a bent joint traps inside the body (by default they "
             "are filled from their neighbours; docs/QUALITY.md)")
@@ -206,6 +211,8 @@ int runPose(const Args& args) {
                     : !single.transform.empty() ? single.transform
                                                 : single.image);
   const std::string outDir = scratch ? scratch->path + "/frames" : p.get("out");
+  if (p.get("label-volumes") != "preserve" && p.get("label-volumes") != "nearest")
+    throw UsageError{"--label-volumes must be preserve or nearest"};
   const std::string format = p.get("output-format");
   if (format != "auto" && format != "nii.gz" && format != "seg.nrrd" && format != "both")
     throw UsageError{"--output-format must be auto, nii.gz, seg.nrrd or both"};
@@ -288,6 +295,7 @@ int runPose(const Args& args) {
   fo.background = p.getDouble("background");
   fo.spacingMm = spacingMm;
   fo.fillPockets = !p.has("keep-pockets");
+  fo.preserveLabelVolumes = p.get("label-volumes") == "preserve";
   fo.labelMapFiles = labelMapFiles;
   json summary = json::array();
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {

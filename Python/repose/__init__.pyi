@@ -124,6 +124,7 @@ class Rig:
     def pose_frame(self, organs: Volume, parts: Volume, index: int = ..., *,
                    image: Optional[Volume] = ..., background: float = ...,
                    spacing_mm: float = ..., fill_pockets: bool = ...,
+                   label_volumes: str = ...,
                    progress: Optional[Progress] = ...) -> PosedFrame: ...
     def pose_labels_to_file(self, organs_path: str, out_path: str, index: int = ..., *,
                             memory_bytes: float = ..., spacing_mm: float = ...,

@@ -331,11 +331,15 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
           "pose_frame",
           [](const Rig& r, const Volume& organs, const Volume& parts, std::size_t index,
              const py::object& image, double background, double spacingMm, bool fillPockets,
-             const py::object& progress) {
+             const std::string& labelVolumes, const py::object& progress) {
             PoseFrameOptions o = r.job->frameOptions();
             o.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
             o.background = background;
             o.fillPockets = fillPockets;
+            if (labelVolumes != "preserve" && labelVolumes != "nearest")
+              throw Error("label_volumes must be 'preserve' or 'nearest', not '" + labelVolumes +
+                          "'");
+            o.preserveLabelVolumes = labelVolumes == "preserve";
             o.spacingMm = spacingMm;
             std::vector<std::string> warnings;
             o.warn = [&](const std::string& line) { warnings.push_back(line); };
@@ -350,10 +354,13 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
           },
           py::arg("organs"), py::arg("parts"), py::arg("index") = 0, py::kw_only(),
           py::arg("image") = py::none(), py::arg("background") = 0.0, py::arg("spacing_mm") = 0.0,
-          py::arg("fill_pockets") = true, py::arg("progress") = py::none(),
+          py::arg("fill_pockets") = true, py::arg("label_volumes") = "preserve",
+          py::arg("progress") = py::none(),
           R"doc(Poses frame `index` at full resolution in core: the posed organ and part maps (and
 image), the displacement field and the report. spacing_mm: the output voxel size (0: the
-input's), e.g. 2 mm for an FDTD grid.)doc")
+input's), e.g. 2 mm for an FDTD grid. label_volumes: "preserve" rounds each soft label to the
+volume the deformation gives it, "nearest" leaves plain nearest-neighbour sampling (as
+`repose pose --label-volumes`).)doc")
       .def(
           "pose_labels_to_file",
           [](const Rig& r, const std::string& organsPath, const std::string& outPath,

@@ -162,7 +162,7 @@ def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     rp.write_volume(g, str(tmp_path / "G.nii"))
     elbow_rig.pose_labels_to_file(str(tmp_path / "G.nii"), str(tmp_path / "posed.nii.gz"),
                                   memory_bytes=32 * 2**20)
-    in_core = elbow_rig.pose_frame(g, s, fill_pockets=False).organs.array
+    in_core = elbow_rig.pose_frame(g, s, fill_pockets=False, label_volumes="nearest").organs.array
     streamed = np.asanyarray(nib.load(tmp_path / "posed.nii.gz").dataobj)
     assert streamed.shape == in_core.shape
     differ = np.argwhere(streamed != in_core)
@@ -171,6 +171,27 @@ def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     for i, j, k in differ:
         near = in_core[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]
         assert bones & set(np.unique(near).tolist()), (i, j, k)
+
+
+def test_label_volumes_preserved_or_sampled(phantom, elbow_rig):
+    # By default each soft label is rounded to the volume the deformation gives it; "nearest"
+    # is plain sampling. The rounding only relabels voxels between soft labels: the body's
+    # outline (background) is the same either way.
+    g, s = phantom["organs"], phantom["parts"]
+    nearest = elbow_rig.pose_frame(g, s, label_volumes="nearest")
+    preserved = elbow_rig.pose_frame(g, s)
+    assert nearest.report["label_volumes"] == {"rounding": "nearest", "relabelled_voxels": 0}
+    assert preserved.report["label_volumes"]["rounding"] == "preserve"
+    relabelled = preserved.report["label_volumes"]["relabelled_voxels"]
+    a, b = nearest.organs.array, preserved.organs.array
+    assert int((a != b).sum()) == relabelled
+    assert np.array_equal(a == 0, b == 0)
+    for row in preserved.report["labels"]:
+        if row.get("rounded") and row["voxels_before"] >= 1000:
+            assert row["change_beyond_floor_percent"] == row["change_percent"]
+            assert abs(row["change_percent"] - row["deformation_change_percent"]) < 0.5, row
+    with pytest.raises(rp.Error, match="label_volumes"):
+        elbow_rig.pose_frame(g, s, label_volumes="cubic")
 
 
 def test_progress_cancellation_and_the_gil(phantom, elbow_rig):

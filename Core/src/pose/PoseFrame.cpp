@@ -194,8 +194,10 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   ro.pieceLabels = &organs;
   ro.bonePieces = &options.bonePieces;
   RasterReport raster;
+  ro.preserveLabelVolumes = options.preserveLabelVolumes;
   out.organs = rasterizeLabels(organs, mesh, frame.deformed, out.grid, ro, &raster);
   ro.progress = {};
+  ro.preserveLabelVolumes = false;  // S's parts are as sampled: they only name where G's tissue is
   out.parts = rasterizeLabels(parts, mesh, frame.deformed, out.grid, ro);
   out.field = rasterizeDisplacement(mesh, frame.deformed, organs.geometry(), out.grid, ro);
   PocketReport pockets;
@@ -228,6 +230,7 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   ri.outlierVertices = rig.deformation().embedding().outliers();
   ri.unreachableVertices = rig.deformation().solver().unconstrainedVertices();
   ri.rigidVertices = rig.influence().rigidVertices();
+  if (options.preserveLabelVolumes) ri.labelTargets = &raster.labelTargets;
   const Eigen::Vector3d spacing = out.grid.spacing();
   out.labelMapFiles = options.labelMapFiles;
   nlohmann::json outputs = outputFiles(out.labelMapFiles);
@@ -243,6 +246,9 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
       {"whole_pieces", {{"labels", pieceLabels}, {"tets", pieceTets}}},
       {"tissue_table", options.tissues ? options.tissueTableName : std::string("none")},
       {"voxels_in_shell", raster.shellVoxels},
+      {"label_volumes",
+       {{"rounding", options.preserveLabelVolumes ? "preserve" : "nearest"},
+        {"relabelled_voxels", raster.roundedVoxels}}},
       {"raster_inverted_tets", raster.invertedTets},
       {"pockets",
        {{"filled_voxels", pockets.filled},

@@ -140,14 +140,25 @@ static json makePoseReport(const PoseReportInput& in) {
                 {"volume_before_ml", before / 1000},
                 {"volume_after_ml", after / 1000},
                 {"change_percent", change}};
-    // The change beyond what resampling alone makes (docs/QUALITY.md).
+    // The change beyond what resampling alone makes (docs/QUALITY.md): the nearest-neighbour
+    // floor, reported for every label; a label rounded to its volume has none left, so its
+    // change itself is held to the target.
     double floor = 0;
+    const bool rounded = in.labelTargets && in.labelTargets->count(value);
     if (!floors.empty() && before > 0) {
       const auto it = floors.find(value);
-      floor = 100 * (double(it == floors.end() ? 0 : it->second) * outVoxelMm3 / before - 1);
-      row["resampling_floor_percent"] = floor;
-      row["change_beyond_floor_percent"] = change - floor;
+      const double nearest =
+          100 * (double(it == floors.end() ? 0 : it->second) * outVoxelMm3 / before - 1);
+      row["resampling_floor_percent"] = nearest;
+      if (!rounded) floor = nearest;
     }
+    if (rounded && before > 0) {
+      row["rounded"] = true;
+      row["deformation_change_percent"] =
+          100 * (in.labelTargets->at(value) * outVoxelMm3 / before - 1);
+    }
+    if (row.contains("resampling_floor_percent") || rounded)
+      row["change_beyond_floor_percent"] = change - floor;
     bodyBefore += before, bodyAfter += after;
     lost += c.first.voxels > 0 && c.second.voxels == 0;
     if (c.first.voxels >= 1000 && std::fabs(change - floor) > std::fabs(worstBeyond))
@@ -266,6 +277,7 @@ static json makePoseReport(const PoseReportInput& in) {
                        return std::string();
                      }()},
                     {"worst_change_percent", worstChange},
+                    // The floor taken off: 0 for a label rounded to its volume.
                     {"worst_resampling_floor_percent", worstFloor},
                     {"worst_change_beyond_floor_percent", worstBeyond},
                     {"rule",

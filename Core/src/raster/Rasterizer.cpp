@@ -1,5 +1,6 @@
 #include "repose/raster/Rasterizer.h"
 
+#include "LabelVolumeRounding.h"
 #include "PieceGhosts.h"
 #include "TetScan.h"
 #include "repose/io/NiftiIO.h"
@@ -446,6 +447,172 @@ T fromDouble(double v) {
   }
 }
 
+// RasterOptions::preserveLabelVolumes, after the nearest-neighbour pass has filled `dst`:
+// per soft label the volume the deformation gives it (a scan of the rest mesh on the input's
+// grid summing each tet's volume ratio over the voxels it carries), then the voxels on borders
+// between soft labels scanned again in the same order, so each keeps the rest position of the
+// write that decided it, and relabelled where that brings the counts to those volumes
+// (LabelVolumeRounding.h). `sourceOf(i, j, k, p, tet)` is the rest voxel the pass sampled.
+template <class T, class Source>
+void roundLabelVolumes(const Volume& labels, const TransferMesh& mesh,
+                       const Eigen::MatrixX3d& deformed, const ScanInput& in, const Shell& shell,
+                       const RasterOptions& options, const VolumeGeometry& output, T* dst,
+                       Source&& sourceOf, RasterReport* report) {
+  const T* src = labels.data<T>();
+  const auto d = labels.dims();
+  const std::int64_t nIn = labels.numVoxels(), nOut = output.numVoxels();
+  // Soft labels: non-zero, not negative, not a piece's; dense up to the largest value.
+  std::int64_t maxLabel = 0;
+  for (std::int64_t v = 0; v < nIn; ++v) maxLabel = std::max<std::int64_t>(maxLabel, src[v]);
+  if (maxLabel <= 0 || maxLabel > (1 << 24)) return;
+  std::vector<char> soft(std::size_t(maxLabel) + 1, 1);
+  soft[0] = 0;
+  for (std::size_t v = 0; v < shell.boneLabel.size() && v < soft.size(); ++v)
+    if (shell.boneLabel[v]) soft[v] = 0;
+  auto isSoft = [&](std::int64_t v) { return v > 0 && v <= maxLabel && soft[std::size_t(v)]; };
+
+  // Volume ratio (deformed over rest) of every tet.
+  const Eigen::Index nt = mesh.tets.rows();
+  std::vector<double> ratio(std::size_t(nt), 1.0);
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    Eigen::Matrix3d R, D;
+    for (int c = 0; c < 3; ++c) {
+      R.col(c) =
+          (mesh.vertices.row(mesh.tets(t, c + 1)) - mesh.vertices.row(mesh.tets(t, 0))).transpose();
+      D.col(c) = (deformed.row(mesh.tets(t, c + 1)) - deformed.row(mesh.tets(t, 0))).transpose();
+    }
+    const double rest = R.determinant();
+    ratio[std::size_t(t)] = rest != 0 ? D.determinant() / rest : 0.0;
+  }
+  // Per label, the sum of the ratios over its rest voxels, in 2^-20 voxels (fixed point, so the
+  // threads' sums add up the same on every run).
+  constexpr double kUnit = 1 << 20;
+  std::vector<std::atomic<std::int64_t>> sums(std::size_t(maxLabel) + 1);
+  for (auto& a : sums) a = 0;
+  {
+    RasterOptions rest;
+    rest.threads = options.threads;
+    rest.shellMm = options.shellMm;
+    rest.outerFaces = options.outerFaces;
+    rest.restParts = options.restParts;
+    const VolumeGeometry& g = labels.geometry();
+    const ScanInput restIn = raster::makeScanInput(mesh, mesh.vertices, g, g);
+    Shell restShell = makeShell(mesh, g, g, rest);
+    restShell.claimsBackground = shell.claimsBackground;
+    const std::int64_t nx = d[0], plane = d[0] * d[1];
+    runScan(restIn, restShell, rest, "label volumes at rest", nullptr, 1.0,
+            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                const Eigen::Vector3d&, const Eigen::Vector3d&, std::int32_t tet) {
+              const T* row = src + k * plane + j * nx;
+              std::int64_t run = 0;
+              T value = row[i0];
+              auto flush = [&] {
+                if (run > 0 && isSoft(std::int64_t(value)))
+                  sums[std::size_t(value)] +=
+                      std::llround(double(run) * ratio[std::size_t(tet)] * kUnit);
+              };
+              for (std::int64_t i = i0; i <= i1; ++i) {
+                if (row[i] != value) flush(), run = 0, value = row[i];
+                ++run;
+              }
+              flush();
+            });
+  }
+  const double voxelRatio = std::fabs(labels.geometry().ijkToRas.block<3, 3>(0, 0).determinant()) /
+                            std::fabs(output.ijkToRas.block<3, 3>(0, 0).determinant());
+  std::vector<double> target(std::size_t(maxLabel) + 1, 0.0), count(target.size(), 0.0);
+  for (std::size_t v = 1; v < target.size(); ++v)
+    if (soft[v]) target[v] = std::max(0.0, double(sums[v].load()) / kUnit * voxelRatio);
+  for (std::int64_t v = 0; v < nOut; ++v)
+    if (isSoft(std::int64_t(dst[v]))) count[std::size_t(dst[v])] += 1;
+
+  // The voxels on a border between two soft labels (6-neighbours), one bit each.
+  const std::int64_t nx = output.dims[0], ny = output.dims[1], nz = output.dims[2], plane = nx * ny;
+  const std::int64_t words = (nOut + 63) / 64;
+  std::vector<std::uint64_t> border(std::size_t(words), 0);
+  parallelFor(words, options.threads, [&](std::int64_t w0, std::int64_t w1) {
+    for (std::int64_t w = w0; w < w1; ++w)
+      for (std::int64_t v = 64 * w; v < std::min(nOut, 64 * (w + 1)); ++v) {
+        const T a = dst[v];
+        if (!isSoft(std::int64_t(a))) continue;
+        const std::int64_t i = v % nx, j = (v / nx) % ny, k = v / plane;
+        auto other = [&](std::int64_t u) { return dst[u] != a && isSoft(std::int64_t(dst[u])); };
+        if ((i > 0 && other(v - 1)) || (i + 1 < nx && other(v + 1)) || (j > 0 && other(v - nx)) ||
+            (j + 1 < ny && other(v + nx)) || (k > 0 && other(v - plane)) ||
+            (k + 1 < nz && other(v + plane)))
+          border[std::size_t(w)] |= std::uint64_t(1) << (v - 64 * w);
+      }
+  });
+  std::vector<std::int64_t> rank(std::size_t(words) + 1, 0);
+  for (std::int64_t w = 0; w < words; ++w)
+    rank[std::size_t(w) + 1] = rank[std::size_t(w)] + __builtin_popcountll(border[std::size_t(w)]);
+  std::vector<raster::RoundingCandidate> candidates(std::size_t(rank.back()));
+  // Each border voxel: its sampled label and the soft label of most trilinear weight among the
+  // other labels of the 8 rest voxels around its rest position, with the weights' difference.
+  RasterOptions again = options;
+  again.progress = {};
+  runScan(in, shell, again, "label borders", nullptr, frameSign(output),
+          [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
+              const Eigen::Vector3d& step, std::int32_t tet) {
+            for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+              const std::int64_t v = k * plane + j * nx + i;
+              const std::uint64_t word = border[std::size_t(v / 64)];
+              if (!(word >> (v % 64) & 1)) continue;
+              raster::RoundingCandidate& c = candidates[std::size_t(
+                  rank[std::size_t(v / 64)] +
+                  __builtin_popcountll(word & ((std::uint64_t(1) << (v % 64)) - 1)))];
+              c.voxel = v;
+              c.to = -1;
+              const std::int64_t at = sourceOf(i, j, k, p, tet);
+              // Only a voxel sampled where its rest position is (not redirected off a piece).
+              if (at < 0 || at != nearestVoxel(p, d)) {
+                c.from = -1;
+                continue;
+              }
+              c.from = std::int32_t(src[at]);
+              std::array<std::int32_t, 8> value;
+              std::array<double, 8> weight;
+              int n = 0;
+              const double fx = std::floor(p.x()), fy = std::floor(p.y()), fz = std::floor(p.z());
+              const double tx = p.x() - fx, ty = p.y() - fy, tz = p.z() - fz;
+              for (int corner = 0; corner < 8; ++corner) {
+                const std::int64_t x = std::int64_t(fx) + (corner & 1),
+                                   y = std::int64_t(fy) + (corner >> 1 & 1),
+                                   z = std::int64_t(fz) + (corner >> 2 & 1);
+                const double w = ((corner & 1) ? tx : 1 - tx) * ((corner >> 1 & 1) ? ty : 1 - ty) *
+                                 ((corner >> 2 & 1) ? tz : 1 - tz);
+                const std::int32_t l =
+                    x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]
+                        ? 0
+                        : std::int32_t(src[x + d[0] * (y + d[1] * z)]);
+                int m = 0;
+                while (m < n && value[std::size_t(m)] != l) ++m;
+                if (m == n) value[std::size_t(n)] = l, weight[std::size_t(n++)] = 0;
+                weight[std::size_t(m)] += w;
+              }
+              double own = 0, best = -1;
+              for (int m = 0; m < n; ++m)
+                if (value[std::size_t(m)] == c.from)
+                  own = weight[std::size_t(m)];
+                else if (isSoft(value[std::size_t(m)]) && weight[std::size_t(m)] > best)
+                  best = weight[std::size_t(m)], c.to = value[std::size_t(m)];
+              c.score = float(best - own);
+            }
+          });
+  std::vector<raster::RoundingCandidate> usable;
+  usable.reserve(candidates.size());
+  for (const raster::RoundingCandidate& c : candidates)
+    if (c.to >= 0 && c.from >= 0 && std::int64_t(dst[c.voxel]) == c.from && isSoft(c.from))
+      usable.push_back(c);
+  const std::vector<std::size_t> taken = raster::chooseVolumeRounding(usable, target, count);
+  for (const std::size_t c : taken) dst[usable[c].voxel] = T(usable[c].to);
+  if (report) {
+    report->roundedVoxels = std::int64_t(taken.size());
+    for (std::size_t v = 1; v < target.size(); ++v)
+      if (soft[v] && target[v] > 0) report->labelTargets[int(v)] = target[v];
+  }
+}
+
 }  // namespace
 
 // Per voxel of `input`: the tet of a whole piece that writes it at rest (its tets and rims),
@@ -662,18 +829,27 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
       }
       return at;
     };
+    // The rest voxel output voxel (i,j,k) samples, at rest position p in tet `tet`.
+    auto sourceOf = [&](std::int64_t i, std::int64_t j, std::int64_t k, const Eigen::Vector3d& p,
+                        std::int32_t tet) {
+      std::int64_t at = nearestVoxel(p, d);
+      if (at >= 0 && !owner.empty() && !mesh.rigid[std::size_t(tet)] && movedAway(at, i, j, k))
+        at = aroundPiece(at);
+      return at;
+    };
     runScan(in, shell, options, "rasterize labels", report, frameSign(output),
             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
                 const Eigen::Vector3d& step, std::int32_t tet) {
               const std::int64_t row = k * plane + j * nx;
               for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-                std::int64_t at = nearestVoxel(p, d);
-                if (at >= 0 && !owner.empty() && !mesh.rigid[std::size_t(tet)] &&
-                    movedAway(at, i, j, k))
-                  at = aroundPiece(at);
+                const std::int64_t at = sourceOf(i, j, k, p, tet);
                 for (int l = 0; l < layers; ++l) dst[l][row + i] = at >= 0 ? src[l][at] : T(0);
               }
             });
+    if constexpr (std::is_integral_v<T>)
+      if (options.preserveLabelVolumes && layers == 1)
+        roundLabelVolumes<T>(labels, mesh, deformed, in, shell, options, output, dst[0], sourceOf,
+                             report);
   });
   return out;
 }

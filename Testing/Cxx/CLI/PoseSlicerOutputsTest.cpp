@@ -126,4 +126,8 @@ TEST(PoseSlicerOutputs, ASegmentationComesBackWithItsNamesColoursAndTerminology)
   EXPECT_EQ(bad.exitCode, 2);
   EXPECT_NE(bad.err.find("--output-format must be"), std::string::npos) << bad.err;
   EXPECT_EQ(filesIn(dir.file("out")).size(), 8u);
+  const CommandResult badRounding = runCommand("repose", common + " --label-volumes cubic");
+  EXPECT_EQ(badRounding.exitCode, 2);
+  EXPECT_NE(badRounding.err.find("--label-volumes must be"), std::string::npos) << badRounding.err;
+  EXPECT_EQ(filesIn(dir.file("out")).size(), 8u);
 }

@@ -34,9 +34,10 @@ struct BendJoint {
   double radiusMm = 0;  // where the two parts meet across the joint (Skeleton's radius_mm)
   // How far from the centre the bend reaches (beyond, each part follows its group's motion), in
   // radii, on the proximal and the distal side; in between it follows the share of the turn, so
-  // the two sides agree at the joint plane. The limb's side bends over 1.5 radii; the trunk's
-  // side of a root joint (shoulder, hip) only near the joint, so the chest wall and the pelvis
-  // stay put.
+  // the two sides agree at the joint plane. The pose job's joints (PoseJob.cpp, bendJoints): a
+  // limb's joint (elbow, wrist, knee, ankle) 2 radii each side; a root joint (shoulder, hip)
+  // 1.5 on the limb's side and only near the joint on the trunk's, so the chest wall and the
+  // pelvis stay put.
   double proximalReach = 1.5, distalReach = 1.5;
 };
 
@@ -49,7 +50,7 @@ class JointBends {
  public:
   JointBends() = default;
   // Finds, per joint, the groups carrying its two parts and the soft-tissue vertices of those
-  // parts within 1.5 radii of its centre (never a whole piece's).
+  // parts within its reach of its centre (never a whole piece's).
   JointBends(const TransferMesh& mesh, const std::vector<RigidHandle>& handles,
              const std::vector<BendJoint>& joints);
   bool empty() const { return joints_.empty(); }

@@ -30,7 +30,11 @@ struct PoseFrameOptions {
   const TissueTable* tissues = nullptr;  // densities and rigid labels; null: no masses
   std::string tissueTableName = "none";  // how the report names the table
   bool fillPockets = true;               // docs/QUALITY.md
-  double spacingMm = 0;                  // output voxel size; 0: the input's spacing
+  // Each soft label of G rounded to the volume the deformation gives it, not left to
+  // nearest-neighbour sampling (RasterOptions::preserveLabelVolumes; docs/QUALITY.md). The
+  // report then holds those labels' change itself to the target (no resampling floor off).
+  bool preserveLabelVolumes = true;
+  double spacingMm = 0;  // output voxel size; 0: the input's spacing
   int threads = 0;
   ProgressFn progress;  // rasterizing G (the long part); may cancel
   // Called with the output grid before anything is allocated for it: a memory budget's check

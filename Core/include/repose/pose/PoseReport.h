@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,12 @@ struct PoseReportInput {
   // they stay at rest (RigiditySolver). Reported so a user sees a body part the cage missed.
   int unreachableVertices = 0;
   int rigidVertices = 0;
+  // RasterReport::labelTargets when G's soft labels were rounded to the deformation's volumes
+  // (PoseFrameOptions::preserveLabelVolumes): those labels' rows say "rounded" and give the
+  // change the deformation itself makes ("deformation_change_percent"); their nearest-neighbour
+  // floor is still reported but not taken off, since the same rounding of a rigid motion keeps
+  // their rest volume.
+  const std::map<int, double>* labelTargets = nullptr;
 };
 
 // The report as a JSON object (text), the keys of docs/FORMATS.md from "labels" on; callers add

@@ -67,6 +67,15 @@ struct RasterOptions {
   // a bone's cortex and marrow are one piece): label -> piece id. Labels not listed are their
   // own piece's id.
   const std::map<int, int>* bonePieces = nullptr;
+  // Labels only (rasterizeLabels, single-layer integer maps): after nearest-neighbour sampling,
+  // relabel voxels on the borders between soft labels so each soft label's voxel count comes to
+  // the volume the deformation gives it (the sum of the tets' volume ratios over its rest voxels)
+  // instead of what sampling a thin structure on a turned grid happens to give
+  // (src/raster/LabelVolumeRounding.h). Label 0 and the labels of whole pieces (pieceLabels and
+  // bonePieces) are neither taken from nor given to, so the body's outline and the bones stay
+  // as sampled. Costs a scan of the rest mesh on the input's grid and a second scan of the
+  // voxels on label borders.
+  bool preserveLabelVolumes = false;
 };
 
 struct RasterReport {
@@ -77,6 +86,10 @@ struct RasterReport {
   // Out of core only: voxels per non-zero label of the written output, counted slab by slab so
   // nobody has to read the file back.
   std::map<int, std::int64_t> labelVoxels;
+  // RasterOptions::preserveLabelVolumes: voxels relabelled, and per soft label the volume the
+  // deformation gives it, in output voxels (the counts it was rounded to).
+  std::int64_t roundedVoxels = 0;
+  std::map<int, double> labelTargets;
 };
 
 // Labels: each output voxel whose centre lies in a deformed tet (or its shell, see RasterOptions)
