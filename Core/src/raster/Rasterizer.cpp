@@ -494,10 +494,14 @@ void roundLabelVolumes(const Volume& labels, const TransferMesh& mesh,
     rest.threads = options.threads;
     rest.shellMm = options.shellMm;
     rest.outerFaces = options.outerFaces;
-    rest.restParts = options.restParts;
     const VolumeGeometry& g = labels.geometry();
     const ScanInput restIn = raster::makeScanInput(mesh, mesh.vertices, g, g);
     Shell restShell = makeShell(mesh, g, g, rest);
+    // The posed shell's rule for whose tissue a shell voxel is, on the same input grid: its
+    // coverage of the rest mesh is shared, not scanned again.
+    restShell.restParts = shell.restParts;
+    restShell.tetParts = shell.tetParts;
+    restShell.restCovered = shell.restCovered;
     restShell.claimsBackground = shell.claimsBackground;
     const std::int64_t nx = d[0], plane = d[0] * d[1];
     runScan(restIn, restShell, rest, "label volumes at rest", nullptr, 1.0,
