@@ -247,13 +247,16 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
       {"tissue_table", options.tissues ? options.tissueTableName : std::string("none")},
       {"voxels_in_shell", raster.shellVoxels},
       {"label_volumes",
-       {{"rounding", options.preserveLabelVolumes ? "preserve" : "nearest"},
+       {{"rounding",
+         options.preserveLabelVolumes && raster.roundingSkipped.empty() ? "preserve" : "nearest"},
         {"relabelled_voxels", raster.roundedVoxels}}},
       {"raster_inverted_tets", raster.invertedTets},
       {"pockets",
        {{"filled_voxels", pockets.filled},
         {"kept_cavity_voxels", pockets.keptCavities},
         {"filled", options.fillPockets}}}};
+  if (!raster.roundingSkipped.empty())
+    report["label_volumes"]["skipped"] = "not rounded: " + raster.roundingSkipped;
   report["predicted"] = prediction;
   report["bone_collisions"] = collisions;
   report.update(nlohmann::json::parse(poseReportJson(ri)));

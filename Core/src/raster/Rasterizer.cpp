@@ -464,7 +464,11 @@ void roundLabelVolumes(const Volume& labels, const TransferMesh& mesh,
   // Soft labels: non-zero, not negative, not a piece's; dense up to the largest value.
   std::int64_t maxLabel = 0;
   for (std::int64_t v = 0; v < nIn; ++v) maxLabel = std::max<std::int64_t>(maxLabel, src[v]);
-  if (maxLabel <= 0 || maxLabel > (1 << 24)) return;
+  if (maxLabel > (1 << 24)) {
+    if (report) report->roundingSkipped = "labels beyond 2^24";
+    return;
+  }
+  if (maxLabel <= 0) return;  // no label to round
   std::vector<char> soft(std::size_t(maxLabel) + 1, 1);
   soft[0] = 0;
   for (std::size_t v = 0; v < shell.boneLabel.size() && v < soft.size(); ++v)
@@ -850,10 +854,17 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
                 for (int l = 0; l < layers; ++l) dst[l][row + i] = at >= 0 ? src[l][at] : T(0);
               }
             });
-    if constexpr (std::is_integral_v<T>)
-      if (options.preserveLabelVolumes && layers == 1)
-        roundLabelVolumes<T>(labels, mesh, deformed, in, shell, options, output, dst[0], sourceOf,
-                             report);
+    if (options.preserveLabelVolumes) {
+      if constexpr (std::is_integral_v<T>) {
+        if (layers == 1)
+          roundLabelVolumes<T>(labels, mesh, deformed, in, shell, options, output, dst[0], sourceOf,
+                               report);
+        else if (report)
+          report->roundingSkipped = "a map of " + std::to_string(layers) + " layers";
+      } else if (report) {
+        report->roundingSkipped = "a map of non-integer values";
+      }
+    }
   });
   return out;
 }

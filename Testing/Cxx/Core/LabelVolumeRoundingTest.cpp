@@ -164,3 +164,22 @@ TEST(LabelVolumeRounding, TheIdentityIsLeftAsSampled) {
   for (std::int64_t v = 0; v < out.numVoxels(); ++v) different += a[v] != r[v];
   EXPECT_EQ(different, 0);
 }
+
+TEST(LabelVolumeRounding, AMapOfLayersIsSampledAndTheReportSaysWhy) {
+  // Overlapping segments (a .seg.nrrd's layers) cannot be relabelled one voxel at a time: the
+  // map is left as sampled, and the report says it was not rounded.
+  const ThickSliceBlock b;
+  Volume layered(b.labels.geometry(), ScalarType::UInt16, 2);
+  layered.setLabelMap(true);
+  std::copy_n(b.labels.data<std::uint16_t>(), b.labels.numVoxels(), layered.data<std::uint16_t>(0));
+  const Eigen::MatrixX3d deformed = b.turned(41);
+  const VolumeGeometry grid = deformedGrid(b.labels.geometry(), deformed);
+  RasterReport preserved, nearest;
+  const Volume p = rasterizeLabels(layered, b.mesh, deformed, grid, b.options(true), &preserved);
+  const Volume n = rasterizeLabels(layered, b.mesh, deformed, grid, b.options(false), &nearest);
+  EXPECT_EQ(preserved.roundingSkipped, "a map of 2 layers");
+  EXPECT_TRUE(nearest.roundingSkipped.empty());
+  EXPECT_EQ(preserved.roundedVoxels, 0);
+  EXPECT_TRUE(std::equal(p.data<std::uint16_t>(0), p.data<std::uint16_t>(0) + p.numVoxels(),
+                         n.data<std::uint16_t>(0)));
+}

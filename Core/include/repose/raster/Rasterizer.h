@@ -90,6 +90,9 @@ struct RasterReport {
   // deformation gives it, in output voxels (the counts it was rounded to).
   std::int64_t roundedVoxels = 0;
   std::map<int, double> labelTargets;
+  // Why it was asked for and not done (empty when done or not asked): a map of several layers
+  // or of non-integer values, or labels beyond 2^24.
+  std::string roundingSkipped;
 };
 
 // Labels: each output voxel whose centre lies in a deformed tet (or its shell, see RasterOptions)
