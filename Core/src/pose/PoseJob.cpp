@@ -144,10 +144,9 @@ std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& pa
     b.distal = *distal;
     // A limb's joint (elbow, wrist, knee, ankle) bends over 2 radii on each side, so the bend
     // fades into the solved blend along the limbs, where the two agree; over the outer 30 % of
-    // 1.5 radii the fade also crossed the joint plane and crushed soft tets there (the arm's
-    // vessels at a 90-degree elbow on 4.8 mm slices: -1.36 % at 1.5 radii, -0.66 % at 2;
-    // docs/QUALITY.md). A root joint's trunk side bends only near the joint and its limb side
-    // over 1.5 radii: at 2 a raised arm pulled the chest wall along (body +1.2 %).
+    // 1.5 radii the fade also crossed the joint plane and crushed soft tets there (docs/QUALITY.md,
+    // "What closed the thick slices"). A root joint's trunk side bends only near the joint and
+    // its limb side over 1.5 radii: bent wider, a raised arm pulls the chest wall along.
     if (j.parts[0] == "torso")
       b.proximalReach = 0.5, b.distalReach = 1.5;
     else
