@@ -52,9 +52,8 @@ void countBadTets(const ScanInput& in, double frameSign, RasterReport& r) {
 // How the shell around the outer faces is scanned (RasterOptions::shellMm).
 // Index of the input voxel nearest to the rest position p (input IJK), or -1 beyond the grid.
 inline std::int64_t nearestVoxel(const Eigen::Vector3d& p, const std::array<std::int64_t, 3>& d) {
-  const std::int64_t x = static_cast<std::int64_t>(std::floor(p.x() + 0.5)),
-                     y = static_cast<std::int64_t>(std::floor(p.y() + 0.5)),
-                     z = static_cast<std::int64_t>(std::floor(p.z() + 0.5));
+  const std::int64_t x = raster::floorToInt(p.x() + 0.5), y = raster::floorToInt(p.y() + 0.5),
+                     z = raster::floorToInt(p.z() + 0.5);
   if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]) return -1;
   return x + d[0] * (y + d[1] * z);
 }
@@ -253,9 +252,26 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   Eigen::MatrixX4i ghostTets;
   const ScanInput ghostIn =
       withRims ? raster::ghostScanInput(in, shell.ghosts, ghostTets) : ScanInput();
+  // Outcodes (Cohen-Sutherland) of the vertices against the scanned rows and slices, grown by
+  // the largest box growth and one voxel more (so rounding cannot reject a tet the box test below
+  // keeps): a tet whose four vertices share a bit lies wholly on one side, found from four bytes.
+  // A live slice keeps a few thousand of 200K tets, and the box test is then run on those only.
+  double gyMax = 0, gzMax = 0;
+  if (withShell) gyMax = shell.boxGrowth[1], gzMax = shell.boxGrowth[2];
+  if (withRims)
+    gyMax = std::max(gyMax, shell.pieceGrowth[1]), gzMax = std::max(gzMax, shell.pieceGrowth[2]);
+  const double zBelow = double(kBegin) - gzMax - 1, zAbove = double(kEnd - 1) + gzMax + 1;
+  const double yBelow = -gyMax - 1, yAbove = double(in.dims[1] - 1) + gyMax + 1;
+  std::vector<std::uint8_t> outcode(in.out.size());
+  for (std::size_t v = 0; v < in.out.size(); ++v) {
+    const double y = in.out[v].y(), z = in.out[v].z();
+    outcode[v] =
+        std::uint8_t((z < zBelow) | (z > zAbove) << 1 | (y < yBelow) << 2 | (y > yAbove) << 3);
+  }
   // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
   struct Candidates {
     std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;
+    std::vector<raster::TetVertices> vertices;
   };
   const int selectThreads = resolveThreads(options.threads);
   std::vector<Candidates> parts(static_cast<std::size_t>(selectThreads));
@@ -266,12 +282,16 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           Candidates& c = parts[static_cast<std::size_t>(part)];
           for (Eigen::Index t = nt * part / selectThreads; t < nt * (part + 1) / selectThreads;
                ++t) {
+            const raster::TetVertices v = raster::tetVertices(in, t);
+            if (outcode[std::size_t(v[0])] & outcode[std::size_t(v[1])] &
+                outcode[std::size_t(v[2])] & outcode[std::size_t(v[3])])
+              continue;
             double gy = 0, gz = 0;  // box growth for the shell and the piece's rim
             if (withShell && shell.outer[t]) gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
             if (withRims && shell.pieceFaces[std::size_t(t)])
               gy = std::max(gy, shell.pieceGrowth[1]), gz = std::max(gz, shell.pieceGrowth[2]);
-            const Eigen::Vector3d &p0 = in.out[T(t, 0)], &p1 = in.out[T(t, 1)],
-                                  &p2 = in.out[T(t, 2)], &p3 = in.out[T(t, 3)];
+            const Eigen::Vector3d &p0 = in.out[v[0]], &p1 = in.out[v[1]], &p2 = in.out[v[2]],
+                                  &p3 = in.out[v[3]];
             const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - gz;
             const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + gz;
             if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
@@ -279,12 +299,11 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             const double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + gy;
             if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
             c.tet.push_back(static_cast<std::int32_t>(t));
-            c.kmin.push_back(static_cast<std::int32_t>(std::max(double(kBegin), std::ceil(zlo))));
-            c.kmax.push_back(
-                static_cast<std::int32_t>(std::min(double(kEnd - 1), std::floor(zhi))));
-            c.jmin.push_back(static_cast<std::int32_t>(std::max(0.0, std::ceil(ylo))));
-            c.jmax.push_back(
-                static_cast<std::int32_t>(std::min(double(in.dims[1] - 1), std::floor(yhi))));
+            c.vertices.push_back(v);
+            c.kmin.push_back(std::int32_t(std::max(kBegin, raster::ceilToInt(zlo))));
+            c.kmax.push_back(std::int32_t(std::min(kEnd - 1, raster::floorToInt(zhi))));
+            c.jmin.push_back(std::int32_t(std::max<std::int64_t>(0, raster::ceilToInt(ylo))));
+            c.jmax.push_back(std::int32_t(std::min(in.dims[1] - 1, raster::floorToInt(yhi))));
           }
         }
       },
@@ -292,6 +311,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // Tets of whole pieces (bones, organs) go last, so where a fold of soft tissue overlaps a bone
   // the bone keeps its voxels: soft tissue is what a bend squeezes.
   std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax;
+  std::vector<raster::TetVertices> vertices;
   const bool withPieces = in.pieces && !in.pieces->empty();
   for (const int pass : {0, 1}) {
     if (pass == 1 && !withPieces) break;
@@ -299,6 +319,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
       for (std::size_t n = 0; n < c.tet.size(); ++n) {
         if (withPieces && ((*in.pieces)[std::size_t(c.tet[n])] != 0) != (pass == 1)) continue;
         candidates.push_back(c.tet[n]);
+        vertices.push_back(c.vertices[n]);
         jmin.push_back(c.jmin[n]), jmax.push_back(c.jmax[n]);
         kmin.push_back(c.kmin[n]), kmax.push_back(c.kmax[n]);
       }
@@ -311,15 +332,17 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   const std::int64_t split = bands ? in.dims[1] : depth;
   const std::int64_t slabs = std::max<std::int64_t>(1, std::min<std::int64_t>(split, 8 * threads));
   const std::int64_t nx = in.dims[0];
-  std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0};
+  std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0}, nextSlab{0};
   std::atomic<bool> stop{false};
   std::mutex progressMutex;
+  // Work items are handed out one at a time: the body fills some bands of a slice and not others
+  // (a sagittal slice's trunk and head against its legs), so fixed halves would leave a core idle.
   parallelFor(
-      slabs, threads,
-      [&](std::int64_t sb, std::int64_t se) {
+      std::min<std::int64_t>(slabs, threads), threads,
+      [&](std::int64_t, std::int64_t) {
         std::int64_t localWrites = 0, localShell = 0;
         std::vector<std::uint8_t> covered;
-        for (std::int64_t slab = sb; slab < se && !stop; ++slab) {
+        for (std::int64_t slab; !stop && (slab = nextSlab++) < slabs;) {
           const std::int64_t s0 = split * slab / slabs, s1 = split * (slab + 1) / slabs;
           const std::int64_t k0 = kBegin + (bands ? 0 : s0), k1 = bands ? kEnd : kBegin + s1;
           const std::int64_t j0 = bands ? s0 : 0, j1 = bands ? s1 : in.dims[1];
@@ -332,7 +355,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           for (std::size_t c = 0; c < candidates.size(); ++c) {
             const std::int32_t t = candidates[c];
             if (kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareTet(in, t, s))
+                !raster::prepareTet(in, vertices[c], s))
               continue;
             const std::uint8_t mark = withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
             raster::scanTet(s, k0, k1, j0, j1,
@@ -368,7 +391,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             const std::int32_t t = candidates[c];
             const unsigned rim = shell.pieceFaces[std::size_t(t)];
             if (!rim || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareShell(in, t, rim, shell.pieceMm, shell.normalToMm,
+                !raster::prepareShell(in, vertices[c], rim, shell.pieceMm, shell.normalToMm,
                                       shell.pieceGrowth, s))
               continue;
             scanRim(t);
@@ -386,7 +409,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           for (std::size_t c = 0; c < candidates.size() && withShell; ++c) {
             const std::int32_t t = candidates[c];
             if (!shell.outer[t] || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareShell(in, t, shell.outer[t], shell.mm, shell.normalToMm,
+                !raster::prepareShell(in, vertices[c], shell.outer[t], shell.mm, shell.normalToMm,
                                       shell.boxGrowth, s))
               continue;
             raster::scanTet(s, k0, k1, j0, j1,

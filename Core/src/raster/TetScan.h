@@ -34,6 +34,24 @@
 
 namespace repose::raster {
 
+// floor and ceil as integers without a call into libm (the x86-64 baseline has no rounding
+// instruction, and these run per voxel and per row). Exact for |x| < 2^52; beyond, where every
+// double is a whole number far outside any grid, saturated at +-2^52 (NaN goes low), so the
+// callers' clamps to the grid decide as before and no conversion overflows.
+constexpr double kWholeLimit = 4503599627370496.0;  // 2^52
+inline std::int64_t floorToInt(double x) {
+  if (!(x > -kWholeLimit)) return -static_cast<std::int64_t>(kWholeLimit);
+  if (!(x < kWholeLimit)) return static_cast<std::int64_t>(kWholeLimit);
+  const auto t = static_cast<std::int64_t>(x);
+  return t - (static_cast<double>(t) > x ? 1 : 0);
+}
+inline std::int64_t ceilToInt(double x) {
+  if (!(x > -kWholeLimit)) return -static_cast<std::int64_t>(kWholeLimit);
+  if (!(x < kWholeLimit)) return static_cast<std::int64_t>(kWholeLimit);
+  const auto t = static_cast<std::int64_t>(x);
+  return t + (static_cast<double>(t) < x ? 1 : 0);
+}
+
 // Vertex positions mapped once into the grids the scan works in.
 struct ScanInput {
   const Eigen::MatrixX4i* tets = nullptr;
@@ -86,12 +104,20 @@ struct ScanTet {
   double signedVolume = 0;             // in output IJK units; < 0 for a tet turned inside out
 };
 
-// False for a tet whose deformed volume is zero (no voxel can be inside it) or whose box misses
-// the grid.
-inline bool prepareTet(const ScanInput& in, Eigen::Index t, ScanTet& s,
-                       const std::array<double, 3>& boxGrowth = {0, 0, 0}) {
+// A tet's four vertex indices, in the mesh's order.
+using TetVertices = std::array<int, 4>;
+
+inline TetVertices tetVertices(const ScanInput& in, Eigen::Index t) {
   const Eigen::MatrixX4i& T = *in.tets;
-  const std::array<int, 4> v{T(t, 0), T(t, 1), T(t, 2), T(t, 3)};
+  return {T(t, 0), T(t, 1), T(t, 2), T(t, 3)};
+}
+
+// False for a tet whose deformed volume is zero (no voxel can be inside it) or whose box misses
+// the grid. Taking the vertex indices (a candidate list keeps them beside the tet's number)
+// spares the four reads from the mesh's index columns, which for the few tets a slice meets
+// are scattered cache misses.
+inline bool prepareTet(const ScanInput& in, const TetVertices& v, ScanTet& s,
+                       const std::array<double, 3>& boxGrowth = {0, 0, 0}) {
   Eigen::Matrix3d D, R;
   for (int c = 0; c < 3; ++c) {
     D.col(c) = in.out[v[c + 1]] - in.out[v[0]];
@@ -103,9 +129,8 @@ inline bool prepareTet(const ScanInput& in, Eigen::Index t, ScanTet& s,
     double mn = in.out[v[0]][c], mx = mn;
     for (int k = 1; k < 4; ++k)
       mn = std::min(mn, in.out[v[k]][c]), mx = std::max(mx, in.out[v[k]][c]);
-    s.lo[c] = std::max<std::int64_t>(0, static_cast<std::int64_t>(std::ceil(mn - boxGrowth[c])));
-    s.hi[c] = std::min<std::int64_t>(in.dims[c] - 1,
-                                     static_cast<std::int64_t>(std::floor(mx + boxGrowth[c])));
+    s.lo[c] = std::max<std::int64_t>(0, ceilToInt(mn - boxGrowth[c]));
+    s.hi[c] = std::min<std::int64_t>(in.dims[c] - 1, floorToInt(mx + boxGrowth[c]));
     if (s.lo[c] > s.hi[c]) return false;
   }
   // Face f is opposite vertex f; its plane from the other three in increasing index order.
@@ -128,20 +153,31 @@ inline bool prepareTet(const ScanInput& in, Eigen::Index t, ScanTet& s,
   return true;
 }
 
+inline bool prepareTet(const ScanInput& in, Eigen::Index t, ScanTet& s,
+                       const std::array<double, 3>& boxGrowth = {0, 0, 0}) {
+  return prepareTet(in, tetVertices(in, t), s, boxGrowth);
+}
+
 // The tet grown beyond its outer faces (bits of `outer`, face f opposite vertex f) by `shell` mm
 // (`normalToMm` = M^-T for the output's IJK->RAS linear part M, so |M^-T n| turns a plane value
 // into mm), clipped to its box grown by `boxGrowth` voxels per axis. For the voxels just outside
 // the mesh's surface, which Mesh_3 places only to within a voxel of the label boundary.
-inline bool prepareShell(const ScanInput& in, Eigen::Index t, unsigned outer, double shell,
+inline bool prepareShell(const ScanInput& in, const TetVertices& v, unsigned outer, double shell,
                          const Eigen::Matrix3d& normalToMm, const std::array<double, 3>& boxGrowth,
                          ScanTet& s) {
-  if (!prepareTet(in, t, s, boxGrowth)) return false;
+  if (!prepareTet(in, v, s, boxGrowth)) return false;
   for (int f = 0; f < 4; ++f)
     if (outer & (1u << f)) {
       Plane& p = s.faces[f];
       p.d -= p.side * shell * (normalToMm * p.n).norm();
     }
   return true;
+}
+
+inline bool prepareShell(const ScanInput& in, Eigen::Index t, unsigned outer, double shell,
+                         const Eigen::Matrix3d& normalToMm, const std::array<double, 3>& boxGrowth,
+                         ScanTet& s) {
+  return prepareShell(in, tetVertices(in, t), outer, shell, normalToMm, boxGrowth, s);
 }
 
 inline bool inside(const ScanTet& s, double i, double j, double k) {
@@ -189,7 +225,7 @@ void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0
       if (empty || a > b + 1 || a > hi + 1 || b < lo - 1) continue;
       std::int64_t i0 = s.lo[0], i1 = s.hi[0];
       if (a >= lo - kSettle) {
-        i0 = static_cast<std::int64_t>(std::ceil(a));
+        i0 = ceilToInt(a);
         if (double(i0) - a < kSettle) {
           if (!inside(s, double(i0), dj, dk)) ++i0;
         } else if (a - double(i0 - 1) < kSettle && i0 - 1 >= s.lo[0] &&
@@ -199,7 +235,7 @@ void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0
         i0 = std::max(i0, s.lo[0]);
       }
       if (b <= hi + kSettle) {
-        i1 = static_cast<std::int64_t>(std::floor(b));
+        i1 = floorToInt(b);
         if (b - double(i1) < kSettle) {
           if (!inside(s, double(i1), dj, dk)) --i1;
         } else if (double(i1 + 1) - b < kSettle && i1 + 1 <= s.hi[0] &&

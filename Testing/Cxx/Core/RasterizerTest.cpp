@@ -461,6 +461,39 @@ TEST(Rasterizer, SliceEqualsThatPlaneOfTheFullOutput) {
       0);
 }
 
+// A slice keeps only the tets whose vertices' outcodes do not put them wholly on one side, and its
+// bands of rows go to whichever thread is free: on any thread count, every plane of a bent body's
+// full output (first, last, and through the trunk) comes out voxel for voxel, shell included.
+TEST(Rasterizer, SlicesEqualTheFullOutputOnAnyNumberOfThreads) {
+  const PhantomScene& s = phantomScene();
+  Eigen::MatrixX3d posed = s.cage.vertices;
+  for (Eigen::Index v = 0; v < posed.rows(); ++v)  // a smooth bend, not an affine map
+    posed(v, 1) += 1e-3 * posed(v, 2) * posed(v, 2) + 0.1 * posed(v, 0);
+  const Eigen::MatrixX3d deformed = s.deformation->deform(posed);
+  const VolumeGeometry full = deformedGrid(s.organs.geometry(), deformed);
+  const Volume out = rasterizeLabels(s.organs, s.mesh, deformed, full);
+  const std::int64_t n = full.dims[0] * full.dims[1];
+  int planes = 0;
+  for (const std::int64_t k :
+       {std::int64_t(0), full.dims[2] / 3, full.dims[2] / 2, full.dims[2] - 1}) {
+    VolumeGeometry plane = full;
+    plane.dims[2] = 1;
+    plane.ijkToRas.block<3, 1>(0, 3) = full.voxelToRas(0, 0, double(k));
+    for (const int threads : {1, 2, 3}) {
+      RasterOptions o;
+      o.threads = threads;
+      const Volume slice = rasterizeLabels(s.organs, s.mesh, deformed, plane, o);
+      EXPECT_TRUE(std::equal(slice.data<std::uint8_t>(), slice.data<std::uint8_t>() + n,
+                             out.data<std::uint8_t>() + k * n))
+          << "plane " << k << " on " << threads << " threads";
+    }
+    planes +=
+        std::count_if(out.data<std::uint8_t>() + k * n, out.data<std::uint8_t>() + (k + 1) * n,
+                      [](std::uint8_t v) { return v != 0; }) > 0;
+  }
+  EXPECT_GE(planes, 2);  // the test looked at the body, not only at empty planes
+}
+
 // Out of core: the input read in place through a small slice cache, the output written in slabs;
 // the file equals the in-core result voxel for voxel, for gzip and plain NIfTI inputs.
 TEST(Rasterizer, OutOfCoreEqualsInCoreVoxelForVoxel) {
