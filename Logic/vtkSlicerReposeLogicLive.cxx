@@ -214,8 +214,9 @@ bool vtkSlicerReposeLogic::SolveLiveFrame(const repose::Pose& pose) {
     const std::size_t frames = pose.frames().size();
     const std::size_t index =
         std::min<std::size_t>(std::size_t(live.Pose->GetCurrentFrame()), frames - 1);
-    const repose::PoseRig::Frame frame =
-        live.Rig->frame(pose, index, repose::GreenPrecision::Preview, repose::FrameMaps::Without);
+    // Warm-started from the last live frame: a drag's free cage vertices converge in a few ARAP
+    // iterations per edit (the export solves its frame from rest).
+    const repose::PoseRig::Frame frame = live.Rig->liveFrame(pose, index);
     live.Deformed = frame.deformed;
     setPoints(live.Cage, frame.cage);
     setPoints(live.Body, frame.deformed);

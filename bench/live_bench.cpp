@@ -6,6 +6,10 @@
 // JSON. Single-shot: run by bench/run_bench.py (`make bench`).
 //
 //   ReposeLiveBench SCENE_DIR [--events 200] [--pixels 512] [--group NAME] [--degrees 90]
+//                   [--pose FILE]
+// --pose replaces the scene's pose before the live pose starts, e.g.
+// bench/live/elbow90_free_upper_arm.pose.json, whose free cage vertices put the cage's ARAP
+// (warm-started from event to event) into every frame.
 #include "vtkMRMLReposePoseNode.h"
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
@@ -21,7 +25,9 @@
 #include <array>
 #include <chrono>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -50,11 +56,14 @@ nlohmann::json statistics(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) fail("usage: ReposeLiveBench SCENE_DIR [--events N] [--pixels N] [--group NAME]");
+  if (argc < 2)
+    fail(
+        "usage: ReposeLiveBench SCENE_DIR [--events N] [--pixels N] [--group NAME] "
+        "[--degrees D] [--pose FILE]");
   const std::string sceneDir = argv[1];
   int events = 200, pixels = 512;
   double degrees = 90;
-  std::string group;
+  std::string group, poseFile;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string key = argv[i], value = argv[i + 1];
     if (key == "--events")
@@ -65,6 +74,8 @@ int main(int argc, char** argv) {
       group = value;
     else if (key == "--degrees")
       degrees = std::stod(value);
+    else if (key == "--pose")
+      poseFile = value;
     else
       fail("unknown option " + key);
   }
@@ -76,6 +87,11 @@ int main(int argc, char** argv) {
       logic->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode").at(0));
   auto* meshNode = vtkMRMLReposeTransferMeshNode::SafeDownCast(
       logic->GetScene()->GetNodesByClass("vtkMRMLReposeTransferMeshNode").at(0));
+  if (!poseFile.empty()) {
+    std::ifstream in(poseFile);
+    if (!in) fail(poseFile + ": cannot be read");
+    pose->SetPoseJSON(std::string(std::istreambuf_iterator<char>(in), {}));
+  }
   const auto prepareStart = Clock::now();
   if (!logic->StartLivePose(pose) || logic->WaitForJob() != vtkSlicerReposeLogic::JobSucceeded)
     fail("live pose: " + logic->GetLastErrorMessage());

@@ -248,6 +248,17 @@ class Bench:
             self.add(f"live path: {stage.replace('_', ' ')} (median / p99)", size,
                      r["tm_vertices"], s["median_ms"], "ms", "p99", s["p99_ms"],
                      s["p99_ms"] / s["median_ms"] if s["median_ms"] > 0 else float("nan"))
+        # The same drag with the left upper arm's cage vertices free: the cage's ARAP, warm-started
+        # from event to event (PoseRig::liveFrame), is in every frame.
+        log("live path: the same drag with free cage vertices (warm-started ARAP)")
+        out, _, _ = run([tool, scene, "--events", 200, "--pixels", 512, "--pose",
+                         SOURCE / "bench/live/elbow90_free_upper_arm.pose.json"])
+        r = json.loads(out)
+        for stage in ("frame", "event"):
+            s = r["stages"][stage]
+            self.add(f"live path, free cage vertices: {stage} (median / p99)", size,
+                     r["tm_vertices"], s["median_ms"], "ms", "p99", s["p99_ms"],
+                     s["p99_ms"] / s["median_ms"] if s["median_ms"] > 0 else float("nan"))
 
     # --- preprocessing and whole-file deformation ----------------------------------------------
     def preprocessing_and_warp(self, mm):

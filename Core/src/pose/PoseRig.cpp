@@ -1,5 +1,7 @@
 #include "repose/pose/PoseRig.h"
 
+#include "repose/cage/ArapDeformer.h"
+#include "repose/mesh/RigidHandles.h"
 #include "repose/util/Error.h"
 
 #include <Eigen/LU>
@@ -9,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 
@@ -232,12 +235,29 @@ TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
   return std::move(result.mesh);
 }
 
+struct PoseRig::CageArap {
+  explicit CageArap(const TriangleMesh& cage) : deformer(cage) {}
+  ArapDeformer deformer;
+  std::vector<int> held;  // the groups' cage vertices, in the order of the solve's targets
+  mutable std::mutex mutex;
+  Eigen::MatrixX3d lastLive;  // empty before the first live frame
+  int lastIterations = 0;
+};
+
 PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads,
                  int jointRings, const std::vector<BendJoint>& bends)
     : geometry_(std::move(geometry)), pose_(pose) {
   deformation_ = std::make_unique<CageDeformation>(geometry_.mesh, geometry_.cage, threads,
                                                    geometry_.coordinatesFile);
   handles_ = resolveHandles(pose_, geometry_.cage, geometry_.mesh, partLabels);
+  std::vector<int> held;
+  for (const RigidHandle& h : handles_)
+    held.insert(held.end(), h.cageVertices.begin(), h.cageVertices.end());
+  if (!held.empty() && Eigen::Index(held.size()) < geometry_.cage.vertices.rows()) {
+    arap_ = std::make_unique<CageArap>(geometry_.cage);
+    arap_->deformer.setHandles(held);
+    arap_->held = std::move(held);
+  }
   influence_ = computeHandleInfluence(geometry_.mesh, geometry_.cage, handles_, threads,
                                       jointRings >= 0 ? jointRings : pose_.jointRings);
   bends_ = JointBends(geometry_.mesh, handles_, bends);
@@ -256,23 +276,67 @@ PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision,
 
 PoseRig::Frame PoseRig::frame(const Pose& edited, std::size_t index, GreenPrecision precision,
                               FrameMaps tetMaps) const {
+  return solveEdited(edited, index, precision, tetMaps, CageStart::Rest);
+}
+
+PoseRig::Frame PoseRig::liveFrame(const Pose& edited, std::size_t index) const {
+  return solveEdited(edited, index, GreenPrecision::Preview, FrameMaps::Without,
+                     CageStart::LastLiveFrame);
+}
+
+PoseRig::Frame PoseRig::solveEdited(const Pose& edited, std::size_t index, GreenPrecision precision,
+                                    FrameMaps tetMaps, CageStart start) const {
   if (!sameHandleGroups(edited, pose_))
     throw Error("pose " + edited.name + ": its groups are not those the rig was prepared for");
   const auto frames = edited.frames();
   if (index >= frames.size())
     throw Error("pose " + edited.name + " has " + std::to_string(frames.size()) + " frames, not " +
                 std::to_string(index + 1));
-  return solveFrame(frames[index].first, frames[index].second, precision, tetMaps);
+  return solveFrame(frames[index].first, frames[index].second, precision, tetMaps, start);
+}
+
+int PoseRig::lastCageIterations() const {
+  if (!arap_) return 0;
+  std::lock_guard<std::mutex> lock(arap_->mutex);
+  return arap_->lastIterations;
+}
+
+Eigen::MatrixX3d PoseRig::posedCage(const std::vector<RigidHandle>& handles,
+                                    CageStart start) const {
+  if (!arap_) return poseCage(geometry_.cage, handles);  // every cage vertex is in a group
+  const Eigen::MatrixX3d moved = moveHandles(geometry_.cage.vertices, handles);
+  Eigen::MatrixX3d targets(Eigen::Index(arap_->held.size()), 3);
+  for (std::size_t i = 0; i < arap_->held.size(); ++i)
+    targets.row(Eigen::Index(i)) = moved.row(arap_->held[i]);
+  std::lock_guard<std::mutex> lock(arap_->mutex);
+  // Warm only for a step of a drag: after a jump (an undo, another keyframe) a few iterations from
+  // the last cage would leave it far off with no next event to converge it, so the cage is solved
+  // from rest, as frame() solves it.
+  bool warm = start == CageStart::LastLiveFrame && arap_->lastLive.rows() > 0;
+  if (warm) {
+    const Eigen::MatrixX3d& c = geometry_.cage.vertices;
+    const double diagonal = (c.colwise().maxCoeff() - c.colwise().minCoeff()).norm();
+    for (std::size_t i = 0; i < arap_->held.size() && warm; ++i)
+      warm = (targets.row(Eigen::Index(i)) - arap_->lastLive.row(arap_->held[i])).norm() <=
+             kLiveCageStep * diagonal;
+  }
+  ArapOptions options;
+  if (warm) options.maxIterations = kLiveCageIterations;
+  ArapResult r = arap_->deformer.solve(targets, warm ? &arap_->lastLive : nullptr, options);
+  arap_->lastIterations = r.iterations;
+  if (start == CageStart::LastLiveFrame) arap_->lastLive = r.positions;
+  return std::move(r.positions);
 }
 
 PoseRig::Frame PoseRig::solveFrame(const std::string& name,
                                    const std::vector<Eigen::Isometry3d>& motions,
-                                   GreenPrecision precision, FrameMaps tetMaps) const {
+                                   GreenPrecision precision, FrameMaps tetMaps,
+                                   CageStart start) const {
   Frame f;
   f.name = name;
   f.handles = handles_;
   setMotions(f.handles, motions);
-  f.cage = poseCage(geometry_.cage, f.handles);
+  f.cage = posedCage(f.handles, start);
   f.deformed = deformation_->deform(f.cage, influence_, f.handles,
                                     tetMaps == FrameMaps::With ? &f.tetMaps : nullptr, precision);
   // Tissue a group carries alone moves with it exactly, also where the cage misses it (the crotch

@@ -4,6 +4,7 @@
 #include "TestPaths.h"
 #include "TestPoses.h"
 
+#include "repose/cage/ArapDeformer.h"
 #include "repose/mesh/TransferMesh.h"
 #include "repose/phantom/Phantom.h"
 #include "repose/pose/PoseRig.h"
@@ -275,4 +276,66 @@ TEST(PoseRig, WherePiecesOfTwoPartsShareAVertexOnlyTheSmallerSideGoesSoft) {
   EXPECT_EQ(demotePiecesAcrossJoints(mesh), 1);
   EXPECT_EQ(mesh.rigid, (std::vector<int>{11, 0}));
   EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
+}
+
+// A drag whose cage has free vertices (the left upper arm is in no group, so ARAP bends it between
+// the fixed body and the turning forearm), one degree per event: each live frame takes at most
+// kLiveCageIterations ARAP iterations from the last one and stays within a tenth of a millimetre
+// of the cage frame() solves to convergence from rest; held still, it converges onto it; after a
+// jump it is that cage exactly; and frame() does not depend on the live frames before it.
+TEST(PoseRig, LiveFramesWarmStartTheCageAndEndWhereFramesFromRestEnd) {
+  const Rigged& r = rigged();
+  PhantomOptions po;
+  po.voxelMm = 4;
+  const Phantom body(po);
+  Pose pose = parsePose(R"({"format": "repose-pose", "version": 1, "name": "drag",
+    "groups": [
+      {"name": "forearm", "select": {"parts": ["forearm_left", "hand_left"]},
+       "rotation": {"axis": "elbow_left.flexion", "angle_deg": 0, "pivot": "elbow_left"}},
+      {"name": "body", "fixed": true, "select": {"parts": ["head", "torso", "upper_arm_right",
+        "forearm_right", "hand_right", "thigh_left", "shank_left", "foot_left", "thigh_right",
+        "shank_right", "foot_right"]}}]})",
+                        "drag");
+  resolvePoseJoints(pose, body.skeleton());
+  const PoseRig rig(buildRigGeometry(r.parts, {}, r.settings, {}, &r.organs), pose,
+                    r.parts.labels());
+  auto at = [&](double angle) {
+    Pose edited = pose;
+    edited.groups[0].transform.angleDeg = angle;
+    return edited;
+  };
+  auto fromRest = [&](const Pose& p) {
+    return rig.frame(p, 0, GreenPrecision::Preview, FrameMaps::Without).cage;
+  };
+  auto gap = [](const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+    return (a - b).rowwise().norm().maxCoeff();
+  };
+  const Eigen::MatrixX3d straight = fromRest(at(0));
+  int warm = 0, cold = 0, events = 0;
+  double worst = 0;
+  rig.liveFrame(at(0), 0);  // the drag's first event solves from rest
+  for (double angle = 1; angle <= 90; angle += 1, ++events) {
+    const PoseRig::Frame live = rig.liveFrame(at(angle), 0);
+    EXPECT_LE(rig.lastCageIterations(), PoseRig::kLiveCageIterations) << angle << " deg";
+    warm += rig.lastCageIterations();
+    const Eigen::MatrixX3d converged = fromRest(at(angle));
+    cold += rig.lastCageIterations();
+    worst = std::max(worst, gap(live.cage, converged));
+    ASSERT_TRUE(live.deformed.allFinite());
+  }
+  EXPECT_GT(cold, 5 * events) << "the pose must leave cage vertices for ARAP to solve";
+  EXPECT_LT(warm, cold / 3) << warm << " iterations warm, " << cold << " from rest";
+  EXPECT_LT(worst, 0.1) << "mm between a live cage and the converged one";
+  // Held still, the live cage converges: to an ARAP energy no higher than that of the cage
+  // solved from rest (which stops at the solver's tolerance), and to within 0.02 mm of it.
+  const Eigen::MatrixX3d end = fromRest(at(90));
+  Eigen::MatrixX3d held;
+  for (int n = 0; n < 6; ++n) held = rig.liveFrame(at(90), 0).cage;
+  const ArapDeformer arap(rig.cage());
+  EXPECT_LE(arap.energy(held), arap.energy(end) * (1 + 1e-9));
+  EXPECT_LT(gap(held, end), 0.02);
+  // A jump (back to 30 degrees in one event) is solved on, from rest: the same cage exactly.
+  EXPECT_EQ(rig.liveFrame(at(30), 0).cage, fromRest(at(30)));
+  // frame() after all this is the frame() before it, bit for bit.
+  EXPECT_EQ(fromRest(at(0)), straight);
 }

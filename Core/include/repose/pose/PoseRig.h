@@ -135,6 +135,22 @@ class PoseRig {
               GreenPrecision precision = GreenPrecision::Exact,
               FrameMaps tetMaps = FrameMaps::With) const;
 
+  // The frame the live view shows after each edit of a drag: preview Green coordinates, no tet
+  // maps, and the cage's free vertices (those no group holds) moved by at most
+  // kLiveCageIterations ARAP local/global iterations started from the previous live frame's
+  // cage, instead of a solve to convergence from rest (the first live frame solves from rest).
+  // Consecutive edits differ little, so the cage converges over the events of a drag and stays
+  // within a small fraction of a millimetre of the converged one (PoseRigTest). frame() never
+  // depends on what was solved before it; liveFrame() continues from the last liveFrame()
+  // (thread-safe).
+  Frame liveFrame(const Pose& edited, std::size_t index) const;
+  static constexpr int kLiveCageIterations = 3;
+  // A live edit that moves a group's cage vertex further than this fraction of the cage's
+  // diagonal (100 mm on a 2 m body) is a jump, not a step of a drag: its cage is solved from rest.
+  static constexpr double kLiveCageStep = 0.05;
+  // ARAP iterations the last cage solve took (0 when every cage vertex is in a group).
+  int lastCageIterations() const;
+
   const TriangleMesh& cage() const { return geometry_.cage; }
   const TransferMesh& mesh() const { return geometry_.mesh; }
   const CageDeformation& deformation() const { return *deformation_; }
@@ -143,8 +159,17 @@ class PoseRig {
   const Pose& pose() const { return pose_; }
 
  private:
+  enum class CageStart { Rest, LastLiveFrame };
   Frame solveFrame(const std::string& name, const std::vector<Eigen::Isometry3d>& motions,
-                   GreenPrecision precision, FrameMaps tetMaps) const;
+                   GreenPrecision precision, FrameMaps tetMaps,
+                   CageStart start = CageStart::Rest) const;
+  Frame solveEdited(const Pose& edited, std::size_t index, GreenPrecision precision,
+                    FrameMaps tetMaps, CageStart start) const;
+  Eigen::MatrixX3d posedCage(const std::vector<RigidHandle>& handles, CageStart start) const;
+  // The ARAP of the free cage vertices, factorized once for the groups' vertices (null when the
+  // groups hold every cage vertex), and the live frames' last cage.
+  struct CageArap;
+  std::unique_ptr<CageArap> arap_;
   RigGeometry geometry_;
   Pose pose_;
   std::unique_ptr<CageDeformation> deformation_;
