@@ -11,6 +11,7 @@ PACKAGES=(
   nlohmann-json3-dev libgtest-dev libbenchmark-dev
   python3-dev pybind11-dev
   python3-numpy python3-nibabel python3-pytest python3-matplotlib python3-jsonschema
+  python3-scipy python3-vtk9
   xvfb xauth libxml2-utils
   plastimatch time
   openems python3-openems libopenems-dev python3-h5py
