@@ -239,6 +239,7 @@ struct PoseRig::CageArap {
   explicit CageArap(const TriangleMesh& cage) : deformer(cage) {}
   ArapDeformer deformer;
   std::vector<int> held;  // the groups' cage vertices, in the order of the solve's targets
+  double jump = 0;        // kLiveCageStep of the rest cage's diagonal, in mm
   mutable std::mutex mutex;
   Eigen::MatrixX3d lastLive;  // empty before the first live frame
   int lastIterations = 0;
@@ -257,6 +258,8 @@ PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partL
     arap_ = std::make_unique<CageArap>(geometry_.cage);
     arap_->deformer.setHandles(held);
     arap_->held = std::move(held);
+    const Eigen::MatrixX3d& c = geometry_.cage.vertices;
+    arap_->jump = kLiveCageStep * (c.colwise().maxCoeff() - c.colwise().minCoeff()).norm();
   }
   influence_ = computeHandleInfluence(geometry_.mesh, geometry_.cage, handles_, threads,
                                       jointRings >= 0 ? jointRings : pose_.jointRings);
@@ -313,13 +316,9 @@ Eigen::MatrixX3d PoseRig::posedCage(const std::vector<RigidHandle>& handles,
   // the last cage would leave it far off with no next event to converge it, so the cage is solved
   // from rest, as frame() solves it.
   bool warm = start == CageStart::LastLiveFrame && arap_->lastLive.rows() > 0;
-  if (warm) {
-    const Eigen::MatrixX3d& c = geometry_.cage.vertices;
-    const double diagonal = (c.colwise().maxCoeff() - c.colwise().minCoeff()).norm();
-    for (std::size_t i = 0; i < arap_->held.size() && warm; ++i)
-      warm = (targets.row(Eigen::Index(i)) - arap_->lastLive.row(arap_->held[i])).norm() <=
-             kLiveCageStep * diagonal;
-  }
+  for (std::size_t i = 0; i < arap_->held.size() && warm; ++i)
+    warm =
+        (targets.row(Eigen::Index(i)) - arap_->lastLive.row(arap_->held[i])).norm() <= arap_->jump;
   ArapOptions options;
   if (warm) options.maxIterations = kLiveCageIterations;
   ArapResult r = arap_->deformer.solve(targets, warm ? &arap_->lastLive : nullptr, options);
