@@ -35,10 +35,13 @@ int runMesh(const Args& args) {
       .option("out", "FILE", "output transfer mesh (.vtu)")
       .option("size-mm", "MM", "tet size (0: 5% of the volume's diagonal)", "0")
       .option("threads", "N", "worker threads (0: all cores)", "0")
-      .flag("json", "print a JSON summary on stdout");
+      .flag("json", "print a JSON summary on stdout")
+      .flag("slicer-progress",
+            "progress as the <filter-progress> lines 3D Slicer's CLI modules print on stdout");
   declareSeparationOptions(p, "split the mesh between");
   declareMemoryOption(p, "above it a downsampled proxy of PARTS (label mode per block) is used");
   if (!p.parse(args)) return 0;
+  if (p.has("slicer-progress")) startSlicerProgress("repose mesh", "meshing " + p.get("parts"));
   for (const char* required : {"parts", "cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
   const std::optional<LimbSeparation> separation = parseSeparationOptions(p);
@@ -68,7 +71,7 @@ int runMesh(const Args& args) {
   // The embedding, its Green coordinates and the solver's factorization: what every later
   // deformation of this mesh needs. The coordinates are kept beside the mesh (tm.vtu ->
   // tm.green) so that `repose warp` reads them instead of computing them again.
-  const CageDeformation deformation(mesh, cage, threads);
+  const CageDeformation deformation(mesh, cage, threads, "", terminalProgress());
   const Embedding& embedding = deformation.embedding();
   const RigiditySolver& solver = deformation.solver();
   const std::string coordinates = greenCoordinatesFileFor(out);
@@ -107,6 +110,7 @@ int runMesh(const Args& args) {
       std::cout << "warning: " << solver.unconstrainedVertices()
                 << " vertices belong to parts with no vertex in the cage; they will not move\n";
   }
+  endSlicerProgress("repose mesh");
   return 0;
 }
 

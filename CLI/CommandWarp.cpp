@@ -222,7 +222,7 @@ int runWarp(const Args& args) {
   const int threads = static_cast<int>(p.getInt("threads"));
   const auto deformStart = std::chrono::steady_clock::now();
   const std::string coordinatesFile = warpCoordinatesFile(p);
-  const CageDeformation deformation(mesh, cage, threads, coordinatesFile);
+  const CageDeformation deformation(mesh, cage, threads, coordinatesFile, terminalProgress());
   const Eigen::MatrixX3d deformed = deformation.deform(posed.vertices);
   const double deformationSeconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - deformStart).count();

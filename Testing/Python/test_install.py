@@ -2,6 +2,7 @@
 installed `repose` finds its library beside it, runs a pose, and the folder's 3D Slicer CLI module
 answers --xml, after the folder was moved; no installed file names the source or build tree.
 """
+import csv
 import json
 import os
 import pathlib
@@ -33,12 +34,26 @@ def test_the_installed_command_runs_a_pose_from_its_folder(installed, tmp_path):
                                     cwd=tmp_path)
     r = run("--version")
     assert r.returncode == 0 and r.stdout.startswith("repose "), r.stderr
-    assert run("phantom", "--voxel", "8", "--out", tmp_path / "ph").returncode == 0
+    # 4 mm: the coarsest phantom whose bones are big enough (>= 1000 voxels) for the report to
+    # check their rigidity; at 8 mm every bone is under that floor and "bones rigid" says nothing.
+    assert run("phantom", "--voxel", "4", "--out", tmp_path / "ph").returncode == 0
     r = run("pose", "--input", tmp_path / "ph" / "G.nii.gz", "--parts", tmp_path / "ph" / "S.nii.gz",
             "--pose", REPO / "bench" / "poses" / "elbow90.pose.json", "--out", tmp_path / "o",
             "--json")
     assert r.returncode == 0, r.stderr
-    assert json.loads(r.stdout)["labels_lost"] == 0
+    report = json.loads(r.stdout)
+    assert report["labels_lost"] == 0
+    # The phantom's tissue table travels with the installed binary: without it no label is a
+    # bone, the pose bends the bones like soft tissue and nothing below would be reported.
+    assert report["tissue_table"] == "phantom default"
+    with open(REPO / "Resources" / "Tissues" / "phantom.csv") as f:
+        rigid = {int(row["label"]) for row in csv.DictReader(
+            line for line in f if not line.startswith("#")) if row["rigid"] == "1"}
+    assert rigid and rigid <= set(report["whole_pieces"]["labels"]), report["whole_pieces"]
+    checked = [t for t in report["rigid_tissues"] if t["checked"]]
+    assert {t["bone"] for t in checked} >= {"femur", "humerus", "skull", "vertebrae"}, checked
+    assert all(t["dice"] >= 0.95 for t in checked), checked
+    assert report["quality"]["bones_rigid"]["met"], report["quality"]["bones_rigid"]
 
 
 def test_the_slicer_module_folder_is_where_the_docs_say(installed):

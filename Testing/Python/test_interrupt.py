@@ -3,7 +3,6 @@
 no temporary folder)."""
 import signal
 import subprocess
-import time
 
 import pytest
 
@@ -19,13 +18,17 @@ def rig(bin_dir, tmp_path_factory):
     return folder
 
 
-def interrupt(command, out_dir, sig, after_s=1.5):
+def interrupt(command, out_dir, sig):
+    """Runs `command` with --slicer-progress and signals it once its first progress line shows
+    the work under way: an event, not a guessed delay, so neither a slow nor a fast machine
+    makes the signal land before the command listens or after it ended."""
     before = sorted(p.name for p in out_dir.iterdir())
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(after_s)
-    assert process.poll() is None, "the command ended before the signal: make it longer"
+    process = subprocess.Popen(command + ["--slicer-progress"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    started = any(line.startswith("<filter-progress>") for line in process.stdout)
+    assert started and process.poll() is None, "the command ended before the signal"
     process.send_signal(sig)
-    _, stderr = process.communicate(timeout=60)
+    _, stderr = process.communicate(timeout=120)
     assert process.returncode == 128 + sig, stderr
     lines = stderr.strip().splitlines()
     assert lines and ("interrupted" in lines[-1] or "terminated" in lines[-1]), stderr
@@ -45,8 +48,9 @@ def test_sigterm_during_warp_leaves_no_output(bin_dir, rig, tmp_path):
                         rig / "cage.obj", "--size-mm", "8.5", "--out", tm], check=True,
                        capture_output=True)
     # The cage itself as the posed cage: the identity, but the embedding runs all the same, since
-    # the Green coordinates `repose mesh` keeps beside the mesh are taken away (read, they make
-    # the whole warp take about a second, too short to interrupt reliably).
+    # the Green coordinates `repose mesh` keeps beside the mesh are taken away. Its first progress
+    # line starts seconds of work; read, they would leave only a rasterization of a fraction of a
+    # second after it, which the signal could miss.
     tm.with_suffix(".green").unlink(missing_ok=True)
     interrupt([str(bin_dir / "repose"), "warp", "--input", rig / "G.nii.gz", "--mesh", tm,
                "--cage", rig / "cage.obj", "--posed-cage", rig / "cage.obj",

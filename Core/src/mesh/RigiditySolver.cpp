@@ -8,7 +8,6 @@
 #include "TetAdjacency.h"
 #include "numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
-#include "repose/util/Interrupt.h"
 #include "repose/util/Parallel.h"
 
 #include <Eigen/LU>
@@ -346,7 +345,7 @@ Eigen::MatrixX3d greenCageValues(const TriangleMesh& rest, const Eigen::MatrixX3
 }  // namespace
 
 CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads,
-                                 const std::string& coordinatesFile)
+                                 const std::string& coordinatesFile, const ProgressFn& progress)
     : cage_(cage), threads_(threads) {
   restCageValues_ = greenCageValues(cage_, cage_.vertices);
   key_ = greenCoordinatesKey(mesh, cage_);
@@ -373,12 +372,13 @@ CageDeformation::CageDeformation(const TransferMesh& mesh, const TriangleMesh& c
     coefficients_ = std::make_unique<CompactGreenMatrix>(std::move(saved->coefficients));
     coordinatesRead_ = true;
   } else {
-    computeCoordinates(mesh, threads);
+    computeCoordinates(mesh, threads, progress);
   }
   solver_ = std::make_unique<RigiditySolver>(mesh, embedding_.cageVertices, embedding_.cageTets);
 }
 
-void CageDeformation::computeCoordinates(const TransferMesh& mesh, int threads) {
+void CageDeformation::computeCoordinates(const TransferMesh& mesh, int threads,
+                                         const ProgressFn& progress) {
   embedding_ = embedInCage(mesh, cage_, threads, false);
   // Green coordinates of V_c in blocks of rows, each compacted at once, so the double matrix
   // (12 bytes more per coefficient) never exists for the whole mesh: at the seed's sizes it would
@@ -396,7 +396,8 @@ void CageDeformation::computeCoordinates(const TransferMesh& mesh, int threads) 
         std::make_unique<CompactGreenMatrix>(n, cage_.vertices.rows(), cage_.faces.rows());
     std::vector<int> missed;
     for (Eigen::Index first = 0; first < n; first += kBlock) {
-      throwIfInterrupted();  // the embedding is the longest step without a progress callback
+      // Also the stop point of an interrupt or a cancel (a second pass, rare, starts over).
+      reportProgress(progress, double(first) / double(n), "Green coordinates");
       const Eigen::Index rows = std::min(kBlock, n - first);
       Eigen::MatrixX3d points(rows, 3);
       for (Eigen::Index r = 0; r < rows; ++r)
@@ -427,6 +428,7 @@ void CageDeformation::computeCoordinates(const TransferMesh& mesh, int threads) 
     }
     embedding_.cageTets = std::move(tets);
   }
+  reportProgress(progress, 1.0, "Green coordinates");
 }
 
 void CageDeformation::saveCoordinates(const std::string& path) const {

@@ -8,7 +8,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 using namespace repose;
 using namespace repose::test;
@@ -36,6 +39,24 @@ TEST(MeshCommand, BuildsEmbedsAndWritesTheTransferMesh) {
                     " --size-mm 30 --separate 9:5 --region sphere:-136,9,526,110 --json");
   ASSERT_EQ(sep.exitCode, 0) << sep.err;
   EXPECT_GT(nlohmann::json::parse(sep.out)["separation_vertices_added"].get<int>(), 0);
+  // With --slicer-progress the embedding, the longest step, reports its own stage from 0 to 1
+  // in order (test_interrupt.py signals on that line).
+  const CommandResult progress =
+      runCommand("repose", "mesh --parts " + parts + " --cage " + cage + " --out " +
+                               shellQuote(dir.file("p.vtu")) + " --size-mm 30 --slicer-progress");
+  ASSERT_EQ(progress.exitCode, 0) << progress.err;
+  const std::size_t stage = progress.out.find("<filter-comment>Green coordinates</filter-comment>");
+  ASSERT_NE(stage, std::string::npos) << progress.out;
+  std::vector<double> fractions;
+  const std::string open = "<filter-progress>";
+  for (std::size_t at = progress.out.find(open, stage); at != std::string::npos;
+       at = progress.out.find(open, at + 1))
+    fractions.push_back(std::stod(progress.out.substr(at + open.size())));
+  ASSERT_GE(fractions.size(), 2u) << progress.out;
+  EXPECT_EQ(fractions.front(), 0.0);
+  EXPECT_EQ(fractions.back(), 1.0);
+  EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end())) << progress.out;
+  EXPECT_NE(progress.out.find("<filter-end>"), std::string::npos) << progress.out;
   for (const std::string extra : {"--separate 5", "--size-mm -3", ""}) {
     const std::string out = dir.file("bad.vtu");
     const std::string cmd = extra.empty() ? "mesh --parts " + parts + " --out " + shellQuote(out)

@@ -208,17 +208,18 @@ TEST(NrrdIO, BadInputGivesOneLineErrors) {
       "NRRD0004\ntype: short\ndimension: 3\nspace: left-posterior-superior\n"
       "sizes: 4 4 4\nspace directions: (1,0,0) (0,1,0) (0,0,1)\nendian: little\n";
   expectError("short.nrrd", head + "encoding: raw\n\n" + std::string(10, 'x'), "truncated");
-  expectError("garbage.nrrd", "this is not a nrrd file\n", "");
-  expectError(
-      "type.nrrd",
-      "NRRD0004\ntype: block\nblock size: 3\ndimension: 3\nsizes: 2 2 2\nencoding: raw\n\n" +
-          std::string(24, 'x'),
-      "");
+  expectError("garbage.nrrd", "this is not a nrrd file\n", "as magic");
+  expectError("type.nrrd",
+              "NRRD0004\ntype: block\nblock size: 3\ndimension: 3\nsizes: 2 2 2\nendian: "
+              "little\nencoding: raw\n\n" +
+                  std::string(24, 'x'),
+              "unsupported voxel type block");
   expectError("twod.nrrd",
               "NRRD0004\ntype: short\ndimension: 2\nsizes: 2 2\nendian: little\nencoding: raw\n\n" +
                   std::string(8, 'x'),
               "2D");
-  expectError("missingdata.nhdr", head + "encoding: raw\ndata file: nowhere.raw\n", "");
+  expectError("missingdata.nhdr", head + "encoding: raw\ndata file: nowhere.raw\n",
+              "couldn't open \"" + dir.file("nowhere.raw") + "\"");
   expectError("badgz.nrrd", head + "encoding: gzip\n\nnot gzip at all", "truncated or corrupt");
   // Regression (Testing/Fuzz/FuzzSegNrrd): a field of ~1,000-1,900 characters that teem cannot
   // parse overflowed teem's error buffer on the stack; it is refused before teem reads it.

@@ -5,6 +5,7 @@
 
 #include "repose/mesh/Embedding.h"
 #include "repose/mesh/RigidHandles.h"
+#include "repose/util/Progress.h"
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -60,8 +61,10 @@ enum class GreenPrecision { Exact, Preview };
 // written for this very mesh and cage, and computed otherwise, with coordinatesNote() saying why.
 class CageDeformation {
  public:
+  // `progress` follows the computation of the coordinates (stage "Green coordinates", the
+  // longest step of a mesh or an uncached warp) and can stop it there; reading them reports none.
   CageDeformation(const TransferMesh& mesh, const TriangleMesh& cage, int threads = 0,
-                  const std::string& coordinatesFile = "");
+                  const std::string& coordinatesFile = "", const ProgressFn& progress = {});
   ~CageDeformation();
   CageDeformation(CageDeformation&&) noexcept;
   CageDeformation& operator=(CageDeformation&&) noexcept;
@@ -98,7 +101,7 @@ class CageDeformation {
 
  private:
   // embedInCage without coordinates, then V_c's coordinates block by block.
-  void computeCoordinates(const TransferMesh& mesh, int threads);
+  void computeCoordinates(const TransferMesh& mesh, int threads, const ProgressFn& progress);
   // Throws repose::Error for a wrong vertex count, a non-finite vertex, or a vertex more than
   // 1000 cage sizes from the rest cage (a handle moved too far).
   void checkPosedCage(const Eigen::MatrixX3d& deformedCage) const;
