@@ -4,15 +4,8 @@
 
 #include "qSlicerReposeModuleWidget.h"
 #include "qSlicerReposeViewsWidget.h"
-#include "vtkMRMLReposeCageNode.h"
 #include "vtkMRMLReposeParametersNode.h"
-#include "vtkMRMLReposeTransferMeshNode.h"
-#include "vtkMRMLReposePoseNode.h"
-#include "vtkMRMLReposeScene.h"
-#include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeLogic.h"
-
-#include <repose/pose/Pose.h>
 
 #include <QDir>
 #include <QFileInfo>
@@ -108,54 +101,12 @@ bool qSlicerReposeModule::openFile(const QString& path, QString* errorMessage) {
 }
 
 bool qSlicerReposeModule::openScene(const QString& folder, QString* errorMessage) {
-  if (!this->Logic->LoadScene(folder.toStdString())) {
-    if (errorMessage) *errorMessage = QString::fromStdString(this->Logic->GetLastErrorMessage());
-    return false;
-  }
-  // The panel shows the scene's first segmentation and pose; a rigged pose goes live (on the
-  // worker: the panel's job timer commits it and the views follow).
-  vtkMRMLReposeScene* scene = this->Logic->GetScene();
-  const auto segs = scene->GetNodesByClass("vtkMRMLReposeSegmentationNode");
-  const auto poses = scene->GetNodesByClass("vtkMRMLReposePoseNode");
-  auto* seg = segs.empty() ? nullptr : vtkMRMLReposeSegmentationNode::SafeDownCast(segs.front());
-  auto* pose = poses.empty() ? nullptr : vtkMRMLReposePoseNode::SafeDownCast(poses.front());
-  const int state = this->ParameterNode->StartModify();
-  if (seg) {
-    this->ParameterNode->SetInputSegmentationNodeID(seg->GetID());
-    this->ParameterNode->SetBodyPartMapPath(seg->GetBodyPartMapFileName());
-    this->ParameterNode->SetImagePath(seg->GetImageFileName());
-  }
-  if (pose) {
-    this->ParameterNode->SetActivePoseNodeID(pose->GetID());
-    const QString file = QString::fromStdString(pose->GetFileName());
-    this->ParameterNode->SetPosePath(
-        (QFileInfo(file).isRelative() ? folder + "/" + file : file).toStdString());
-    for (const repose::PoseGroup& g :
-         repose::parsePose(pose->GetPoseJSON(), pose->GetName()).groups)
-      if (!g.fixed) {
-        this->ParameterNode->SetActiveGroup(g.name);
-        break;
-      }
-  }
-  if (auto* cage = pose
-                       ? vtkMRMLReposeCageNode::SafeDownCast(scene->GetReferencedNode(pose, "cage"))
-                       : nullptr) {
-    this->ParameterNode->SetCageVertexCount(cage->GetTargetVertexCount());
-    this->ParameterNode->SetCageDilationMm(cage->GetDilationMm());
-  }
-  if (auto* mesh = pose ? vtkMRMLReposeTransferMeshNode::SafeDownCast(
-                              scene->GetReferencedNode(pose, "transfer_mesh"))
-                        : nullptr)
-    this->ParameterNode->SetTransferMeshSizeMm(mesh->GetSizeMm());
-  this->ParameterNode->EndModify(state);
-  if (seg) this->Logic->LoadVolume(seg->GetLabelMapFileName());  // the Input box's summary
-  if (pose && scene->GetReferencedNode(pose, "transfer_mesh") &&
-      !this->Logic->StartLivePose(pose)) {
-    if (errorMessage) *errorMessage = QString::fromStdString(this->Logic->GetLastErrorMessage());
-    return false;
-  }
-  this->Logic->Modified();
-  return true;
+  // The Logic loads the scene, points the parameter node (and so every panel) at it and makes a
+  // rigged pose live; the module only reports.
+  const bool ok = this->Logic->OpenScene(folder.toStdString());
+  if (!ok && errorMessage)
+    *errorMessage = QString::fromStdString(this->Logic->GetLastErrorMessage());
+  return ok;
 }
 
 QWidget* qSlicerReposeModule::createViewRepresentation(QWidget* parent) {

@@ -135,6 +135,17 @@ double ArgParser::getDouble(const std::string& name) const {
   return d;
 }
 
+std::optional<double> ArgParser::getDoubleUnless(const std::string& name,
+                                                 const std::string& word) const {
+  if (get(name) == word) return std::nullopt;
+  const std::string v = get(name);
+  char* end = nullptr;
+  const double d = std::strtod(v.c_str(), &end);
+  if (v.empty() || *end != '\0')
+    throw UsageError{"--" + name + " expects a number or '" + word + "', got '" + v + "'"};
+  return d;
+}
+
 long ArgParser::getInt(const std::string& name) const {
   const std::string v = get(name);
   char* end = nullptr;

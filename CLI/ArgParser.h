@@ -3,6 +3,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,8 @@ class ArgParser {
   std::string get(const std::string& name) const;   // value or default; positionals by name
   double getDouble(const std::string& name) const;  // UsageError naming the option if not a number
   long getInt(const std::string& name) const;
+  // A number, or nothing when the value is `word` (a default decided elsewhere, e.g. "min").
+  std::optional<double> getDoubleUnless(const std::string& name, const std::string& word) const;
 
  private:
   struct Spec {

@@ -105,7 +105,10 @@ int runPose(const Args& args) {
   p.option("input", "FILE", "label map G (NIfTI, NRRD, .seg.nrrd)")
       .option("parts", "FILE", "body-part map S on G's grid (the cage and mesh follow it)")
       .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
-      .option("background", "VALUE", "image value where no tissue is (with --image)", "0")
+      .option("background", "VALUE",
+              "image value where no tissue is (with --image): a number, or min for the image's "
+              "minimum (air in a CT)",
+              "min")
       .option("pose", "FILE", "pose file (*.pose.json, docs/POSES.md)")
       .option("out", "DIR",
               "output folder (created if missing; its parent must exist); may be left out when "
@@ -204,6 +207,7 @@ int runPose(const Args& args) {
   request.autoSeparate = !p.has("no-auto-separate");
   const double spacingMm = p.getDouble("spacing-mm");
   if (!(spacingMm >= 0)) throw UsageError{"--spacing-mm must be >= 0"};
+  const std::optional<double> background = p.getDoubleUnless("background", "min");
   std::optional<ScratchFolder> scratch;
   if (!p.has("out"))
     scratch.emplace(!single.labels.empty()      ? single.labels
@@ -292,7 +296,7 @@ int runPose(const Args& args) {
   fs::create_directories(outDir);
   PoseFrameOptions fo = job.frameOptions();
   fo.image = image ? &*image : nullptr;
-  fo.background = p.getDouble("background");
+  fo.background = background;  // unset: the image's minimum (Core's rule)
   fo.spacingMm = spacingMm;
   fo.fillPockets = !p.has("keep-pockets");
   fo.preserveLabelVolumes = p.get("label-volumes") == "preserve";
@@ -303,12 +307,8 @@ int runPose(const Args& args) {
     // Memory: the posed G and S, the image and the field beside the inputs, refused above the
     // budget before anything is allocated.
     fo.checkGrid = [&](const VolumeGeometry& grid) {
-      const double need = double(grid.numVoxels()) * posedBytesPerVoxel(organs, parts, fo.image);
-      if (peakResidentBytes() + need > budget)
-        throw Error(outDir + ": frame " + frameName + " needs " + gib(need) + " for " +
-                    std::to_string(grid.numVoxels()) + " output voxels beyond the " +
-                    gib(peakResidentBytes()) + " in use, more than the budget of " + gib(budget) +
-                    " (out-of-core posing: `repose warp`)");
+      checkFrameMemory(grid, posedBytesPerVoxel(organs, parts, fo.image), budget,
+                       outDir + ": frame " + frameName, "--memory; out of core: `repose warp`");
       say("frame " + frameName + ": " + std::to_string(grid.dims[0]) + " x " +
           std::to_string(grid.dims[1]) + " x " + std::to_string(grid.dims[2]) + " voxels");
     };

@@ -17,6 +17,7 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
+#include "repose/pose/PoseFrame.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
@@ -148,7 +149,10 @@ int runWarp(const Args& args) {
       .option("out", "FILE", "posed label map")
       .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
       .option("image-out", "FILE", "posed image (with --image)")
-      .option("background", "VALUE", "image value where no tissue is (with --image)", "0")
+      .option("background", "VALUE",
+              "image value where no tissue is (with --image): a number, or min for the image's "
+              "minimum (air in a CT)",
+              "min")
       .option("transform-out", "FILE",
               "displacement-field transform (.nrrd, LPS, output->input as ITK and Slicer use)")
       .option("spacing-mm", "MM", "output voxel size along every axis (0: the input's)", "0")
@@ -170,6 +174,7 @@ int runWarp(const Args& args) {
   if (p.has("slicer-progress")) startSlicerProgress("repose warp", "warping " + p.get("input"));
   for (const char* required : {"input", "mesh", "cage", "posed-cage", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
+  const std::optional<double> background = p.getDoubleUnless("background", "min");
   if (p.has("image") != p.has("image-out")) throw UsageError{"--image and --image-out go together"};
   const std::string out = p.get("out");
   const std::string transformOut = p.has("transform-out") ? p.get("transform-out") : "";
@@ -274,8 +279,8 @@ int runWarp(const Args& args) {
     const Volume posedLabels = rasterizeLabels(*labels, mesh, deformed, grid, ro, &report);
     if (p.has("image")) {
       const Volume image = readVolume(p.get("image"), readOptionsWithin(budget, false));
-      const Volume posedImage =
-          rasterizeImage(image, mesh, deformed, grid, p.getDouble("background"), ro);
+      const Volume posedImage = rasterizeImage(
+          image, mesh, deformed, grid, background ? *background : imageBackground(image), ro);
       writeVolume(posedImage, imageFile->tempPath());
     }
     if (p.has("transform-out"))

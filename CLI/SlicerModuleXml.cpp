@@ -80,13 +80,14 @@ Parameter imageInput() {
           "An optional intensity image on G's grid, posed alongside."};
 }
 Parameter backgroundOption() {
-  return {"double",
+  return {"string",
           "",
           "background",
           "Image background",
           "",
-          "0",
-          "The image's value where no tissue is."};
+          "min",
+          "The image's value where no tissue is: a number, or min for the image's minimum (air "
+          "in a CT)."};
 }
 Parameter fieldOutput(const char* name) {
   return {"transform",

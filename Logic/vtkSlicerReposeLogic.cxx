@@ -71,7 +71,7 @@ bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
   this->VolumeImageData = nullptr;
   this->VolumeIJKToRASMatrix = nullptr;
   this->VolumeLookupTable = nullptr;
-  this->VolumeLabelTable = {};
+  this->VolumeLabelNames.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath = path;  // before the node is told, so its Modified does not reload
   this->LastErrorMessage.clear();
@@ -81,7 +81,8 @@ bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
     this->VolumeImageData = vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =
         vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);
-    this->VolumeLabelTable = volume.labels();
+    for (const repose::Label& l : volume.labels().labels())
+      this->VolumeLabelNames.push_back({l.layer, l.value, l.name});
     if (volume.isLabelMap())
       this->VolumeLabelsPresent = static_cast<int>(repose::countLabels(volume).size());
     this->VolumeLookupTable = vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels());
@@ -102,11 +103,17 @@ void vtkSlicerReposeLogic::ClearVolume() {
   this->VolumeImageData = nullptr;
   this->VolumeIJKToRASMatrix = nullptr;
   this->VolumeLookupTable = nullptr;
-  this->VolumeLabelTable = {};
+  this->VolumeLabelNames.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath.clear();
   this->LastErrorMessage.clear();
   this->Modified();
+}
+
+vtkSmartPointer<vtkLookupTable> vtkSlicerReposeLogic::GetLabelLookupTable(vtkImageData* labelMap) {
+  if (!labelMap) return nullptr;
+  return vtkSlicerReposeVolumeConversion::ToLookupTable(
+      vtkSlicerReposeVolumeConversion::GetLabelTable(labelMap));
 }
 
 std::string vtkSlicerReposeLogic::GetVolumeSummary() const {
@@ -128,7 +135,7 @@ std::string vtkSlicerReposeLogic::GetVolumeSummary() const {
   if (this->VolumeLabelsPresent < 0)
     out << "Labels: none (not a label map)";
   else
-    out << "Labels: " << this->VolumeLabelsPresent << " present, " << this->VolumeLabelTable.size()
+    out << "Labels: " << this->VolumeLabelsPresent << " present, " << this->VolumeLabelNames.size()
         << " named";
   return out.str();
 }

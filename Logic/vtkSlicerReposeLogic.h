@@ -4,8 +4,6 @@
 
 #include "vtkSlicerReposeModuleLogicExport.h"
 
-#include <repose/volume/LabelTable.h>
-
 #include "vtkMRMLReposeParametersNode.h"
 
 #include <vtkImageData.h>
@@ -55,7 +53,12 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   vtkImageData* GetVolumeImageData() const { return this->VolumeImageData; }
   vtkMatrix4x4* GetVolumeIJKToRASMatrix() const { return this->VolumeIJKToRASMatrix; }
   vtkLookupTable* GetVolumeLookupTable() const { return this->VolumeLookupTable; }
-  const repose::LabelTable& GetVolumeLabelTable() const { return this->VolumeLabelTable; }
+  // The names of its label table (the file's), by layer and value.
+  struct LabelName {
+    int layer = 0, value = 0;
+    std::string name;
+  };
+  const std::vector<LabelName>& GetVolumeLabelNames() const { return this->VolumeLabelNames; }
   // Distinct non-zero (layer, value) pairs in the voxels; -1 when the volume is not a
   // label map (an intensity image) or there is none.
   int GetVolumeLabelsPresent() const { return this->VolumeLabelsPresent; }
@@ -66,6 +69,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // Several lines for an info box: dimensions, spacing, orientation codes, scalar type, layers,
   // labels present and named. Empty when no volume is loaded.
   std::string GetVolumeSummary() const;
+  // A display lookup table of a label map a node holds (the colours of the label table it
+  // carries, layer 0); null for a null image.
+  static vtkSmartPointer<vtkLookupTable> GetLabelLookupTable(vtkImageData* labelMap);
 
   // ---- The pipeline on the nodes of a scene (vtkSlicerReposeLogicPipeline.cxx) ----
   // The logic creates an empty scene; a caller may give its own.
@@ -79,6 +85,18 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
                                                  const std::string& imagePath = "");
   // Reads and validates a pose file into a new pose node (null and a message on failure).
   vtkMRMLReposePoseNode* AddPose(const std::string& path);
+  // What a panel shows of a pose node, parsed once per change of the node: the groups a user can
+  // turn (not fixed, in the file's order), the number of keyframes, the separations as
+  // "part A | part B" (names, else label values). `valid` is false, with `error`, for a pose
+  // text that does not parse.
+  struct PoseSummary {
+    bool valid = false;
+    std::string error;
+    std::vector<std::string> movableGroups;
+    int keyframes = 0;
+    std::vector<std::string> separations;
+  };
+  PoseSummary GetPoseSummary(vtkMRMLReposePoseNode* pose) const;
 
   // Long steps run one at a time on a worker thread; the nodes they make are added to the scene
   // by WaitForJob/PollJob on the calling thread, and only when the step finished, so a cancelled
@@ -162,6 +180,11 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // scene.json last; loading replaces the scene only if every file read.
   bool SaveScene(const std::string& folder);
   bool LoadScene(const std::string& folder);
+  // What a module or application does when a user opens a folder: LoadScene, then the parameter
+  // node follows the scene (its first segmentation's S and image paths, its first pose as the
+  // active one with its file and first movable group, the cage's and transfer mesh's settings),
+  // G is the current volume, and a rigged pose goes live (a job). False with a message.
+  bool OpenScene(const std::string& folder);
 
   // ---- Live posing while a pose is edited (vtkSlicerReposeLogicLive.cxx) ----
   // Prepares a pose node whose rig is built for interactive frames: G converted, the transfer
@@ -239,7 +262,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   vtkSmartPointer<vtkImageData> VolumeImageData;
   vtkSmartPointer<vtkMatrix4x4> VolumeIJKToRASMatrix;
   vtkSmartPointer<vtkLookupTable> VolumeLookupTable;
-  repose::LabelTable VolumeLabelTable;
+  std::vector<LabelName> VolumeLabelNames;
   int VolumeLabelsPresent = -1;
   std::string VolumePath;
   std::string LastErrorMessage;
@@ -258,4 +281,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   bool Interacting = false, InteractionRecorded = false;
   struct LiveSession;
   std::shared_ptr<LiveSession> Live;  // shared_ptr: its type is complete only in the Live file
+  // GetPoseSummary's last answer, for the node and modification time it was parsed at.
+  mutable const vtkMRMLReposePoseNode* SummarizedPose = nullptr;
+  mutable vtkMTimeType SummarizedTime = 0;
+  mutable PoseSummary Summary;
 };

@@ -66,9 +66,11 @@ vtkSmartPointer<vtkPolyData> bodySurface(const repose::TransferMesh& mesh,
   return poly;
 }
 
-// The image's background (its minimum) and a grey window: CT's soft-tissue window when the
-// values are Hounsfield units (air near -1000), else the 1st..99th percentile of a sample.
+// The image's background (repose::imageBackground, as the export has it) and a grey window: CT's
+// soft-tissue window when the values are Hounsfield units (air near -1000), else the 1st..99th
+// percentile of a sample.
 void imageWindow(const repose::Volume& image, double& background, double& window, double& level) {
+  background = repose::imageBackground(image);
   std::vector<double> sample;
   const std::int64_t n = image.numVoxels();
   const std::int64_t stride = std::max<std::int64_t>(1, n / 200000);
@@ -79,7 +81,6 @@ void imageWindow(const repose::Volume& image, double& background, double& window
   });
   if (sample.empty()) return;
   std::sort(sample.begin(), sample.end());
-  background = sample.front();
   const double lo = sample[sample.size() / 100], hi = sample[sample.size() * 99 / 100];
   if (background <= -900 && background >= -1100 && hi > 0) {
     window = 400;

@@ -27,6 +27,7 @@
 #include <repose/pose/SlicerSceneMrml.h>
 #include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
+#include <repose/schema/SceneSchema.h>
 #include <repose/util/Error.h>
 
 #include <nlohmann/json.hpp>
@@ -355,31 +356,18 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
     // Tissues, skeleton and the joints' bends as `repose pose` has them.
     const std::shared_ptr<const repose::PoseJob> job = this->PoseJobFor(seg, pose, *G, *S);
-    // Memory: the posed G, S and image and the displacement field (3 floats a voxel), refused
-    // above the budget with the numbers: first on the input's grid (here), then on the frame's
-    // (on the worker, before any voxel is written).
+    // Memory: the posed G, S and image and the displacement field beside what the workbench
+    // holds, by the rule `repose pose` has (repose::checkFrameMemory): first on the input's grid
+    // (here), then on the frame's (on the worker, before any voxel is written). 0 MiB: half the
+    // physical memory, as --memory's default.
     const double budget =
-        1048576.0 * (this->ParameterNode ? this->ParameterNode->GetOutputMemoryBudgetMB() : 4096);
+        1048576.0 * (this->ParameterNode ? this->ParameterNode->GetOutputMemoryBudgetMB() : 0);
     const double bytesPerVoxel = repose::posedBytesPerVoxel(*G, *S, I.get());
-    auto checkBudget = [budget, bytesPerVoxel](std::int64_t voxels) {
-      const double need = double(voxels) * bytesPerVoxel;
-      if (need > budget) {
-        std::ostringstream m;
-        m << std::fixed << std::setprecision(2) << "the posed volumes need " << need / 1073741824.0
-          << " GiB for " << voxels << " voxels, more than the memory budget of "
-          << budget / 1073741824.0 << " GiB (Output > Memory budget; out of core: `repose warp`)";
-        throw repose::Error(m.str());
-      }
+    auto checkBudget = [budget, bytesPerVoxel](const repose::VolumeGeometry& grid) {
+      repose::checkFrameMemory(grid, bytesPerVoxel, budget, "the posed volumes",
+                               "Output > Memory budget; out of core: `repose warp`");
     };
-    checkBudget(G->numVoxels());
-    // Where no tissue is, the image's own minimum (air in a CT), not 0.
-    double background = 0;
-    if (I)
-      repose::dispatchScalar(I->scalarType(), [&](auto* tag) {
-        using T = std::remove_pointer_t<decltype(tag)>;
-        const T* v = I->data<T>();
-        background = I->numVoxels() ? double(*std::min_element(v, v + I->numVoxels())) : 0.0;
-      });
+    checkBudget(G->geometry());
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(
@@ -390,9 +378,8 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           const std::unique_ptr<repose::PoseRig> rig = job->makeRig(std::move(geometry));
           // The frame as `repose pose` poses it (one implementation: repose::poseFrame).
           repose::PoseFrameOptions fo = job->frameOptions();
-          fo.image = I.get();
-          fo.background = background;
-          fo.checkGrid = [&](const repose::VolumeGeometry& grid) { checkBudget(grid.numVoxels()); };
+          fo.image = I.get();  // where no tissue is: Core's rule (imageBackground)
+          fo.checkGrid = checkBudget;
           fo.progress = [&](double x, const std::string& stage) {
             return progress(0.1 + 0.8 * x, stage);
           };
@@ -550,7 +537,8 @@ bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
     }
     repose::writeTextFileAtomically((dir / "scene.mrml").string(),
                                     repose::formatSlicerScene(mrml, dir.string()));
-    repose::writeTextFileAtomically((dir / "scene.json").string(), this->Scene->WriteJSON() + "\n");
+    repose::writeTextFileAtomically((dir / repose::scene_schema::kDocument).string(),
+                                    this->Scene->WriteJSON() + "\n");
     return true;
   } catch (const std::exception& e) {
     this->LastErrorMessage = e.what();
@@ -564,8 +552,8 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
     const fs::path dir = folder;
     vtkNew<vtkMRMLReposeScene> loaded;
     std::string error;
-    if (!loaded->ReadJSON(readText((dir / "scene.json").string()), &error))
-      throw repose::Error((dir / "scene.json").string() + ": " + error);
+    if (!loaded->ReadJSON(readText((dir / repose::scene_schema::kDocument).string()), &error))
+      throw repose::Error((dir / repose::scene_schema::kDocument).string() + ": " + error);
     auto need = [&](const std::string& name, vtkMRMLReposeNode* node) {
       if (name.empty())
         throw repose::Error(folder + ": node " + node->GetID() + " names no data file");
@@ -612,4 +600,75 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
     this->LastErrorMessage = e.what();
     return false;
   }
+}
+
+bool vtkSlicerReposeLogic::OpenScene(const std::string& folder) {
+  if (!this->LoadScene(folder)) return false;
+  if (!this->ParameterNode) return true;
+  const auto segs = this->Scene->GetNodesByClass("vtkMRMLReposeSegmentationNode");
+  const auto poses = this->Scene->GetNodesByClass("vtkMRMLReposePoseNode");
+  auto* seg = segs.empty() ? nullptr : vtkMRMLReposeSegmentationNode::SafeDownCast(segs.front());
+  auto* pose = poses.empty() ? nullptr : vtkMRMLReposePoseNode::SafeDownCast(poses.front());
+  // The nodes name their files relative to the folder (or absolute, as the command line writes).
+  auto inFolder = [&](const std::string& name) {
+    return name.empty() || fs::path(name).is_absolute() ? name : (fs::path(folder) / name).string();
+  };
+  vtkMRMLReposeParametersNode* p = this->ParameterNode;
+  const int state = p->StartModify();
+  if (seg) {
+    p->SetInputSegmentationNodeID(seg->GetID());
+    p->SetBodyPartMapPath(inFolder(seg->GetBodyPartMapFileName()));
+    p->SetImagePath(inFolder(seg->GetImageFileName()));
+  }
+  if (pose) {
+    p->SetActivePoseNodeID(pose->GetID());
+    p->SetPosePath(inFolder(pose->GetFileName()));
+    const PoseSummary summary = this->GetPoseSummary(pose);
+    if (!summary.movableGroups.empty()) p->SetActiveGroup(summary.movableGroups.front());
+    if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(
+            this->Scene->GetReferencedNode(pose, repose::scene_schema::kCageRole))) {
+      p->SetCageVertexCount(cage->GetTargetVertexCount());
+      p->SetCageDilationMm(cage->GetDilationMm());
+    }
+    if (auto* mesh = vtkMRMLReposeTransferMeshNode::SafeDownCast(
+            this->Scene->GetReferencedNode(pose, repose::scene_schema::kTransferMeshRole)))
+      p->SetTransferMeshSizeMm(mesh->GetSizeMm());
+  }
+  p->EndModify(state);
+  // The input box shows G (read again from its file: the node holds its voxels, not its table).
+  if (seg && !this->LoadVolume(inFolder(seg->GetLabelMapFileName()))) return false;
+  // A rigged pose goes live (a job: PollJob/WaitForJob commits it).
+  if (pose && this->Scene->GetReferencedNode(pose, repose::scene_schema::kTransferMeshRole) &&
+      !this->StartLivePose(pose))
+    return false;
+  this->Modified();
+  return true;
+}
+
+vtkSlicerReposeLogic::PoseSummary vtkSlicerReposeLogic::GetPoseSummary(
+    vtkMRMLReposePoseNode* pose) const {
+  if (!pose) return {};
+  if (pose == this->SummarizedPose && pose->GetMTime() == this->SummarizedTime)
+    return this->Summary;
+  PoseSummary s;
+  try {
+    const repose::Pose p = repose::parsePose(pose->GetPoseJSON(), pose->GetName());
+    for (const repose::PoseGroup& g : p.groups)
+      if (!g.fixed) s.movableGroups.push_back(g.name);
+    s.keyframes = int(p.keyframes.size());
+    for (const repose::PoseSeparation& sep : p.separations) {
+      auto part = [&](int k) {
+        return sep.partNames[std::size_t(k)].empty() ? std::to_string(sep.parts[std::size_t(k)])
+                                                     : sep.partNames[std::size_t(k)];
+      };
+      s.separations.push_back(part(0) + " | " + part(1));
+    }
+    s.valid = true;
+  } catch (const std::exception& e) {
+    s.error = e.what();
+  }
+  this->SummarizedPose = pose;
+  this->SummarizedTime = pose->GetMTime();
+  this->Summary = s;
+  return s;
 }

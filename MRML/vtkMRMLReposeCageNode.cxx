@@ -1,6 +1,9 @@
 #include "vtkMRMLReposeCageNode.h"
 
 #include <vtkObjectFactory.h>
+#include "repose/schema/SceneSchema.h"
+
+namespace sc = repose::scene_schema;
 
 vtkStandardNewMacro(vtkMRMLReposeCageNode);
 
@@ -10,43 +13,47 @@ void vtkMRMLReposeCageNode::SetMesh(vtkPolyData* mesh) {
 }
 
 void vtkMRMLReposeCageNode::WriteFields(nlohmann::ordered_json& json) const {
-  json["FileName"] = this->FileName;
-  json["TargetVertexCount"] = this->TargetVertexCount;
-  json["DilationMm"] = this->DilationMm;
+  json[sc::cage::kFile] = this->FileName;
+  json[sc::cage::kTargetVertexCount] = this->TargetVertexCount;
+  json[sc::cage::kDilationMm] = this->DilationMm;
   nlohmann::ordered_json groups = nlohmann::ordered_json::array();
   for (const HandleGroup& g : this->HandleGroups)
-    groups.push_back({{"name", g.name}, {"vertices", g.vertices}});
-  json["HandleGroups"] = groups;
+    groups.push_back({{sc::cage::kGroupName, g.name}, {sc::cage::kGroupVertices, g.vertices}});
+  json[sc::cage::kHandleGroups] = groups;
 }
 
 bool vtkMRMLReposeCageNode::ReadFields(const nlohmann::json& json, bool apply, std::string& error) {
   if (!apply) {
-    if (!CheckString(json, "FileName", error) || !CheckInteger(json, "TargetVertexCount", error) ||
-        !CheckNumber(json, "DilationMm", error))
+    if (!CheckString(json, sc::cage::kFile, error) ||
+        !CheckInteger(json, sc::cage::kTargetVertexCount, error) ||
+        !CheckNumber(json, sc::cage::kDilationMm, error))
       return false;
-    if (json.contains("HandleGroups")) {
-      const auto& groups = json["HandleGroups"];
+    if (json.contains(sc::cage::kHandleGroups)) {
+      const auto& groups = json[sc::cage::kHandleGroups];
       if (!groups.is_array()) return error = "HandleGroups: expected an array", false;
       for (std::size_t i = 0; i < groups.size(); ++i) {
         const std::string f = "HandleGroups[" + std::to_string(i) + "]";
         const auto& g = groups[i];
-        if (!g.is_object() || !g.contains("name") || !g["name"].is_string() ||
-            !g.contains("vertices") || !g["vertices"].is_array())
+        if (!g.is_object() || !g.contains(sc::cage::kGroupName) ||
+            !g[sc::cage::kGroupName].is_string() || !g.contains(sc::cage::kGroupVertices) ||
+            !g[sc::cage::kGroupVertices].is_array())
           return error = f + ": expected {\"name\": text, \"vertices\": [indices]}", false;
-        for (const auto& v : g["vertices"])
+        for (const auto& v : g[sc::cage::kGroupVertices])
           if (!v.is_number_integer() || v.get<long long>() < 0)
             return error = f + ".vertices: expected non-negative integers", false;
       }
     }
     return true;
   }
-  if (json.contains("FileName")) this->SetFileName(json["FileName"]);
-  if (json.contains("TargetVertexCount")) this->SetTargetVertexCount(json["TargetVertexCount"]);
-  if (json.contains("DilationMm")) this->SetDilationMm(json["DilationMm"]);
-  if (json.contains("HandleGroups")) {
+  if (json.contains(sc::cage::kFile)) this->SetFileName(json[sc::cage::kFile]);
+  if (json.contains(sc::cage::kTargetVertexCount))
+    this->SetTargetVertexCount(json[sc::cage::kTargetVertexCount]);
+  if (json.contains(sc::cage::kDilationMm)) this->SetDilationMm(json[sc::cage::kDilationMm]);
+  if (json.contains(sc::cage::kHandleGroups)) {
     std::vector<HandleGroup> groups;
-    for (const auto& g : json["HandleGroups"])
-      groups.push_back({g["name"].get<std::string>(), g["vertices"].get<std::vector<int>>()});
+    for (const auto& g : json[sc::cage::kHandleGroups])
+      groups.push_back({g[sc::cage::kGroupName].get<std::string>(),
+                        g[sc::cage::kGroupVertices].get<std::vector<int>>()});
     this->SetHandleGroups(groups);
   }
   return true;

@@ -1,4 +1,7 @@
 #include "vtkMRMLReposeNode.h"
+#include "repose/schema/SceneSchema.h"
+
+namespace sc = repose::scene_schema;
 
 void vtkMRMLReposeNode::SetID(const std::string& id) {
   this->SetField(this->ID, id);
@@ -25,10 +28,10 @@ std::string vtkMRMLReposeNode::GetNodeReferenceID(const std::string& role) const
 }
 
 nlohmann::ordered_json vtkMRMLReposeNode::ToJSON() const {
-  nlohmann::ordered_json json = {{"class", this->GetNodeClassName()},
-                                 {"id", this->ID},
-                                 {"name", this->Name},
-                                 {"references", this->References}};
+  nlohmann::ordered_json json = {{sc::kClass, this->GetNodeClassName()},
+                                 {sc::kId, this->ID},
+                                 {sc::kName, this->Name},
+                                 {sc::kReferences, this->References}};
   this->WriteFields(json);
   return json;
 }
@@ -53,21 +56,21 @@ bool vtkMRMLReposeNode::FromJSON(const nlohmann::json& json, std::string* error)
     return false;
   };
   if (!json.is_object()) return fail("expected an object");
-  if (json.contains("class") && json["class"] != this->GetNodeClassName())
-    return fail("class is " + json["class"].dump() + ", not " + this->GetNodeClassName());
-  if (json.contains("id") && !json["id"].is_string()) return fail("id: expected a string");
-  if (!CheckString(json, "name", problem)) return fail(problem);
-  if (json.contains("references")) {
-    if (!json["references"].is_object()) return fail("references: expected an object");
-    for (const auto& [role, id] : json["references"].items())
+  if (json.contains(sc::kClass) && json[sc::kClass] != this->GetNodeClassName())
+    return fail("class is " + json[sc::kClass].dump() + ", not " + this->GetNodeClassName());
+  if (json.contains(sc::kId) && !json[sc::kId].is_string()) return fail("id: expected a string");
+  if (!CheckString(json, sc::kName, problem)) return fail(problem);
+  if (json.contains(sc::kReferences)) {
+    if (!json[sc::kReferences].is_object()) return fail("references: expected an object");
+    for (const auto& [role, id] : json[sc::kReferences].items())
       if (!id.is_string()) return fail("references." + role + ": expected a node ID");
   }
   if (!this->ReadFields(json, false, problem)) return fail(problem);
   const int state = this->StartModify();
-  if (json.contains("name")) this->SetName(json["name"].get<std::string>());
-  if (json.contains("references")) {
+  if (json.contains(sc::kName)) this->SetName(json[sc::kName].get<std::string>());
+  if (json.contains(sc::kReferences)) {
     std::map<std::string, std::string> refs;
-    for (const auto& [role, id] : json["references"].items()) refs[role] = id.get<std::string>();
+    for (const auto& [role, id] : json[sc::kReferences].items()) refs[role] = id.get<std::string>();
     if (refs != this->References) {
       this->References = refs;
       this->Modified();

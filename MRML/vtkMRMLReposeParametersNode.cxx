@@ -68,7 +68,9 @@ void vtkMRMLReposeParametersNode::SetTransferMeshSizeMm(double mm) {
   if (clampAssign(this->TransferMeshSizeMm, mm, 0.0, 1000.0)) this->Modified();
 }
 void vtkMRMLReposeParametersNode::SetOutputMemoryBudgetMB(int mib) {
-  if (clampAssign(this->OutputMemoryBudgetMB, mib, 64, 1 << 20)) this->Modified();
+  // 0 (or less): automatic, half the physical memory; else at least 64 MiB.
+  if (clampAssign(this->OutputMemoryBudgetMB, mib <= 0 ? 0 : std::max(mib, 64), 0, 1 << 20))
+    this->Modified();
 }
 
 void vtkMRMLReposeParametersNode::SetSelectedCageVertices(const std::vector<int>& vertices) {

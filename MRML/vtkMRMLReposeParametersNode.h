@@ -98,7 +98,7 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   int CageVertexCount = 300;
   double CageDilationMm = 10.0;  // as `repose pose --dilate-mm`
   double TransferMeshSizeMm = 0.0;
-  int OutputMemoryBudgetMB = 4096;
+  int OutputMemoryBudgetMB = 0;  // 0: half the physical memory (repose pose --memory's default)
   std::string OutputFolder;
   std::string PosePath;
   std::string ActivePoseNodeID;

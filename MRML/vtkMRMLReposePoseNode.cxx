@@ -1,20 +1,24 @@
 #include "vtkMRMLReposePoseNode.h"
 
 #include <vtkObjectFactory.h>
+#include "repose/schema/SceneSchema.h"
+
+namespace sc = repose::scene_schema;
 
 vtkStandardNewMacro(vtkMRMLReposePoseNode);
 
 // The pose text is the node's bulk data (its file); the JSON carries where it is and the frame.
 void vtkMRMLReposePoseNode::WriteFields(nlohmann::ordered_json& json) const {
-  json["FileName"] = this->FileName;
-  json["CurrentFrame"] = this->CurrentFrame;
+  json[sc::pose::kFile] = this->FileName;
+  json[sc::pose::kCurrentFrame] = this->CurrentFrame;
 }
 
 bool vtkMRMLReposePoseNode::ReadFields(const nlohmann::json& json, bool apply, std::string& error) {
   if (!apply)
-    return CheckString(json, "FileName", error) && CheckInteger(json, "CurrentFrame", error);
-  if (json.contains("FileName")) this->SetFileName(json["FileName"]);
-  if (json.contains("CurrentFrame")) this->SetCurrentFrame(json["CurrentFrame"]);
+    return CheckString(json, sc::pose::kFile, error) &&
+           CheckInteger(json, sc::pose::kCurrentFrame, error);
+  if (json.contains(sc::pose::kFile)) this->SetFileName(json[sc::pose::kFile]);
+  if (json.contains(sc::pose::kCurrentFrame)) this->SetCurrentFrame(json[sc::pose::kCurrentFrame]);
   return true;
 }
 

@@ -5,6 +5,8 @@
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
 
+#include "repose/schema/SceneSchema.h"
+
 #include <vtkObjectFactory.h>
 
 #include <set>
@@ -13,12 +15,13 @@ vtkStandardNewMacro(vtkMRMLReposeScene);
 
 vtkSmartPointer<vtkMRMLReposeNode> vtkMRMLReposeScene::CreateNodeByClass(
     const std::string& className) {
-  if (className == "vtkMRMLReposeSegmentationNode")
+  namespace sc = repose::scene_schema;
+  if (className == sc::segmentation::kClassName)
     return vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
-  if (className == "vtkMRMLReposeCageNode") return vtkSmartPointer<vtkMRMLReposeCageNode>::New();
-  if (className == "vtkMRMLReposeTransferMeshNode")
+  if (className == sc::cage::kClassName) return vtkSmartPointer<vtkMRMLReposeCageNode>::New();
+  if (className == sc::transfer_mesh::kClassName)
     return vtkSmartPointer<vtkMRMLReposeTransferMeshNode>::New();
-  if (className == "vtkMRMLReposePoseNode") return vtkSmartPointer<vtkMRMLReposePoseNode>::New();
+  if (className == sc::pose::kClassName) return vtkSmartPointer<vtkMRMLReposePoseNode>::New();
   return nullptr;
 }
 
@@ -81,8 +84,10 @@ vtkMRMLReposeNode* vtkMRMLReposeScene::GetReferencedNode(vtkMRMLReposeNode* node
 std::string vtkMRMLReposeScene::WriteJSON() const {
   nlohmann::ordered_json nodes = nlohmann::ordered_json::array();
   for (const auto& n : this->Nodes) nodes.push_back(n->ToJSON());
-  return nlohmann::ordered_json{{"format", "repose-scene"}, {"version", 2}, {"nodes", nodes}}.dump(
-      2);
+  namespace sc = repose::scene_schema;
+  return nlohmann::ordered_json{
+      {sc::kFormatKey, sc::kFormat}, {sc::kVersionKey, sc::kVersion}, {sc::kNodes, nodes}}
+      .dump(2);
 }
 
 bool vtkMRMLReposeScene::ReadJSON(const std::string& text, std::string* error) {
@@ -90,28 +95,31 @@ bool vtkMRMLReposeScene::ReadJSON(const std::string& text, std::string* error) {
     if (error) *error = "scene JSON: " + message;
     return false;
   };
+  namespace sc = repose::scene_schema;
   const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
   if (json.is_discarded()) return fail("not valid JSON");
-  if (!json.is_object() || json.value("format", "") != "repose-scene")
-    return fail("format: expected \"repose-scene\"");
-  if (json.value("version", 0) != 2) return fail("version: expected 2");
-  if (!json.contains("nodes") || !json["nodes"].is_array()) return fail("nodes: expected an array");
+  if (!json.is_object() || json.value(sc::kFormatKey, "") != sc::kFormat)
+    return fail(std::string(sc::kFormatKey) + ": expected \"" + sc::kFormat + "\"");
+  if (json.value(sc::kVersionKey, 0) != sc::kVersion)
+    return fail(std::string(sc::kVersionKey) + ": expected " + std::to_string(sc::kVersion));
+  if (!json.contains(sc::kNodes) || !json[sc::kNodes].is_array())
+    return fail(std::string(sc::kNodes) + ": expected an array");
   std::vector<vtkSmartPointer<vtkMRMLReposeNode>> nodes;
   std::set<std::string> ids;
-  for (std::size_t i = 0; i < json["nodes"].size(); ++i) {
-    const nlohmann::json& j = json["nodes"][i];
+  for (std::size_t i = 0; i < json[sc::kNodes].size(); ++i) {
+    const nlohmann::json& j = json[sc::kNodes][i];
     const std::string f = "nodes[" + std::to_string(i) + "]";
-    if (!j.is_object() || !j.contains("class") || !j["class"].is_string())
+    if (!j.is_object() || !j.contains(sc::kClass) || !j[sc::kClass].is_string())
       return fail(f + ".class: expected a node class name");
-    auto node = CreateNodeByClass(j["class"].get<std::string>());
-    if (!node) return fail(f + ".class: unknown node class " + j["class"].dump());
-    if (!j.contains("id") || !j["id"].is_string() || j["id"].get<std::string>().empty())
+    auto node = CreateNodeByClass(j[sc::kClass].get<std::string>());
+    if (!node) return fail(f + ".class: unknown node class " + j[sc::kClass].dump());
+    if (!j.contains(sc::kId) || !j[sc::kId].is_string() || j[sc::kId].get<std::string>().empty())
       return fail(f + ".id: expected a node ID");
-    if (!ids.insert(j["id"].get<std::string>()).second)
-      return fail(f + ".id: " + j["id"].dump() + " used twice");
+    if (!ids.insert(j[sc::kId].get<std::string>()).second)
+      return fail(f + ".id: " + j[sc::kId].dump() + " used twice");
     std::string problem;
     if (!node->FromJSON(j, &problem)) return fail(f + ": " + problem);
-    node->SetID(j["id"].get<std::string>());
+    node->SetID(j[sc::kId].get<std::string>());
     nodes.push_back(node);
   }
   for (std::size_t i = 0; i < nodes.size(); ++i)

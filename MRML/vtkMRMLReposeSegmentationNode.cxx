@@ -1,6 +1,9 @@
 #include "vtkMRMLReposeSegmentationNode.h"
 
 #include <vtkObjectFactory.h>
+#include "repose/schema/SceneSchema.h"
+
+namespace sc = repose::scene_schema;
 
 vtkStandardNewMacro(vtkMRMLReposeSegmentationNode);
 
@@ -12,8 +15,9 @@ vtkSmartPointer<vtkImageData> copyOf(vtkImageData* image) {
   copy->DeepCopy(image);
   return copy;
 }
-const char* const kFileFields[] = {"LabelMapFileName", "BodyPartMapFileName", "ImageFileName",
-                                   "SkeletonJSON"};
+const char* const kFileFields[] = {sc::segmentation::kLabelMapFile,
+                                   sc::segmentation::kBodyPartMapFile, sc::segmentation::kImageFile,
+                                   sc::segmentation::kSkeleton};
 }  // namespace
 
 void vtkMRMLReposeSegmentationNode::SetLabelMap(vtkImageData* image) {
@@ -30,10 +34,10 @@ void vtkMRMLReposeSegmentationNode::SetImage(vtkImageData* image) {
 }
 
 void vtkMRMLReposeSegmentationNode::WriteFields(nlohmann::ordered_json& json) const {
-  json["LabelMapFileName"] = this->LabelMapFileName;
-  json["BodyPartMapFileName"] = this->BodyPartMapFileName;
-  json["ImageFileName"] = this->ImageFileName;
-  json["SkeletonJSON"] = this->SkeletonJSON;
+  json[sc::segmentation::kLabelMapFile] = this->LabelMapFileName;
+  json[sc::segmentation::kBodyPartMapFile] = this->BodyPartMapFileName;
+  json[sc::segmentation::kImageFile] = this->ImageFileName;
+  json[sc::segmentation::kSkeleton] = this->SkeletonJSON;
 }
 
 bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool apply,
@@ -43,11 +47,14 @@ bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool 
       if (!CheckString(json, key, error)) return false;
     return true;
   }
-  if (json.contains("LabelMapFileName")) this->SetLabelMapFileName(json["LabelMapFileName"]);
-  if (json.contains("BodyPartMapFileName"))
-    this->SetBodyPartMapFileName(json["BodyPartMapFileName"]);
-  if (json.contains("ImageFileName")) this->SetImageFileName(json["ImageFileName"]);
-  if (json.contains("SkeletonJSON")) this->SetSkeletonJSON(json["SkeletonJSON"]);
+  if (json.contains(sc::segmentation::kLabelMapFile))
+    this->SetLabelMapFileName(json[sc::segmentation::kLabelMapFile]);
+  if (json.contains(sc::segmentation::kBodyPartMapFile))
+    this->SetBodyPartMapFileName(json[sc::segmentation::kBodyPartMapFile]);
+  if (json.contains(sc::segmentation::kImageFile))
+    this->SetImageFileName(json[sc::segmentation::kImageFile]);
+  if (json.contains(sc::segmentation::kSkeleton))
+    this->SetSkeletonJSON(json[sc::segmentation::kSkeleton]);
   return true;
 }
 

@@ -1,6 +1,9 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 
 #include <vtkObjectFactory.h>
+#include "repose/schema/SceneSchema.h"
+
+namespace sc = repose::scene_schema;
 
 vtkStandardNewMacro(vtkMRMLReposeTransferMeshNode);
 
@@ -10,15 +13,17 @@ void vtkMRMLReposeTransferMeshNode::SetMesh(vtkUnstructuredGrid* mesh) {
 }
 
 void vtkMRMLReposeTransferMeshNode::WriteFields(nlohmann::ordered_json& json) const {
-  json["FileName"] = this->FileName;
-  json["SizeMm"] = this->SizeMm;
+  json[sc::transfer_mesh::kFile] = this->FileName;
+  json[sc::transfer_mesh::kSizeMm] = this->SizeMm;
 }
 
 bool vtkMRMLReposeTransferMeshNode::ReadFields(const nlohmann::json& json, bool apply,
                                                std::string& error) {
-  if (!apply) return CheckString(json, "FileName", error) && CheckNumber(json, "SizeMm", error);
-  if (json.contains("FileName")) this->SetFileName(json["FileName"]);
-  if (json.contains("SizeMm")) this->SetSizeMm(json["SizeMm"]);
+  if (!apply)
+    return CheckString(json, sc::transfer_mesh::kFile, error) &&
+           CheckNumber(json, sc::transfer_mesh::kSizeMm, error);
+  if (json.contains(sc::transfer_mesh::kFile)) this->SetFileName(json[sc::transfer_mesh::kFile]);
+  if (json.contains(sc::transfer_mesh::kSizeMm)) this->SetSizeMm(json[sc::transfer_mesh::kSizeMm]);
   return true;
 }
 

@@ -11,8 +11,6 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
 
-#include <repose/pose/Pose.h>
-
 #include <vtkCommand.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkSmartPointer.h>
@@ -196,12 +194,9 @@ bool qSlicerReposeModuleWidget::setPosePath(const QString& path) {
   const int state = d->ParameterNode->StartModify();
   d->ParameterNode->SetPosePath(path.toStdString());
   d->ParameterNode->SetActivePoseNodeID(pose ? pose->GetID() : "");
-  std::string first;
-  if (pose)
-    for (const repose::PoseGroup& g :
-         repose::parsePose(pose->GetPoseJSON(), path.toStdString()).groups)
-      if (!g.fixed && first.empty()) first = g.name;
-  d->ParameterNode->SetActiveGroup(first);
+  const vtkSlicerReposeLogic::PoseSummary summary = d->Logic->GetPoseSummary(pose);
+  d->ParameterNode->SetActiveGroup(summary.movableGroups.empty() ? std::string()
+                                                                 : summary.movableGroups.front());
   d->ParameterNode->EndModify(state);
   if (!pose) d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
   this->updateWidgetFromMRML();
@@ -517,14 +512,11 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
 
   // Pose: the groups that can turn, the active one's angle, keyframes, undo/redo.
   vtkMRMLReposePoseNode* pose = this->activePose();
+  // Parsed once per change of the pose node (the Logic keeps the summary).
+  const vtkSlicerReposeLogic::PoseSummary summary = d->Logic->GetPoseSummary(pose);
   QStringList groups;
-  int keyframes = 0;
-  if (pose) {
-    const repose::Pose p = repose::parsePose(pose->GetPoseJSON(), pose->GetName());
-    for (const repose::PoseGroup& g : p.groups)
-      if (!g.fixed) groups << QString::fromStdString(g.name);
-    keyframes = int(p.keyframes.size());
-  }
+  for (const std::string& g : summary.movableGroups) groups << QString::fromStdString(g);
+  const int keyframes = summary.keyframes;
   QStringList current;
   for (int i = 0; i < d->GroupComboBox->count(); ++i) current << d->GroupComboBox->itemText(i);
   if (current != groups) {
@@ -571,16 +563,7 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
       combo->setCurrentText(typed);
     }
   QStringList separations;
-  if (pose)
-    for (const repose::PoseSeparation& sep :
-         repose::parsePose(pose->GetPoseJSON(), pose->GetName()).separations) {
-      auto part = [&](int k) {
-        return sep.partNames[std::size_t(k)].empty()
-                   ? QString::number(sep.parts[std::size_t(k)])
-                   : QString::fromStdString(sep.partNames[std::size_t(k)]);
-      };
-      separations << part(0) + " | " + part(1);
-    }
+  for (const std::string& sep : summary.separations) separations << QString::fromStdString(sep);
   d->SeparationsInfoLabel->setText(
       separations.isEmpty() ? QString("No separation.") : "Separations: " + separations.join(", "));
   d->AddSeparationButton->setEnabled(pose != nullptr);

@@ -8,7 +8,6 @@
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeLogic.h"
-#include "vtkSlicerReposeVolumeConversion.h"
 
 #include <QVTKOpenGLNativeWidget.h>
 #include <vtkActor.h>
@@ -213,8 +212,7 @@ void qSlicerReposeViewsWidget::refresh() {
     auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
         d->Logic->GetScene()->GetReferencedNode(pose, "segmentation"));
     if (seg && seg->GetLabelMap())
-      d->Lookup = vtkSlicerReposeVolumeConversion::ToLookupTable(
-          vtkSlicerReposeVolumeConversion::GetLabelTable(seg->GetLabelMap()));
+      d->Lookup = vtkSlicerReposeLogic::GetLabelLookupTable(seg->GetLabelMap());
   }
   const std::array<double, 3> centre = d->Logic->GetLiveRestCenter();
   std::array<double, 3> sliceMs{};

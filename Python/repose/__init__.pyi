@@ -122,9 +122,9 @@ class Rig:
     def tissue_table(self) -> str: ...
     def deform(self, index: int = ...) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
     def pose_frame(self, organs: Volume, parts: Volume, index: int = ..., *,
-                   image: Optional[Volume] = ..., background: float = ...,
+                   image: Optional[Volume] = ..., background: Optional[float] = ...,
                    spacing_mm: float = ..., fill_pockets: bool = ...,
-                   label_volumes: str = ...,
+                   label_volumes: str = ..., memory_bytes: float = ...,
                    progress: Optional[Progress] = ...) -> PosedFrame: ...
     def pose_labels_to_file(self, organs_path: str, out_path: str, index: int = ..., *,
                             memory_bytes: float = ..., spacing_mm: float = ...,

@@ -330,8 +330,9 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
       .def(
           "pose_frame",
           [](const Rig& r, const Volume& organs, const Volume& parts, std::size_t index,
-             const py::object& image, double background, double spacingMm, bool fillPockets,
-             const std::string& labelVolumes, const py::object& progress) {
+             const py::object& image, std::optional<double> background, double spacingMm,
+             bool fillPockets, const std::string& labelVolumes, double memoryBytes,
+             const py::object& progress) {
             PoseFrameOptions o = r.job->frameOptions();
             o.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
             o.background = background;
@@ -341,6 +342,11 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
                           "'");
             o.preserveLabelVolumes = labelVolumes == "preserve";
             o.spacingMm = spacingMm;
+            if (!(memoryBytes >= 0)) throw Error("pose_frame: memory_bytes must be >= 0");
+            o.checkGrid = [&](const VolumeGeometry& grid) {
+              checkFrameMemory(grid, posedBytesPerVoxel(organs, parts, o.image), memoryBytes,
+                               "pose_frame", "memory_bytes=; out of core: pose_labels_to_file");
+            };
             std::vector<std::string> warnings;
             o.warn = [&](const std::string& line) { warnings.push_back(line); };
             PosedFrame f = withProgress(progress, [&](const ProgressFn& fn) {
@@ -353,14 +359,18 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
             return f;
           },
           py::arg("organs"), py::arg("parts"), py::arg("index") = 0, py::kw_only(),
-          py::arg("image") = py::none(), py::arg("background") = 0.0, py::arg("spacing_mm") = 0.0,
-          py::arg("fill_pockets") = true, py::arg("label_volumes") = "preserve",
+          py::arg("image") = py::none(), py::arg("background") = py::none(),
+          py::arg("spacing_mm") = 0.0, py::arg("fill_pockets") = true,
+          py::arg("label_volumes") = "preserve", py::arg("memory_bytes") = 0.0,
           py::arg("progress") = py::none(),
           R"doc(Poses frame `index` at full resolution in core: the posed organ and part maps (and
 image), the displacement field and the report. spacing_mm: the output voxel size (0: the
 input's), e.g. 2 mm for an FDTD grid. label_volumes: "preserve" rounds each soft label to the
 volume the deformation gives it, "nearest" leaves plain nearest-neighbour sampling (as
-`repose pose --label-volumes`).)doc")
+`repose pose --label-volumes`). background: the posed image's value where no tissue is (None: the
+image's minimum, air in a CT, as `repose pose --background min`). memory_bytes: the posed
+volumes beside what the process holds must fit in it (0: half the physical memory, as
+`repose pose --memory`), else an error with the numbers before anything is allocated.)doc")
       .def(
           "pose_labels_to_file",
           [](const Rig& r, const std::string& organsPath, const std::string& outPath,

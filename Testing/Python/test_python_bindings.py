@@ -151,6 +151,31 @@ def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose):
     assert field.shape == frame.organs.shape + (3,) and np.isfinite(field).all()
 
 
+def test_the_posed_image_background_is_the_images_minimum_unless_given(phantom, elbow_rig):
+    g, s = phantom["organs"], phantom["parts"]
+    # A CT padded outside its field of view: its minimum (-3024) is what the default takes.
+    ct = phantom["image"].array.copy()
+    ct[0, 0, 0] = -3024
+    image = rp.volume_from_array(ct, phantom["image"].affine)
+    outside = lambda frame: frame.image.array[frame.organs.array == 0]
+    default = elbow_rig.pose_frame(g, s, image=image, fill_pockets=False)
+    assert outside(default).min() == -3024 and np.median(outside(default)) == -3024
+    given = elbow_rig.pose_frame(g, s, image=image, background=-1000, fill_pockets=False)
+    assert np.median(outside(given)) == -1000
+    # Inside the body both are the same posed image.
+    inside = given.organs.array != 0
+    np.testing.assert_array_equal(default.image.array[inside], given.image.array[inside])
+
+
+def test_a_frame_beyond_the_memory_budget_is_refused_with_the_numbers(phantom, elbow_rig):
+    g, s = phantom["organs"], phantom["parts"]
+    with pytest.raises(rp.Error) as refused:
+        elbow_rig.pose_frame(g, s, memory_bytes=1e6)
+    message = str(refused.value)
+    assert message.startswith("pose_frame needs ") and "output voxels beyond the" in message
+    assert "more than the memory budget of 0.000931 GiB" in message and "\n" not in message
+
+
 def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     g, s = phantom["organs"], phantom["parts"]
     frame = elbow_rig.pose_frame(g, s, spacing_mm=4.0, image=phantom["image"], background=-1000)

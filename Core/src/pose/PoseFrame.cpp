@@ -14,6 +14,7 @@
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 #include "repose/util/Interrupt.h"
+#include "repose/util/Memory.h"
 
 #include <nlohmann/json.hpp>
 
@@ -22,9 +23,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <stdlib.h>
 #include <set>
+#include <sstream>
 
 namespace repose {
 namespace {
@@ -161,6 +164,36 @@ double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volum
          (image ? double(scalarSize(image->scalarType())) : 0);
 }
 
+void checkFrameMemory(const VolumeGeometry& grid, double bytesPerVoxel, double budget,
+                      const std::string& what, const std::string& hint) {
+  if (budget <= 0) budget = memoryBudgetByDefault();
+  if (budget <= 0) return;  // physical memory unknown: no limit rather than refusing every job
+  const double need = double(grid.numVoxels()) * bytesPerVoxel, inUse = residentBytes();
+  if (inUse + need <= budget) return;
+  auto gib = [](double bytes) {
+    std::ostringstream s;
+    s.precision(3);
+    s << bytes / 1073741824.0 << " GiB";
+    return s.str();
+  };
+  throw Error(what + " needs " + gib(need) + " for " + std::to_string(grid.numVoxels()) +
+              " output voxels beyond the " + gib(inUse) +
+              " in use, more than the memory budget of " + gib(budget) + " (" + hint + ")");
+}
+
+double imageBackground(const Volume& image) {
+  // NaN voxels (a float image's "no data") are not a background: the comparison skips them.
+  double lowest = std::numeric_limits<double>::infinity();
+  for (int layer = 0; layer < image.layers(); ++layer)
+    dispatchScalar(image.scalarType(), [&](auto* tag) {
+      using T = std::remove_pointer_t<decltype(tag)>;
+      const T* v = image.data<T>(layer);
+      for (std::int64_t i = 0, n = image.numVoxels(); i < n; ++i)
+        if (double(v[i]) < lowest) lowest = double(v[i]);
+    });
+  return std::isfinite(lowest) ? lowest : 0.0;
+}
+
 PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs,
                      const Volume& parts, const PoseFrameOptions& options) {
   if (parts.dims() != organs.dims())
@@ -203,8 +236,9 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   PocketReport pockets;
   if (options.fillPockets) pockets = fillPosePockets(out.organs, organs, out.field, &out.parts);
   if (options.image)
-    out.image =
-        rasterizeImage(*options.image, mesh, frame.deformed, out.grid, options.background, ro);
+    out.image = rasterizeImage(
+        *options.image, mesh, frame.deformed, out.grid,
+        options.background ? *options.background : imageBackground(*options.image), ro);
 
   // Rigid pieces run into each other.
   std::string collisionWarning;

@@ -4,6 +4,7 @@
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/MeshIO.h"
+#include "repose/schema/SceneSchema.h"
 #include "repose/util/Error.h"
 
 #include <nlohmann/json.hpp>
@@ -14,6 +15,7 @@
 namespace repose {
 
 namespace fs = std::filesystem;
+namespace sc = scene_schema;
 using nlohmann::json;
 
 std::string sceneRigKey(const std::string& partsPath, const std::vector<LimbSeparation>& cuts,
@@ -62,44 +64,46 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
   writePoseFile(rig.pose(), (scene / poseFile).string());
   json groups = json::array();
   for (std::size_t g = 0; g < rig.handles().size(); ++g)
-    groups.push_back(
-        {{"name", rig.pose().groups[g].name}, {"vertices", rig.handles()[g].cageVertices}});
-  const std::string seg = "vtkMRMLReposeSegmentationNode1", cage = "vtkMRMLReposeCageNode1",
-                    mesh = "vtkMRMLReposeTransferMeshNode1";
+    groups.push_back({{sc::cage::kGroupName, rig.pose().groups[g].name},
+                      {sc::cage::kGroupVertices, rig.handles()[g].cageVertices}});
+  const std::string seg = std::string(sc::segmentation::kClassName) + "1",
+                    cage = std::string(sc::cage::kClassName) + "1",
+                    mesh = std::string(sc::transfer_mesh::kClassName) + "1";
   auto absolute = [](const std::string& p) { return p.empty() ? p : fs::absolute(p).string(); };
   const json nodes = json::array(
-      {{{"class", "vtkMRMLReposeSegmentationNode"},
-        {"id", seg},
-        {"name", fs::path(inputs.organs).filename().string()},
-        {"references", json::object()},
-        {"LabelMapFileName", absolute(inputs.organs)},
-        {"BodyPartMapFileName", absolute(inputs.parts)},
-        {"ImageFileName", absolute(inputs.image)}},
-       {{"class", "vtkMRMLReposeCageNode"},
-        {"id", cage},
-        {"name", "cage"},
-        {"references", {{"segmentation", seg}}},
-        {"FileName", "cage.vtk"},
-        {"TargetVertexCount", settings.cageVertices},
-        {"DilationMm", settings.dilateMm},
-        {"HandleGroups", groups}},
-       {{"class", "vtkMRMLReposeTransferMeshNode"},
-        {"id", mesh},
-        {"name", "transfer mesh"},
-        {"references", {{"cage", cage}, {"segmentation", seg}}},
-        {"FileName", "tm.vtu"},
-        {"SizeMm", settings.meshMm}},
-       {{"class", "vtkMRMLReposePoseNode"},
-        {"id", "vtkMRMLReposePoseNode1"},
-        {"name", rig.pose().name},
-        {"references", {{"cage", cage}, {"segmentation", seg}, {"transfer_mesh", mesh}}},
-        {"FileName", poseFile},
-        {"CurrentFrame", 0}}});
-  const json doc = {{"format", "repose-scene"},
-                    {"version", 2},
-                    {"nodes", nodes},
-                    {"built_for", key.empty() ? json() : json::parse(key)}};
-  writeTextFileAtomically((scene / "scene.json").string(), doc.dump(2) + "\n");
+      {{{sc::kClass, sc::segmentation::kClassName},
+        {sc::kId, seg},
+        {sc::kName, fs::path(inputs.organs).filename().string()},
+        {sc::kReferences, json::object()},
+        {sc::segmentation::kLabelMapFile, absolute(inputs.organs)},
+        {sc::segmentation::kBodyPartMapFile, absolute(inputs.parts)},
+        {sc::segmentation::kImageFile, absolute(inputs.image)}},
+       {{sc::kClass, sc::cage::kClassName},
+        {sc::kId, cage},
+        {sc::kName, "cage"},
+        {sc::kReferences, {{sc::kSegmentationRole, seg}}},
+        {sc::cage::kFile, "cage.vtk"},
+        {sc::cage::kTargetVertexCount, settings.cageVertices},
+        {sc::cage::kDilationMm, settings.dilateMm},
+        {sc::cage::kHandleGroups, groups}},
+       {{sc::kClass, sc::transfer_mesh::kClassName},
+        {sc::kId, mesh},
+        {sc::kName, "transfer mesh"},
+        {sc::kReferences, {{sc::kCageRole, cage}, {sc::kSegmentationRole, seg}}},
+        {sc::transfer_mesh::kFile, "tm.vtu"},
+        {sc::transfer_mesh::kSizeMm, settings.meshMm}},
+       {{sc::kClass, sc::pose::kClassName},
+        {sc::kId, std::string(sc::pose::kClassName) + "1"},
+        {sc::kName, rig.pose().name},
+        {sc::kReferences,
+         {{sc::kCageRole, cage}, {sc::kSegmentationRole, seg}, {sc::kTransferMeshRole, mesh}}},
+        {sc::pose::kFile, poseFile},
+        {sc::pose::kCurrentFrame, 0}}});
+  const json doc = {{sc::kFormatKey, sc::kFormat},
+                    {sc::kVersionKey, sc::kVersion},
+                    {sc::kNodes, nodes},
+                    {sc::kBuiltFor, key.empty() ? json() : json::parse(key)}};
+  writeTextFileAtomically((scene / sc::kDocument).string(), doc.dump(2) + "\n");
 }
 
 namespace {
@@ -113,18 +117,20 @@ std::string stringOf(const json& node, const char* key) {
 }
 
 json nodesOf(const json& doc) {
-  const auto it = doc.find("nodes");
+  const auto it = doc.find(sc::kNodes);
   return it != doc.end() && it->is_array() ? *it : json::array();
 }
 
 json readSceneJson(const fs::path& scene) {
-  const fs::path file = scene / "scene.json";
+  const fs::path file = scene / sc::kDocument;
   std::ifstream in(file);
-  if (!in) throw Error(scene.string() + ": not a scene folder (no scene.json)");
+  if (!in)
+    throw Error(scene.string() + ": not a scene folder (no " + std::string(sc::kDocument) + ")");
   const json doc = json::parse(in, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) throw Error(file.string() + ": not valid JSON");
-  if (stringOf(doc, "format") != "repose-scene")
-    throw Error(file.string() + ": not a Repose scene (format is not \"repose-scene\")");
+  if (stringOf(doc, sc::kFormatKey) != sc::kFormat)
+    throw Error(file.string() + ": not a Repose scene (" + sc::kFormatKey + " is not \"" +
+                sc::kFormat + "\")");
   return doc;
 }
 
@@ -143,20 +149,20 @@ SceneContents readSceneFolder(const std::string& folder) {
   SceneContents out;
   std::string cageFile, meshFile, poseFile;
   for (const json& node : nodesOf(doc)) {
-    const std::string cls = stringOf(node, "class");
-    if (cls == "vtkMRMLReposeSegmentationNode" && out.inputs.organs.empty()) {
-      out.inputs.organs = fileOf(scene, node, "LabelMapFileName");
-      out.inputs.parts = fileOf(scene, node, "BodyPartMapFileName");
-      out.inputs.image = fileOf(scene, node, "ImageFileName");
-    } else if (cls == "vtkMRMLReposeCageNode" && cageFile.empty()) {
-      cageFile = fileOf(scene, node, "FileName");
-    } else if (cls == "vtkMRMLReposeTransferMeshNode" && meshFile.empty()) {
-      meshFile = fileOf(scene, node, "FileName");
-    } else if (cls == "vtkMRMLReposePoseNode" && poseFile.empty()) {
-      poseFile = fileOf(scene, node, "FileName");
+    const std::string cls = stringOf(node, sc::kClass);
+    if (cls == sc::segmentation::kClassName && out.inputs.organs.empty()) {
+      out.inputs.organs = fileOf(scene, node, sc::segmentation::kLabelMapFile);
+      out.inputs.parts = fileOf(scene, node, sc::segmentation::kBodyPartMapFile);
+      out.inputs.image = fileOf(scene, node, sc::segmentation::kImageFile);
+    } else if (cls == sc::cage::kClassName && cageFile.empty()) {
+      cageFile = fileOf(scene, node, sc::cage::kFile);
+    } else if (cls == sc::transfer_mesh::kClassName && meshFile.empty()) {
+      meshFile = fileOf(scene, node, sc::transfer_mesh::kFile);
+    } else if (cls == sc::pose::kClassName && poseFile.empty()) {
+      poseFile = fileOf(scene, node, sc::pose::kFile);
     }
   }
-  const std::string json = (scene / "scene.json").string();
+  const std::string json = (scene / sc::kDocument).string();
   if (out.inputs.organs.empty()) throw Error(json + ": no segmentation node with a label map");
   if (cageFile.empty() || meshFile.empty())
     throw Error(json + ": no cage and transfer mesh (the rig was never built)");
@@ -165,28 +171,28 @@ SceneContents readSceneFolder(const std::string& folder) {
   out.geometry.mesh = readTransferMesh(meshFile);
   out.geometry.coordinatesFile = greenCoordinatesFileFor(meshFile);
   out.pose = readPoseFile(poseFile);
-  if (doc.contains("built_for") && !doc["built_for"].is_null())
-    out.key = doc["built_for"].dump(-1, ' ', false, json::error_handler_t::replace);
+  if (doc.contains(sc::kBuiltFor) && !doc[sc::kBuiltFor].is_null())
+    out.key = doc[sc::kBuiltFor].dump(-1, ' ', false, json::error_handler_t::replace);
   return out;
 }
 
 std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::string& key) {
   const fs::path scene = folder;
-  if (!fs::exists(scene / "scene.json")) return std::nullopt;
+  if (!fs::exists(scene / sc::kDocument)) return std::nullopt;
   json doc;
   try {
     doc = readSceneJson(scene);
   } catch (const Error&) {
     return std::nullopt;  // not ours: built again (and written over)
   }
-  const auto builtFor = doc.find("built_for");
+  const auto builtFor = doc.find(sc::kBuiltFor);
   if (builtFor == doc.end() || *builtFor != json::parse(key, nullptr, false)) return std::nullopt;
   std::string cageFile, meshFile;
   for (const json& node : nodesOf(doc)) {
-    if (stringOf(node, "class") == "vtkMRMLReposeCageNode")
-      cageFile = fileOf(scene, node, "FileName");
-    if (stringOf(node, "class") == "vtkMRMLReposeTransferMeshNode")
-      meshFile = fileOf(scene, node, "FileName");
+    if (stringOf(node, sc::kClass) == sc::cage::kClassName)
+      cageFile = fileOf(scene, node, sc::cage::kFile);
+    if (stringOf(node, sc::kClass) == sc::transfer_mesh::kClassName)
+      meshFile = fileOf(scene, node, sc::transfer_mesh::kFile);
   }
   if (cageFile.empty() || meshFile.empty()) return std::nullopt;
   return RigGeometry{readTriangleMesh(cageFile), readTransferMesh(meshFile),

@@ -99,6 +99,7 @@ TEST(WarpCommand, RefusesBadRequestsWithOneLineAndNoOutput) {
         p.common(p.cage) + " --out " + shellQuote(out) + " --memory 1K",
         p.common(p.cage) + " --out " + shellQuote(out) + " --image " + shellQuote(p.organs),
         p.common(p.cage) + " --out " + shellQuote(p.organs),
+        p.common(p.cage) + " --out " + shellQuote(out) + " --background air",
         // Two outputs naming one file: the second would replace the first when both commit.
         p.common(p.cage) + " --out " + shellQuote(out) + " --image " + shellQuote(p.organs) +
             " --image-out " + shellQuote(out)}) {
@@ -111,6 +112,11 @@ TEST(WarpCommand, RefusesBadRequestsWithOneLineAndNoOutput) {
       runCommand("repose", p.common(p.cage) + " --out " + shellQuote(out) + " --memory 1K");
   EXPECT_NE(memory.err.find("budget"), std::string::npos) << memory.err;
   EXPECT_NE(memory.err.find("never.nii.gz"), std::string::npos) << memory.err;
+  const CommandResult background =
+      runCommand("repose", p.common(p.cage) + " --out " + shellQuote(out) + " --background air");
+  EXPECT_NE(background.err.find("--background expects a number or 'min', got 'air'"),
+            std::string::npos)
+      << background.err;
 }
 
 // Out of core under a budget the in-core run would exceed: the same voxels, a peak resident set

@@ -45,7 +45,7 @@ void expectMatchesCore(vtkSlicerReposeLogic* logic, const std::string& path) {
             vtkSlicerReposeVolumeConversion::ToVTKScalarType(core.scalarType()));
   const repose::Volume back = vtkSlicerReposeVolumeConversion::FromImageData(image);
   EXPECT_TRUE(back.bytes() == core.bytes());
-  EXPECT_EQ(logic->GetVolumeLabelTable().size(), core.labels().size());
+  EXPECT_EQ(logic->GetVolumeLabelNames().size(), core.labels().size());
 }
 
 }  // namespace
@@ -62,7 +62,7 @@ TEST(vtkSlicerReposeLogic, LoadsTotalSegmentatorNifti) {
   EXPECT_EQ(dims[1], 101);
   EXPECT_EQ(dims[2], 30);
   EXPECT_NEAR(logic->GetVolumeImageData()->GetSpacing()[0], 3.0, 1e-4);
-  EXPECT_GE(logic->GetVolumeLabelTable().size(), 41u);
+  EXPECT_GE(logic->GetVolumeLabelNames().size(), 41u);
   ASSERT_NE(logic->GetVolumeLookupTable(), nullptr);
   const std::string summary = logic->GetVolumeSummary();
   EXPECT_NE(summary.find("Dimensions: 122 x 101 x 30"), std::string::npos) << summary;
@@ -77,7 +77,7 @@ TEST(vtkSlicerReposeLogic, LoadsSlicerSegmentationsInLps) {
   const std::string path = repose::test::dataPath("slicer_seg/Segmentation.seg.nrrd");
   ASSERT_TRUE(logic->LoadVolume(path)) << logic->GetLastErrorMessage();
   expectMatchesCore(logic, path);
-  EXPECT_EQ(logic->GetVolumeLabelTable().size(), 7u);
+  EXPECT_EQ(logic->GetVolumeLabelNames().size(), 7u);
   EXPECT_EQ(logic->GetVolumeLabelsPresent(), 7);
   // An intensity image has no labels to count.
   ASSERT_TRUE(logic->LoadVolume(repose::test::dataPath("slicer_seg/CTChest4.nrrd")));

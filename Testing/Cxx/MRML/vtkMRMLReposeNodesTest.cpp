@@ -9,6 +9,8 @@
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
 
+#include "repose/schema/SceneSchema.h"
+
 #include <gtest/gtest.h>
 
 #include <vtkCallbackCommand.h>
@@ -213,4 +215,29 @@ TEST(vtkMRMLReposeScene, GivesIDsResolvesReferencesAndRoundTrips) {
   EXPECT_FALSE(loaded->ReadJSON(
       R"({"format":"repose-scene","version":2,"nodes":[{"class":"X","id":"a"}]})", &error));
   EXPECT_NE(error.find("unknown node class"), std::string::npos);
+}
+
+// The nodes are the classes scene.json names (repose/schema/SceneSchema.h, which Core's scene
+// folders write and read too), and a scene's document carries the schema's format and version.
+TEST(vtkMRMLReposeScene, NodesAndDocumentFollowTheSceneSchema) {
+  namespace sc = repose::scene_schema;
+  EXPECT_STREQ(vtkNew<vtkMRMLReposeSegmentationNode>()->GetNodeClassName(),
+               sc::segmentation::kClassName);
+  EXPECT_STREQ(vtkNew<vtkMRMLReposeCageNode>()->GetNodeClassName(), sc::cage::kClassName);
+  EXPECT_STREQ(vtkNew<vtkMRMLReposeTransferMeshNode>()->GetNodeClassName(),
+               sc::transfer_mesh::kClassName);
+  EXPECT_STREQ(vtkNew<vtkMRMLReposePoseNode>()->GetNodeClassName(), sc::pose::kClassName);
+  for (const char* name : {sc::segmentation::kClassName, sc::cage::kClassName,
+                           sc::transfer_mesh::kClassName, sc::pose::kClassName})
+    EXPECT_TRUE(vtkMRMLReposeScene::CreateNodeByClass(name)) << name;
+  vtkNew<vtkMRMLReposeScene> scene;
+  vtkNew<vtkMRMLReposeCageNode> cage;
+  cage->SetFileName("cage.vtk");
+  scene->AddNode(cage);
+  const nlohmann::json doc = nlohmann::json::parse(scene->WriteJSON());
+  EXPECT_EQ(doc[sc::kFormatKey], sc::kFormat);
+  EXPECT_EQ(doc[sc::kVersionKey], sc::kVersion);
+  ASSERT_EQ(doc[sc::kNodes].size(), 1u);
+  EXPECT_EQ(doc[sc::kNodes][0][sc::kClass], sc::cage::kClassName);
+  EXPECT_EQ(doc[sc::kNodes][0][sc::cage::kFile], "cage.vtk");
 }

@@ -86,7 +86,7 @@ TEST(vtkMRMLReposeParametersNode, DefaultsAndSetGet) {
   EXPECT_EQ(node->GetCageVertexCount(), 300);
   EXPECT_EQ(node->GetCageDilationMm(), 10.0);
   EXPECT_EQ(node->GetTransferMeshSizeMm(), 0.0);
-  EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 4096);
+  EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 0);  // automatic: half the physical memory
   EXPECT_TRUE(node->GetInputSegmentationPath().empty());
   fillNonDefault(node);
   EXPECT_EQ(node->GetInputSegmentationNodeID(), "vtkMRMLSegmentationNode1");
@@ -114,6 +114,8 @@ TEST(vtkMRMLReposeParametersNode, ClampsToRanges) {
   EXPECT_EQ(node->GetTransferMeshSizeMm(), 1000.0);
   node->SetOutputMemoryBudgetMB(1);
   EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 64);
+  node->SetOutputMemoryBudgetMB(-3);
+  EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 0);
   node->SetLabelOpacity(1.5);
   EXPECT_EQ(node->GetLabelOpacity(), 1.0);
   node->SetLabelOpacity(-0.5);

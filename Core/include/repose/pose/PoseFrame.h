@@ -25,8 +25,9 @@ enum class LabelMapFiles { Nifti, SegNrrd, Both };
 LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inputPath);
 
 struct PoseFrameOptions {
-  const Volume* image = nullptr;         // on G's grid, posed alongside (trilinear)
-  double background = 0;                 // the image's value where no tissue is
+  const Volume* image = nullptr;  // on G's grid, posed alongside (trilinear)
+  // The image's value where no tissue is; unset: imageBackground(*image).
+  std::optional<double> background;
   const TissueTable* tissues = nullptr;  // densities and rigid labels; null: no masses
   std::string tissueTableName = "none";  // how the report names the table
   bool fillPockets = true;               // docs/QUALITY.md
@@ -63,6 +64,19 @@ struct PosedFrame {
 // Bytes a posed frame holds per output voxel (G, S, image, field): budgets check this times the
 // grid's voxels before posing.
 double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volume* image);
+
+// The one memory rule of a pose job, for every front end: the posed volumes of a frame on `grid`
+// (`bytesPerVoxel`, posedBytesPerVoxel) beside what the process holds now (its resident set)
+// must fit in `budget` bytes (0: memoryBudgetByDefault(), half the physical memory). Otherwise
+// throws one line: "<what> needs ... beyond the ... in use, more than the memory budget of ...
+// (<hint>)", the hint saying where the front end sets the budget and how to pose out of core.
+void checkFrameMemory(const VolumeGeometry& grid, double bytesPerVoxel, double budget,
+                      const std::string& what, const std::string& hint);
+
+// The value a posed image takes where no tissue is, unless the user gives one: the image's
+// minimum, which is air in a CT (-1000 or -1024 HU) and the dark of an MR, so the body is not
+// posed into water (0 HU). The same rule for every front end, the live slices and the export.
+double imageBackground(const Volume& image);
 
 // The frame `index` of the rig, posed. G and S are the rig's inputs at rest (S's labels name the
 // parts). Throws repose::Error, or Cancelled when the progress callback says so.

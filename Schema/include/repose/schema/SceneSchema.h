@@ -1,0 +1,63 @@
+// scene.json, the document of a Repose scene folder (docs/FORMATS.md, "Scene folders"): the names
+// its writers and readers share. Core's scene folders (`repose pose --scene`, Python's
+// load_scene) and the MRML scene (the workbench and the Slicer module) write and read the same
+// document through these names only, so neither can rename a node class or a field the other
+// still reads. This header is the whole module (the INTERFACE library ReposeSceneSchema): no
+// dependency, so the MRML layer takes it without taking Core.
+#pragma once
+
+namespace repose::scene_schema {
+
+inline constexpr char kDocument[] = "scene.json";  // in the scene folder
+inline constexpr char kFormatKey[] = "format";
+inline constexpr char kFormat[] = "repose-scene";
+inline constexpr char kVersionKey[] = "version";
+inline constexpr int kVersion = 2;
+inline constexpr char kNodes[] = "nodes";  // an array of node objects
+// The rig key a folder's cage and mesh were built for (Core's SceneFolder.h: sceneRigKey); a
+// scene the workbench saved has none, so `repose pose --scene` builds the rig again there.
+inline constexpr char kBuiltFor[] = "built_for";
+
+// Members of every node. Files are relative to the scene folder unless absolute.
+inline constexpr char kClass[] = "class";
+inline constexpr char kId[] = "id";
+inline constexpr char kName[] = "name";
+inline constexpr char kReferences[] = "references";  // role -> node id
+
+// Reference roles.
+inline constexpr char kSegmentationRole[] = "segmentation";
+inline constexpr char kCageRole[] = "cage";
+inline constexpr char kTransferMeshRole[] = "transfer_mesh";
+
+// The node classes and their fields.
+namespace segmentation {
+inline constexpr char kClassName[] = "vtkMRMLReposeSegmentationNode";
+inline constexpr char kLabelMapFile[] = "LabelMapFileName";        // G
+inline constexpr char kBodyPartMapFile[] = "BodyPartMapFileName";  // S
+inline constexpr char kImageFile[] = "ImageFileName";              // optional, on G's grid
+inline constexpr char kSkeleton[] = "SkeletonJSON";                // the rig's joints, as text
+}  // namespace segmentation
+
+namespace cage {
+inline constexpr char kClassName[] = "vtkMRMLReposeCageNode";
+inline constexpr char kFile[] = "FileName";  // .vtk or .obj
+inline constexpr char kTargetVertexCount[] = "TargetVertexCount";
+inline constexpr char kDilationMm[] = "DilationMm";
+inline constexpr char kHandleGroups[] = "HandleGroups";  // [{name, vertices}]
+inline constexpr char kGroupName[] = "name";
+inline constexpr char kGroupVertices[] = "vertices";
+}  // namespace cage
+
+namespace transfer_mesh {
+inline constexpr char kClassName[] = "vtkMRMLReposeTransferMeshNode";
+inline constexpr char kFile[] = "FileName";  // .vtu; its Green coordinates beside it (.green)
+inline constexpr char kSizeMm[] = "SizeMm";
+}  // namespace transfer_mesh
+
+namespace pose {
+inline constexpr char kClassName[] = "vtkMRMLReposePoseNode";
+inline constexpr char kFile[] = "FileName";  // .pose.json
+inline constexpr char kCurrentFrame[] = "CurrentFrame";
+}  // namespace pose
+
+}  // namespace repose::scene_schema
