@@ -15,6 +15,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -140,11 +141,14 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
                              const std::array<double, 3>& pivot,
                              const std::array<double, 3>& translation);
   // The group's transform in the pose's current keyframe (its base transform where the keyframe
-  // does not name it). False for an unknown or fixed group.
-  bool GetPoseGroupTransform(vtkMRMLReposePoseNode* pose, const std::string& group,
-                             std::array<double, 3>& axis, double& angleDeg,
-                             std::array<double, 3>& pivot,
-                             std::array<double, 3>& translation) const;
+  // does not name it). Empty for an unknown or fixed group.
+  struct GroupTransform {
+    std::array<double, 3> axis{0, 0, 1};
+    double angleDeg = 0;
+    std::array<double, 3> pivot{0, 0, 0}, translation{0, 0, 0};
+  };
+  std::optional<GroupTransform> GetPoseGroupTransform(vtkMRMLReposePoseNode* pose,
+                                                      const std::string& group) const;
   // The same transform as a 4x4 matrix (rest RAS mm -> posed RAS mm), and setting it from one
   // (the 3D view's transform widget): the group keeps its pivot and its axis direction. False
   // with a message when the matrix is not a rigid motion.
@@ -199,6 +203,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   bool UpdateLiveFrame();
   // Wall time of the last live frame solve (ms).
   double GetLiveFrameMilliseconds() const;
+  // Wall time of the last ComputeLiveSlice (ms; 0 before the first).
+  double GetLiveSliceMilliseconds() const { return this->LiveSliceMilliseconds; }
   // The posed cage and the posed body surface (the transfer mesh's outer faces), RAS mm; null
   // without a live pose.
   vtkPolyData* GetLiveCage() const;
@@ -218,18 +224,20 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // The live frame's labels of G on the slice plane through `positionMm` (orientation 0 axial,
   // 1 coronal, 2 sagittal), square pixels, `pixels` across the box's larger in-plane side and as
   // many as the box needs across the other: a one-voxel-thick label image on RAS axes (what the
-  // slice views show while a handle is dragged). Null without a live pose. `milliseconds`
-  // (optional) receives the rasterization time.
-  vtkSmartPointer<vtkImageData> ComputeLiveSlice(int orientation, double positionMm, int pixels,
-                                                 double* milliseconds = nullptr);
+  // slice views show while a handle is dragged). Null without a live pose. Its time:
+  // GetLiveSliceMilliseconds.
+  vtkSmartPointer<vtkImageData> ComputeLiveSlice(int orientation, double positionMm, int pixels);
   // The segmentation's image (CT, MR) on the same plane and grid as ComputeLiveSlice, posed the
   // same way (trilinear at the rest position; the image's minimum where no tissue is). Null when
   // the segmentation has no image or there is no live pose.
   vtkSmartPointer<vtkImageData> ComputeLiveImageSlice(int orientation, double positionMm,
                                                       int pixels);
   // A grey window for that image: a soft-tissue CT window (W 400, L 40) for a CT in Hounsfield
-  // units, else the 1st..99th percentile of the image's voxels. False without a live image.
-  bool GetLiveImageWindow(double& window, double& level) const;
+  // units, else the 1st..99th percentile of the image's voxels. Empty without a live image.
+  struct ImageWindow {
+    double window = 0, level = 0;
+  };
+  std::optional<ImageWindow> GetLiveImageWindow() const;
 
  protected:
   vtkSlicerReposeLogic();
@@ -252,6 +260,11 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   vtkMRMLReposePoseNode* AddPoseNode(const std::string& name, const std::string& json);
   // Pushes an undo step (or extends the current drag's) and sets the pose node's JSON.
   void RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after);
+  // Runs `body` for a call that can fail: LastErrorMessage is cleared, and an exception becomes
+  // its one line and the `failed` result (vtkSlicerReposeLogicGuarded.h). The one try/catch of
+  // the Logic's calls.
+  template <class Result, class Body>
+  Result Guarded(Result failed, Body&& body);
 
  private:
   vtkSlicerReposeLogic(const vtkSlicerReposeLogic&) = delete;
@@ -285,4 +298,5 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   mutable const vtkMRMLReposePoseNode* SummarizedPose = nullptr;
   mutable vtkMTimeType SummarizedTime = 0;
   mutable PoseSummary Summary;
+  double LiveSliceMilliseconds = 0;
 };

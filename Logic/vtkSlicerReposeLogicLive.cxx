@@ -8,6 +8,7 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeJob.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicGuarded.h"
 #include "vtkSlicerReposeLogicInputs.h"
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
@@ -103,8 +104,7 @@ void setPoints(vtkPolyData* poly, const Eigen::MatrixX3d& positions) {
 }  // namespace
 
 bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
     const auto nodes = vtkSlicerReposeLogicInputs::Resolve(this->Scene, poseNode);
     // Converted here, on the caller's thread: the worker never touches the nodes.
@@ -156,10 +156,7 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           };
         });
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 void vtkSlicerReposeLogic::OnLivePoseModified() {
@@ -167,15 +164,15 @@ void vtkSlicerReposeLogic::OnLivePoseModified() {
   // New or changed handle groups (a group made from a selection, or its undo) need the rig
   // prepared again: a job, after which the frame is solved. Until then the last frame stays.
   std::optional<repose::Pose> pose;
-  try {
-    pose = repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName());
-    if (!repose::sameHandleGroups(*pose, this->Live->Rig->pose())) {
-      if (!this->StartLivePose(this->Live->Pose)) this->Modified();
-      return;
-    }
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
+  if (!this->Guarded<bool>(false, [&] {
+        pose = repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName());
+        return true;
+      })) {
     this->Modified();
+    return;
+  }
+  if (!repose::sameHandleGroups(*pose, this->Live->Rig->pose())) {
+    if (!this->StartLivePose(this->Live->Pose)) this->Modified();
     return;
   }
   this->SolveLiveFrame(*pose);  // the pose parsed once per change
@@ -198,19 +195,20 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::GetLivePose() const {
 
 bool vtkSlicerReposeLogic::UpdateLiveFrame() {
   if (!this->Live) return false;
-  try {
-    return this->SolveLiveFrame(
-        repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName()));
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
+  std::optional<repose::Pose> pose;
+  if (!this->Guarded<bool>(false, [&] {
+        pose = repose::parsePose(this->Live->Pose->GetPoseJSON(), this->Live->Pose->GetName());
+        return true;
+      })) {
     this->Modified();
     return false;
   }
+  return this->SolveLiveFrame(*pose);
 }
 
 bool vtkSlicerReposeLogic::SolveLiveFrame(const repose::Pose& pose) {
   LiveSession& live = *this->Live;
-  try {
+  const bool solved = this->Guarded<bool>(false, [&] {
     const auto start = std::chrono::steady_clock::now();
     const std::size_t frames = pose.frames().size();
     const std::size_t index =
@@ -228,13 +226,10 @@ bool vtkSlicerReposeLogic::SolveLiveFrame(const repose::Pose& pose) {
         frame.deformed.colwise().maxCoeff().transpose());
     live.FrameMilliseconds =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    this->Modified();
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    this->Modified();
-    return false;
-  }
+  });
+  this->Modified();  // the views follow a new frame, or show the message
+  return solved;
 }
 
 double vtkSlicerReposeLogic::GetLiveFrameMilliseconds() const {
@@ -324,8 +319,8 @@ repose::VolumeGeometry liveSliceGrid(const Eigen::Vector3d& lo, const Eigen::Vec
 }  // namespace
 
 vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orientation,
-                                                                     double positionMm, int pixels,
-                                                                     double* milliseconds) {
+                                                                     double positionMm,
+                                                                     int pixels) {
   if (!this->Live || this->Live->Deformed.rows() == 0 || orientation < 0 || orientation > 2 ||
       pixels < 2)
     return nullptr;
@@ -337,9 +332,8 @@ vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orienta
   options.outerFaces = &live.OuterFaces;
   const repose::Volume slice =
       repose::rasterizeLabels(*live.Labels, live.Rig->mesh(), live.Deformed, grid, options);
-  if (milliseconds)
-    *milliseconds =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  this->LiveSliceMilliseconds =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return Conversion::ToImageData(slice);
 }
 
@@ -358,9 +352,7 @@ vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveImageSlice(int or
                              live.ImageBackground, options));
 }
 
-bool vtkSlicerReposeLogic::GetLiveImageWindow(double& window, double& level) const {
-  if (!this->Live || !this->Live->Image) return false;
-  window = this->Live->ImageWindow;
-  level = this->Live->ImageLevel;
-  return true;
+std::optional<vtkSlicerReposeLogic::ImageWindow> vtkSlicerReposeLogic::GetLiveImageWindow() const {
+  if (!this->Live || !this->Live->Image) return std::nullopt;
+  return ImageWindow{this->Live->ImageWindow, this->Live->ImageLevel};
 }

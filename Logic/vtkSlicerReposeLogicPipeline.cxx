@@ -10,6 +10,7 @@
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeJob.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicGuarded.h"
 #include "vtkSlicerReposeLogicRead.h"
 #include "vtkSlicerReposeLogicInputs.h"
 #include "vtkSlicerReposeMeshConversion.h"
@@ -124,36 +125,32 @@ vtkMRMLReposeScene* vtkSlicerReposeLogic::GetScene() const {
 vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::string& labels,
                                                                      const std::string& parts,
                                                                      const std::string& image) {
-  this->LastErrorMessage.clear();
-  try {
-    const repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels);
-    if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
-    auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
-    node->SetName(stemOf(labels));
-    node->SetLabelMap(Conversion::ToImageData(G));
-    for (const auto& [path, setter] :
-         {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
-          std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
-      if (path.empty()) continue;
-      const repose::Volume v = vtkSlicerReposeLogicRead::ReadVolume(path);
-      if (v.dims() != G.dims() || !v.geometry().ijkToRas.isApprox(G.geometry().ijkToRas, 1e-6))
-        throw repose::Error(path + ": not on the grid of " + labels);
-      (node->*setter)(Conversion::ToImageData(v));
-    }
-    // The joints pose files name: the skeleton beside S, as `repose pose` finds it.
-    if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())
-      node->SetSkeletonJSON(readText(skeleton));
-    this->Scene->AddNode(node);
-    return node;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return nullptr;
-  }
+  return this->Guarded<vtkMRMLReposeSegmentationNode*>(
+      nullptr, [&]() -> vtkMRMLReposeSegmentationNode* {
+        const repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels);
+        if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
+        auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
+        node->SetName(stemOf(labels));
+        node->SetLabelMap(Conversion::ToImageData(G));
+        for (const auto& [path, setter] :
+             {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
+              std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
+          if (path.empty()) continue;
+          const repose::Volume v = vtkSlicerReposeLogicRead::ReadVolume(path);
+          if (v.dims() != G.dims() || !v.geometry().ijkToRas.isApprox(G.geometry().ijkToRas, 1e-6))
+            throw repose::Error(path + ": not on the grid of " + labels);
+          (node->*setter)(Conversion::ToImageData(v));
+        }
+        // The joints pose files name: the skeleton beside S, as `repose pose` finds it.
+        if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())
+          node->SetSkeletonJSON(readText(skeleton));
+        this->Scene->AddNode(node);
+        return node;
+      });
 }
 
 vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<vtkMRMLReposePoseNode*>(nullptr, [&]() -> vtkMRMLReposePoseNode* {
     repose::Pose pose = repose::readPoseFile(path);
     // Named joints become numbers with the skeleton of the newest segmentation that has one;
     // without one they stay named until the rig is built for a segmentation (StartBuildRig).
@@ -169,10 +166,7 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {
     }
     return this->AddPoseNode(pose.name.empty() ? stemOf(path) : pose.name,
                              repose::poseToJson(pose));
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return nullptr;
-  }
+  });
 }
 
 vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPoseNode(const std::string& name,
@@ -186,8 +180,7 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPoseNode(const std::string& name
 
 bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
                                          vtkMRMLReposePoseNode* poseNode) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (!seg || !seg->GetLabelMap() || !poseNode)
       throw repose::Error("building the rig needs a segmentation with a label map and a pose");
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
@@ -239,10 +232,7 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
           };
         });
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 std::string vtkSlicerReposeLogic::PartsPath() const {
@@ -267,8 +257,7 @@ std::shared_ptr<const repose::PoseJob> vtkSlicerReposeLogic::PoseJobFor(
 }
 
 bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int iterations) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
     const auto nodes = vtkSlicerReposeLogicInputs::Resolve(this->Scene, poseNode);
     vtkPolyData* posed = this->GetLiveCage();
@@ -326,16 +315,12 @@ bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int 
                        };
                      });
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
                                           const std::string& outputFolder) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (this->Job->IsRunning()) throw repose::Error("another job is running");
     const auto nodes = vtkSlicerReposeLogicInputs::Resolve(this->Scene, poseNode);
     auto* seg = nodes.Segmentation;
@@ -403,10 +388,7 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           };
         });
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 bool vtkSlicerReposeLogic::IsJobRunning() const {
@@ -462,8 +444,7 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::GetLastPosedSegmentation() 
 }
 
 bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (!fs::is_directory(fs::absolute(folder).parent_path()))
       throw repose::Error(folder + ": its parent folder does not exist");
     fs::create_directories(folder);
@@ -540,15 +521,11 @@ bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
     repose::writeTextFileAtomically((dir / repose::scene_schema::kDocument).string(),
                                     this->Scene->WriteJSON() + "\n");
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     const fs::path dir = folder;
     vtkNew<vtkMRMLReposeScene> loaded;
     std::string error;
@@ -596,10 +573,7 @@ bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
     this->LastPosedSegmentation = nullptr;
     this->Modified();
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 bool vtkSlicerReposeLogic::OpenScene(const std::string& folder) {

@@ -6,6 +6,7 @@
 #include "vtkMRMLReposePoseNode.h"
 #include "vtkMRMLReposeScene.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicGuarded.h"
 
 #include <repose/pose/Pose.h>
 #include <repose/util/Error.h>
@@ -87,8 +88,7 @@ bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
                                                  const std::array<double, 3>& axis, double angleDeg,
                                                  const std::array<double, 3>& pivot,
                                                  const std::array<double, 3>& translation) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (!node) throw repose::Error("no pose");
     repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
     repose::PoseGroup& g = findGroup(pose, group, node->GetName());
@@ -107,44 +107,37 @@ bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
     setCurrentTransform(pose, node, g, t);
     this->RecordPoseEdit(node, repose::poseToJson(pose));
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
-bool vtkSlicerReposeLogic::GetPoseGroupTransform(vtkMRMLReposePoseNode* node,
-                                                 const std::string& group,
-                                                 std::array<double, 3>& axis, double& angleDeg,
-                                                 std::array<double, 3>& pivot,
-                                                 std::array<double, 3>& translation) const {
-  if (!node) return false;
+std::optional<vtkSlicerReposeLogic::GroupTransform> vtkSlicerReposeLogic::GetPoseGroupTransform(
+    vtkMRMLReposePoseNode* node, const std::string& group) const {
+  if (!node) return std::nullopt;
   try {
     repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
     const repose::PoseGroup& g = findGroup(pose, group, node->GetName());
-    if (g.fixed) return false;
+    if (g.fixed) return std::nullopt;
     const repose::PoseTransform t = currentTransform(pose, node, g);
-    axis = {t.axis.x(), t.axis.y(), t.axis.z()};
-    angleDeg = t.angleDeg;
-    pivot = {t.pivot.x(), t.pivot.y(), t.pivot.z()};
-    translation = {t.translation.x(), t.translation.y(), t.translation.z()};
-    return true;
+    GroupTransform out;
+    out.axis = {t.axis.x(), t.axis.y(), t.axis.z()};
+    out.angleDeg = t.angleDeg;
+    out.pivot = {t.pivot.x(), t.pivot.y(), t.pivot.z()};
+    out.translation = {t.translation.x(), t.translation.y(), t.translation.z()};
+    return out;
   } catch (const std::exception&) {
-    return false;
+    return std::nullopt;  // a query: an unknown group is an answer, not an error to report
   }
 }
 
 bool vtkSlicerReposeLogic::GetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
                                               vtkMatrix4x4* matrix) const {
-  std::array<double, 3> axis, pivot, translation;
-  double angle = 0;
-  if (!matrix || !this->GetPoseGroupTransform(node, group, axis, angle, pivot, translation))
-    return false;
+  const std::optional<GroupTransform> g = this->GetPoseGroupTransform(node, group);
+  if (!matrix || !g) return false;
   repose::PoseTransform t;
-  t.axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
-  t.angleDeg = angle;
-  t.pivot = Eigen::Vector3d(pivot[0], pivot[1], pivot[2]);
-  t.translation = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+  t.axis = Eigen::Vector3d(g->axis[0], g->axis[1], g->axis[2]);
+  t.angleDeg = g->angleDeg;
+  t.pivot = Eigen::Vector3d(g->pivot[0], g->pivot[1], g->pivot[2]);
+  t.translation = Eigen::Vector3d(g->translation[0], g->translation[1], g->translation[2]);
   const Eigen::Matrix4d m = t.isometry().matrix();
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) matrix->SetElement(r, c, m(r, c));
@@ -154,10 +147,8 @@ bool vtkSlicerReposeLogic::GetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
 bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
                                               vtkMatrix4x4* matrix) {
   this->LastErrorMessage.clear();
-  std::array<double, 3> oldAxis, pivot, oldTranslation;
-  double oldAngle = 0;
-  if (!matrix ||
-      !this->GetPoseGroupTransform(node, group, oldAxis, oldAngle, pivot, oldTranslation)) {
+  const std::optional<GroupTransform> old = this->GetPoseGroupTransform(node, group);
+  if (!matrix || !old) {
     this->LastErrorMessage = "pose group \"" + group + "\" cannot be moved (unknown or fixed)";
     return false;
   }
@@ -174,8 +165,9 @@ bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
   }
   // x' = R (x - p) + p + T with the group's own pivot p: T = shift + R p - p. The axis keeps the
   // direction it had, so the panel's angle control still turns the same way after a drag.
+  const std::array<double, 3>& pivot = old->pivot;
   const Eigen::Vector3d p(pivot[0], pivot[1], pivot[2]);
-  const Eigen::Vector3d oldA(oldAxis[0], oldAxis[1], oldAxis[2]);
+  const Eigen::Vector3d oldA(old->axis[0], old->axis[1], old->axis[2]);
   Eigen::AngleAxisd aa(R);
   Eigen::Vector3d axis = aa.axis();
   double angle = aa.angle() * 180.0 / M_PI;
@@ -192,8 +184,7 @@ bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
 }
 
 vtkMRMLReposePoseNode* vtkSlicerReposeLogic::NewPose(const std::string& name) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<vtkMRMLReposePoseNode*>(nullptr, [&]() -> vtkMRMLReposePoseNode* {
     repose::Pose pose;
     pose.name = name.empty() ? "pose" : name;
     repose::PoseGroup rest;
@@ -202,16 +193,12 @@ vtkMRMLReposePoseNode* vtkSlicerReposeLogic::NewPose(const std::string& name) {
     rest.fixed = true;
     pose.groups.push_back(rest);
     return this->AddPoseNode(pose.name, repose::poseToJson(pose));
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return nullptr;
-  }
+  });
 }
 
 std::string vtkSlicerReposeLogic::AddPoseGroup(vtkMRMLReposePoseNode* node,
                                                const std::vector<int>& cageVertices, int bodyPart) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<std::string>("", [&]() -> std::string {
     if (!node) throw repose::Error("no pose");
     if (node != this->GetLivePose())
       throw repose::Error("pose " + node->GetName() +
@@ -274,16 +261,12 @@ std::string vtkSlicerReposeLogic::AddPoseGroup(vtkMRMLReposePoseNode* node,
     pose.groups.push_back(group);
     this->RecordPoseEdit(node, repose::poseToJson(pose));
     return group.name;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return "";
-  }
+  });
 }
 
 bool vtkSlicerReposeLogic::AddPoseSeparation(vtkMRMLReposePoseNode* node, const std::string& partA,
                                              const std::string& partB, const std::string& region) {
-  this->LastErrorMessage.clear();
-  try {
+  return this->Guarded<bool>(false, [&]() -> bool {
     if (!node) throw repose::Error("no pose");
     repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
     repose::PoseSeparation separation;
@@ -301,10 +284,7 @@ bool vtkSlicerReposeLogic::AddPoseSeparation(vtkMRMLReposePoseNode* node, const 
     pose.separations.push_back(separation);
     this->RecordPoseEdit(node, repose::poseToJson(pose));
     return true;
-  } catch (const std::exception& e) {
-    this->LastErrorMessage = e.what();
-    return false;
-  }
+  });
 }
 
 bool vtkSlicerReposeLogic::CanUndo() const {

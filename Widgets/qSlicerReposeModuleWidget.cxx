@@ -333,23 +333,18 @@ bool qSlicerReposeModuleWidget::setActiveGroupAngle(double angleDeg) {
   Q_D(qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!pose || !d->Logic) return false;
-  std::array<double, 3> axis, pivot, translation;
-  double angle = 0;
   const std::string group = d->ParameterNode->GetActiveGroup();
-  if (!d->Logic->GetPoseGroupTransform(pose, group, axis, angle, pivot, translation)) return false;
-  return d->Logic->SetPoseGroupTransform(pose, group, axis, angleDeg, pivot, translation);
+  const auto t = d->Logic->GetPoseGroupTransform(pose, group);
+  return t &&
+         d->Logic->SetPoseGroupTransform(pose, group, t->axis, angleDeg, t->pivot, t->translation);
 }
 
 double qSlicerReposeModuleWidget::activeGroupAngle() const {
   Q_D(const qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!pose || !d->ParameterNode || !d->Logic) return 0;
-  std::array<double, 3> axis, pivot, translation;
-  double angle = 0;
-  return d->Logic->GetPoseGroupTransform(pose, d->ParameterNode->GetActiveGroup(), axis, angle,
-                                         pivot, translation)
-             ? angle
-             : 0;
+  const auto t = d->Logic->GetPoseGroupTransform(pose, d->ParameterNode->GetActiveGroup());
+  return t ? t->angleDeg : 0;
 }
 
 bool qSlicerReposeModuleWidget::newPose() {

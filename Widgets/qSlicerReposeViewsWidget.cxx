@@ -219,16 +219,14 @@ void qSlicerReposeViewsWidget::refresh() {
   for (int o = 0; o < 3; ++o) {
     const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;  // axial: S, coronal: A, sagittal: R
     if (std::isnan(d->Positions[o])) d->Positions[o] = centre[std::size_t(axis)];
-    double ms = 0;
-    vtkSmartPointer<vtkImageData> slice =
-        d->Logic->ComputeLiveSlice(o, d->Positions[o], d->Pixels, &ms);
+    vtkSmartPointer<vtkImageData> slice = d->Logic->ComputeLiveSlice(o, d->Positions[o], d->Pixels);
+    const double ms = d->Logic->GetLiveSliceMilliseconds();
     d->SliceMilliseconds += ms;
     sliceMs[std::size_t(o)] = ms;
     vtkSmartPointer<vtkImageData> image =
         d->Logic->ComputeLiveImageSlice(o, d->Positions[o], d->Pixels);
-    double window = 0, level = 0;
-    d->Logic->GetLiveImageWindow(window, level);
-    d->Slices[o]->setWindowLevel(window, level);
+    const auto window = d->Logic->GetLiveImageWindow();
+    d->Slices[o]->setWindowLevel(window ? window->window : 0, window ? window->level : 0);
     d->Slices[o]->setPositionMm(d->Positions[o]);
     if (vtkMRMLReposeParametersNode* p = d->Logic->GetParameterNode())
       d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());

@@ -98,18 +98,19 @@ int main(int argc, char** argv) {
   const double prepareMs = ms(prepareStart, Clock::now());
 
   // The group to drag: the one named, else the first the pose moves.
-  std::array<double, 3> axis{}, pivot{}, translation{};
-  double restAngle = 0;
   if (group.empty()) {
     for (const std::string candidate : {"left forearm and hand", "left arm", "left leg"})
-      if (logic->GetPoseGroupTransform(pose, candidate, axis, restAngle, pivot, translation)) {
+      if (logic->GetPoseGroupTransform(pose, candidate)) {
         group = candidate;
         break;
       }
   }
-  if (group.empty() ||
-      !logic->GetPoseGroupTransform(pose, group, axis, restAngle, pivot, translation))
+  const auto rest = logic->GetPoseGroupTransform(pose, group);
+  if (group.empty() || !rest)
     fail("no movable group \"" + group + "\" in the scene's pose (--group NAME)");
+  const std::array<double, 3> axis = rest->axis, pivot = rest->pivot,
+                              translation = rest->translation;
+  const double restAngle = rest->angleDeg;
 
   const std::array<double, 6> box = logic->GetLiveBounds();
   const std::array<double, 3> centre{(box[0] + box[1]) / 2, (box[2] + box[3]) / 2,

@@ -84,11 +84,12 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
 
   // The coronal plane through the elbow's pivot (A = -14 mm).
   const double y = -14;
-  double ms = 0;
+  EXPECT_EQ(logic->GetLiveSliceMilliseconds(), 0.0);  // before the first slice
   const auto start = std::chrono::steady_clock::now();
-  vtkSmartPointer<vtkImageData> bent = logic->ComputeLiveSlice(1, y, 128, &ms);
+  vtkSmartPointer<vtkImageData> bent = logic->ComputeLiveSlice(1, y, 128);
   const double wall =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = logic->GetLiveSliceMilliseconds();
   ASSERT_TRUE(bent);
   // The time shown in the views is this call's, in milliseconds: within the call's wall time
   // and most of it (not seconds, not microseconds, not a stale figure of another call).
@@ -171,10 +172,10 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
     vtkSmartPointer<vtkImageData> image = logic->ComputeLiveImageSlice(1, 0, 96);
     ASSERT_TRUE(labels && image);
     ASSERT_EQ(image->GetNumberOfPoints(), labels->GetNumberOfPoints());
-    double window = 0, level = 0;
-    ASSERT_TRUE(logic->GetLiveImageWindow(window, level));
-    EXPECT_EQ(window, 400);
-    EXPECT_EQ(level, 40);
+    const auto window = logic->GetLiveImageWindow();
+    ASSERT_TRUE(window);
+    EXPECT_EQ(window->window, 400);
+    EXPECT_EQ(window->level, 40);
     const repose::Volume table = repose::readVolume(phantom.G);
     auto labelOf = [&](const std::string& name) {
       for (const repose::Label& l : table.labels().labels())
