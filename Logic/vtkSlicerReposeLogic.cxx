@@ -68,6 +68,10 @@ std::string oneLine(std::string text) {
 }  // namespace
 
 bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
+  return this->ShowVolume(path, nullptr);
+}
+
+bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* held) {
   this->VolumeImageData = nullptr;
   this->VolumeIJKToRASMatrix = nullptr;
   this->VolumeLookupTable = nullptr;
@@ -77,8 +81,10 @@ bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
   this->LastErrorMessage.clear();
   try {
     if (path.empty()) throw repose::Error("no input file given");
-    const repose::Volume volume = vtkSlicerReposeLogicRead::ReadVolume(path);
-    this->VolumeImageData = vtkSlicerReposeVolumeConversion::ToImageData(volume);
+    const repose::Volume volume = held ? vtkSlicerReposeVolumeConversion::FromImageData(held)
+                                       : vtkSlicerReposeLogicRead::ReadVolume(path);
+    this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
+                                 : vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =
         vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);
     for (const repose::Label& l : volume.labels().labels())

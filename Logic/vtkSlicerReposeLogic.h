@@ -258,6 +258,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // `repose rig` is looked for.
   std::string PartsPath() const;
   vtkMRMLReposePoseNode* AddPoseNode(const std::string& name, const std::string& json);
+  // LoadVolume, or with `held` (a node's label map, read already) that image instead of the
+  // file at `path`, which then only names it.
+  bool ShowVolume(const std::string& path, vtkImageData* held);
   // Pushes an undo step (or extends the current drag's) and sets the pose node's JSON.
   void RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after);
   // Runs `body` for a call that can fail: LastErrorMessage is cleared, and an exception becomes

@@ -609,8 +609,9 @@ bool vtkSlicerReposeLogic::OpenScene(const std::string& folder) {
       p->SetTransferMeshSizeMm(mesh->GetSizeMm());
   }
   p->EndModify(state);
-  // The input box shows G (read again from its file: the node holds its voxels, not its table).
-  if (seg && !this->LoadVolume(inFolder(seg->GetLabelMapFileName()))) return false;
+  // The input box shows G: the voxels and label table the node read, not the file again.
+  if (seg && !this->ShowVolume(inFolder(seg->GetLabelMapFileName()), seg->GetLabelMap()))
+    return false;
   // A rigged pose goes live (a job: PollJob/WaitForJob commits it).
   if (pose && this->Scene->GetReferencedNode(pose, repose::scene_schema::kTransferMeshRole) &&
       !this->StartLivePose(pose))

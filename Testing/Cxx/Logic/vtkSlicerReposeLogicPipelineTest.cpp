@@ -278,6 +278,29 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
       << reloaded->GetLastErrorMessage();
   std::ifstream reloadedReport(reloadedOut + "/report.json");
   EXPECT_TRUE(nlohmann::json::parse(reloadedReport)["green_coordinates"]["read"].get<bool>());
+
+  // Opening the folder as a user does (the module's File > Open): the parameter node follows the
+  // scene, its files named where they are (the workbench saved them relative to the folder), G
+  // shown as reading its file shows it, and the rigged pose goes live.
+  vtkNew<vtkSlicerReposeLogic> opened;
+  vtkNew<vtkMRMLReposeParametersNode> parameters;
+  opened->SetParameterNode(parameters);
+  ASSERT_TRUE(opened->OpenScene(saved)) << opened->GetLastErrorMessage();
+  auto* openedPose = vtkMRMLReposePoseNode::SafeDownCast(
+      opened->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode").at(0));
+  EXPECT_EQ(parameters->GetActivePoseNodeID(), openedPose->GetID());
+  EXPECT_TRUE(std::filesystem::exists(parameters->GetPosePath())) << parameters->GetPosePath();
+  EXPECT_TRUE(std::filesystem::exists(parameters->GetBodyPartMapPath()))
+      << parameters->GetBodyPartMapPath();
+  EXPECT_EQ(parameters->GetActiveGroup(), opened->GetPoseSummary(openedPose).movableGroups.at(0));
+  ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << opened->GetLastErrorMessage();
+  EXPECT_EQ(opened->GetLivePose(), openedPose);
+  vtkNew<vtkSlicerReposeLogic> fromFile;
+  ASSERT_TRUE(fromFile->LoadVolume(parameters->GetInputSegmentationPath()))
+      << fromFile->GetLastErrorMessage();
+  EXPECT_EQ(opened->GetVolumeSummary(), fromFile->GetVolumeSummary());
+  EXPECT_EQ(opened->GetVolumeLabelNames().size(), fromFile->GetVolumeLabelNames().size());
 }
 
 // Output > Memory budget: an export whose posed volumes would not fit is refused before any work,
