@@ -1,5 +1,5 @@
-// Checks of input volumes shared by the commands that pose (issue 10, validation on input): one
-// line naming the file for what cannot be posed, a warning for what can but may surprise.
+// Checks of input volumes shared by the commands that pose: one line naming the file for what
+// cannot be posed, a warning for what can but may surprise.
 #pragma once
 
 #include "repose/volume/Volume.h"

@@ -16,7 +16,7 @@ struct ReadOptions {
   ProgressFn progress;
   // Bytes this read may allocate (0: no limit). Each reader estimates its need from the header
   // (the volume, plus staging or the library's own copy) before allocating anything, and above
-  // the limit throws repose::Error naming the file with the numbers (issue 10, memory budgets).
+  // the limit throws repose::Error naming the file with the numbers.
   double memoryLimitBytes = 0;
   // How the caller's user gets a larger budget, ending that error (the command line's option).
   std::string budgetHint = "raise --memory";

@@ -73,8 +73,8 @@ class CageDeformation {
   const RigiditySolver& solver() const { return *solver_; }
   // Vertices the winding number puts inside the cage whose Green coordinates do not reproduce
   // their rest position. They are left out of V_c, to the rigidity solver like the vertices
-  // outside the cage. A safety net: the one cause seen (a vertex right above the line of a cage
-  // edge, 146 mm off) is fixed in GreenCoordinates.cpp, and none is expected.
+  // outside the cage. A safety net: none is expected (GreenQuasiConformalTest reproduces points
+  // right above a face's edge and above an edge's line).
   int unreproducedVertices() const { return unreproduced_; }
   std::size_t coefficientBytes() const;
   // Writes V_c and the coefficients to `path` (atomically), for this mesh and cage only.
