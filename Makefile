@@ -32,7 +32,9 @@ test: build fuzz-build
 	cd $(FUZZ_DIR) && ctest --output-on-failure -j $(JOBS)
 
 # The readers' libFuzzer targets (clang, ASan + UBSan) in their own build folder; `make test` runs
-# each a few seconds (fuzz-smoke); scripts/fuzz.sh runs long campaigns (docs/RELIABILITY.md).
+# each a few seconds (fuzz-smoke), and there the sanitizer gate: the unit tests of the readers,
+# writers and the rasterizer's scan under the same sanitizers (ReposeSanitizedCoreTests);
+# scripts/fuzz.sh runs long campaigns (docs/RELIABILITY.md).
 FUZZ_DIR ?= build-fuzz
 $(FUZZ_DIR)/build.ninja: | deps
 	cmake -S . -B $(FUZZ_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release \

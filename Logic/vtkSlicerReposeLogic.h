@@ -5,6 +5,7 @@
 #include "vtkSlicerReposeModuleLogicExport.h"
 
 #include "vtkMRMLReposeParametersNode.h"
+#include "vtkSlicerReposePoseHistory.h"
 
 #include <vtkImageData.h>
 #include <vtkLookupTable.h>
@@ -290,11 +291,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::vector<double> RefinementErrors;
   std::unique_ptr<vtkSlicerReposeJob> Job;
   vtkSmartPointer<vtkMRMLReposeSegmentationNode> LastPosedSegmentation;
-  struct PoseEdit {
-    std::string nodeID, before, after;
-  };
-  std::vector<PoseEdit> UndoStack, RedoStack;
-  bool Interacting = false, InteractionRecorded = false;
+  vtkSlicerReposePoseHistory History;  // undo and redo of pose edits
   struct LiveSession;
   std::shared_ptr<LiveSession> Live;  // shared_ptr: its type is complete only in the Live file
   // GetPoseSummary's last answer, for the node and modification time it was parsed at.

@@ -11,13 +11,12 @@
 #include "vtkSlicerReposeJob.h"
 #include "vtkSlicerReposeLogic.h"
 #include "vtkSlicerReposeLogicGuarded.h"
+#include "vtkSlicerReposeSceneIO.h"
 #include "vtkSlicerReposeLogicRead.h"
 #include "vtkSlicerReposeLogicInputs.h"
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
-#include <repose/io/ColorTableIO.h>
-#include <repose/io/AtomicOutput.h>
 #include <repose/io/MeshIO.h>
 #include <repose/io/NrrdIO.h>
 #include <repose/io/VolumeIO.h>
@@ -25,7 +24,6 @@
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseReport.h>
 #include <repose/pose/PoseRig.h>
-#include <repose/pose/SlicerSceneMrml.h>
 #include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/schema/SceneSchema.h>
@@ -51,14 +49,6 @@ std::string stemOf(const std::string& path) {
         name.compare(name.size() - std::strlen(ext), std::strlen(ext), ext) == 0)
       return name.substr(0, name.size() - std::strlen(ext));
   return name;
-}
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw repose::Error(path + ": cannot open");
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 }  // namespace
@@ -114,8 +104,7 @@ repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg) {
 void vtkSlicerReposeLogic::SetScene(vtkMRMLReposeScene* scene) {
   if (!scene || scene == this->Scene) return;
   this->Scene = scene;
-  this->UndoStack.clear();
-  this->RedoStack.clear();
+  this->History.Clear();
   this->Modified();
 }
 vtkMRMLReposeScene* vtkSlicerReposeLogic::GetScene() const {
@@ -143,7 +132,7 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
         }
         // The joints pose files name: the skeleton beside S, as `repose pose` finds it.
         if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())
-          node->SetSkeletonJSON(readText(skeleton));
+          node->SetSkeletonJSON(vtkSlicerReposeLogicRead::ReadText(skeleton));
         this->Scene->AddNode(node);
         return node;
       });
@@ -444,132 +433,19 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::GetLastPosedSegmentation() 
 }
 
 bool vtkSlicerReposeLogic::SaveScene(const std::string& folder) {
-  return this->Guarded<bool>(false, [&]() -> bool {
-    if (!fs::is_directory(fs::absolute(folder).parent_path()))
-      throw repose::Error(folder + ": its parent folder does not exist");
-    fs::create_directories(folder);
-    const fs::path dir = folder;
-    for (int n = 0; n < this->Scene->GetNumberOfNodes(); ++n) {
-      vtkMRMLReposeNode* node = this->Scene->GetNthNode(n);
-      const std::string id = node->GetID();
-      if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
-        const int state = seg->StartModify();
-        for (auto [image, setter, suffix] :
-             {std::tuple{seg->GetLabelMap(), &vtkMRMLReposeSegmentationNode::SetLabelMapFileName,
-                         "_G"},
-              std::tuple{seg->GetBodyPartMap(),
-                         &vtkMRMLReposeSegmentationNode::SetBodyPartMapFileName, "_S"},
-              std::tuple{seg->GetImage(), &vtkMRMLReposeSegmentationNode::SetImageFileName,
-                         "_image"}}) {
-          const std::string name = image ? id + suffix + ".nii.gz" : "";
-          if (image) repose::writeVolume(Conversion::FromImageData(image), (dir / name).string());
-          (seg->*setter)(name);
-        }
-        seg->EndModify(state);
-      } else if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node)) {
-        cage->SetFileName(id + ".vtk");
-        repose::writeTriangleMesh(vtkSlicerReposeMeshConversion::FromPolyData(cage->GetMesh()),
-                                  (dir / cage->GetFileName()).string());
-      } else if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node)) {
-        tm->SetFileName(id + ".vtu");
-        repose::writeTransferMesh(
-            vtkSlicerReposeMeshConversion::FromUnstructuredGrid(tm->GetMesh()),
-            (dir / tm->GetFileName()).string());
-        // Its Green coordinates go along (whether they still fit the mesh and its cage is
-        // checked where they are read).
-        const std::string coordinates =
-            repose::greenCoordinatesFileFor((dir / tm->GetFileName()).string());
-        const std::string from = tm->GetCoordinatesFile();
-        std::error_code ec;
-        if (!from.empty() && fs::is_regular_file(from, ec) &&
-            !fs::equivalent(from, coordinates, ec)) {
-          repose::AtomicOutput copy(coordinates);
-          fs::copy_file(from, copy.tempPath(), fs::copy_options::overwrite_existing);
-          copy.commit();
-          tm->SetCoordinatesFile(coordinates);
-        } else if (from.empty() || !fs::is_regular_file(from, ec)) {
-          tm->SetCoordinatesFile("");
-        }
-      } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
-        pose->SetFileName(id + ".pose.json");
-        repose::writeTextFileAtomically((dir / pose->GetFileName()).string(), pose->GetPoseJSON());
-      }
-    }
-    // The same scene for 3D Slicer (docs/SLICER.md): the input and the last posed label maps
-    // (with a colour table: Slicer ignores a NIfTI's label table), the cage and the mesh.
-    repose::SlicerSceneFiles mrml;
-    for (int n = 0; n < this->Scene->GetNumberOfNodes(); ++n) {
-      vtkMRMLReposeNode* node = this->Scene->GetNthNode(n);
-      auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node);
-      if (seg && !seg->GetLabelMapFileName().empty()) {
-        const bool posed = this->Scene->GetReferencedNode(seg, "source") != nullptr;
-        std::string& slot = posed ? mrml.posedLabels : mrml.inputLabels;
-        if (slot.empty()) slot = (dir / seg->GetLabelMapFileName()).string();
-        if (!posed && mrml.colorTable.empty()) {
-          mrml.colorTable = (dir / (std::string(seg->GetID()) + "_G.ctbl")).string();
-          repose::writeColorTable(Conversion::FromImageData(seg->GetLabelMap()), mrml.colorTable);
-        }
-      }
-      if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node); cage && mrml.cage.empty())
-        mrml.cage = (dir / cage->GetFileName()).string();
-      if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node);
-          tm && mrml.transferMesh.empty())
-        mrml.transferMesh = (dir / tm->GetFileName()).string();
-    }
-    repose::writeTextFileAtomically((dir / "scene.mrml").string(),
-                                    repose::formatSlicerScene(mrml, dir.string()));
-    repose::writeTextFileAtomically((dir / repose::scene_schema::kDocument).string(),
-                                    this->Scene->WriteJSON() + "\n");
+  return this->Guarded<bool>(false, [&] {
+    vtkSlicerReposeSceneIO::Save(this->Scene, folder);
     return true;
   });
 }
 
 bool vtkSlicerReposeLogic::LoadScene(const std::string& folder) {
-  return this->Guarded<bool>(false, [&]() -> bool {
-    const fs::path dir = folder;
-    vtkNew<vtkMRMLReposeScene> loaded;
-    std::string error;
-    if (!loaded->ReadJSON(readText((dir / repose::scene_schema::kDocument).string()), &error))
-      throw repose::Error((dir / repose::scene_schema::kDocument).string() + ": " + error);
-    auto need = [&](const std::string& name, vtkMRMLReposeNode* node) {
-      if (name.empty())
-        throw repose::Error(folder + ": node " + node->GetID() + " names no data file");
-      return (dir / name).string();
-    };
-    for (int n = 0; n < loaded->GetNumberOfNodes(); ++n) {
-      vtkMRMLReposeNode* node = loaded->GetNthNode(n);
-      if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
-        seg->SetLabelMap(Conversion::ToImageData(
-            vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg))));
-        if (!seg->GetBodyPartMapFileName().empty()) {
-          const std::string parts = (dir / seg->GetBodyPartMapFileName()).string();
-          seg->SetBodyPartMap(Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(parts)));
-          // A scene the command line wrote names S where it is; its skeleton is beside it.
-          if (seg->GetSkeletonJSON().empty())
-            if (const std::string skeleton = repose::findSkeletonBeside(parts); !skeleton.empty())
-              seg->SetSkeletonJSON(readText(skeleton));
-        }
-        if (!seg->GetImageFileName().empty())
-          seg->SetImage(Conversion::ToImageData(
-              vtkSlicerReposeLogicRead::ReadVolume((dir / seg->GetImageFileName()).string())));
-      } else if (auto* cage = vtkMRMLReposeCageNode::SafeDownCast(node)) {
-        cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(
-            repose::readTriangleMesh(need(cage->GetFileName(), cage))));
-      } else if (auto* tm = vtkMRMLReposeTransferMeshNode::SafeDownCast(node)) {
-        const std::string meshFile = need(tm->GetFileName(), tm);
-        tm->SetMesh(
-            vtkSlicerReposeMeshConversion::ToUnstructuredGrid(repose::readTransferMesh(meshFile)));
-        tm->SetCoordinatesFile(repose::greenCoordinatesFileFor(meshFile));
-      } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
-        const std::string path = need(pose->GetFileName(), pose);
-        pose->SetPoseJSON(repose::poseToJson(repose::readPoseFile(path)));
-      }
-    }
+  return this->Guarded<bool>(false, [&] {
+    const vtkSmartPointer<vtkMRMLReposeScene> loaded = vtkSlicerReposeSceneIO::Load(folder);
     this->Scene->Clear();
     for (int n = 0; n < loaded->GetNumberOfNodes(); ++n)
       this->Scene->AddNode(loaded->GetNthNode(n));
-    this->UndoStack.clear();
-    this->RedoStack.clear();
+    this->History.Clear();
     this->LastPosedSegmentation = nullptr;
     this->Modified();
     return true;

@@ -61,26 +61,15 @@ void setCurrentTransform(repose::Pose& pose, vtkMRMLReposePoseNode* node, repose
 }  // namespace
 
 void vtkSlicerReposeLogic::RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after) {
-  const std::string before = node->GetPoseJSON();
-  if (after == before) return;
-  if (this->Interacting && this->InteractionRecorded && !this->UndoStack.empty() &&
-      this->UndoStack.back().nodeID == node->GetID())
-    this->UndoStack.back().after = after;  // the same drag: one step
-  else
-    this->UndoStack.push_back({node->GetID(), before, after});
-  this->InteractionRecorded = this->Interacting;
-  this->RedoStack.clear();
-  node->SetPoseJSON(after);
+  if (this->History.Record(node->GetID(), node->GetPoseJSON(), after)) node->SetPoseJSON(after);
 }
 
 void vtkSlicerReposeLogic::BeginPoseInteraction() {
-  this->Interacting = true;
-  this->InteractionRecorded = false;
+  this->History.BeginInteraction();
 }
 
 void vtkSlicerReposeLogic::EndPoseInteraction() {
-  this->Interacting = false;
-  this->InteractionRecorded = false;
+  this->History.EndInteraction();
 }
 
 bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
@@ -288,28 +277,24 @@ bool vtkSlicerReposeLogic::AddPoseSeparation(vtkMRMLReposePoseNode* node, const 
 }
 
 bool vtkSlicerReposeLogic::CanUndo() const {
-  return !this->UndoStack.empty();
+  return this->History.CanUndo();
 }
 bool vtkSlicerReposeLogic::CanRedo() const {
-  return !this->RedoStack.empty();
+  return this->History.CanRedo();
 }
 
 bool vtkSlicerReposeLogic::Undo() {
-  if (this->UndoStack.empty()) return false;
-  const PoseEdit edit = this->UndoStack.back();
-  this->UndoStack.pop_back();
-  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(edit.nodeID)))
-    node->SetPoseJSON(edit.before);
-  this->RedoStack.push_back(edit);
+  const auto step = this->History.Undo();
+  if (!step) return false;
+  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(step->nodeID)))
+    node->SetPoseJSON(step->before);
   return true;
 }
 
 bool vtkSlicerReposeLogic::Redo() {
-  if (this->RedoStack.empty()) return false;
-  const PoseEdit edit = this->RedoStack.back();
-  this->RedoStack.pop_back();
-  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(edit.nodeID)))
-    node->SetPoseJSON(edit.after);
-  this->UndoStack.push_back(edit);
+  const auto step = this->History.Redo();
+  if (!step) return false;
+  if (auto* node = vtkMRMLReposePoseNode::SafeDownCast(this->Scene->GetNodeByID(step->nodeID)))
+    node->SetPoseJSON(step->after);
   return true;
 }

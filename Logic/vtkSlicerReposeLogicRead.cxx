@@ -1,7 +1,11 @@
 #include "vtkSlicerReposeLogicRead.h"
 
 #include <repose/io/VolumeIO.h>
+#include <repose/util/Error.h>
 #include <repose/util/Memory.h>
+
+#include <fstream>
+#include <sstream>
 
 namespace vtkSlicerReposeLogicRead {
 
@@ -12,6 +16,14 @@ repose::Volume ReadVolume(const std::string& path) {
       "the workbench reads within half the physical memory; free memory, or use the command "
       "line's --memory";
   return repose::readVolume(path, options);
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw repose::Error(path + ": cannot open");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 }  // namespace vtkSlicerReposeLogicRead

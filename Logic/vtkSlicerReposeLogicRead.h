@@ -13,6 +13,8 @@ namespace vtkSlicerReposeLogicRead {
 
 // Throws repose::Error naming the file, as repose::readVolume does.
 repose::Volume ReadVolume(const std::string& path);
+// A small text file (a pose, a skeleton, scene.json) whole; repose::Error "path: cannot open".
+std::string ReadText(const std::string& path);
 
 }  // namespace vtkSlicerReposeLogicRead
 
