@@ -89,9 +89,15 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
         vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);
     for (const repose::Label& l : volume.labels().labels())
       this->VolumeLabelNames.push_back({l.layer, l.value, l.name});
-    if (volume.isLabelMap())
-      this->VolumeLabelsPresent = static_cast<int>(repose::countLabels(volume).size());
-    this->VolumeLookupTable = vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels());
+    std::vector<int> present;  // layer 0's values, coloured even when the table lacks them
+    if (volume.isLabelMap()) {
+      const std::vector<repose::LabelCount> counts = repose::countLabels(volume);
+      this->VolumeLabelsPresent = static_cast<int>(counts.size());
+      for (const repose::LabelCount& c : counts)
+        if (c.layer == 0) present.push_back(c.value);
+    }
+    this->VolumeLookupTable =
+        vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels(), 0, present);
   } catch (const repose::Error& e) {
     this->LastErrorMessage = oneLine(e.what());
   } catch (const std::bad_alloc&) {
@@ -118,8 +124,11 @@ void vtkSlicerReposeLogic::ClearVolume() {
 
 vtkSmartPointer<vtkLookupTable> vtkSlicerReposeLogic::GetLabelLookupTable(vtkImageData* labelMap) {
   if (!labelMap) return nullptr;
-  return vtkSlicerReposeVolumeConversion::ToLookupTable(
-      vtkSlicerReposeVolumeConversion::GetLabelTable(labelMap));
+  const repose::Volume volume = vtkSlicerReposeVolumeConversion::FromImageData(labelMap);
+  std::vector<int> present;
+  for (const repose::LabelCount& c : repose::countLabels(volume))
+    if (c.layer == 0) present.push_back(c.value);
+  return vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels(), 0, present);
 }
 
 std::string vtkSlicerReposeLogic::GetVolumeSummary() const {

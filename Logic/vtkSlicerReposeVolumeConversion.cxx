@@ -166,15 +166,24 @@ repose::LabelTable vtkSlicerReposeVolumeConversion::GetLabelTable(vtkImageData* 
 }
 
 vtkSmartPointer<vtkLookupTable> vtkSlicerReposeVolumeConversion::ToLookupTable(
-    const repose::LabelTable& labels, int layer) {
+    const repose::LabelTable& labels, int layer, const std::vector<int>& present) {
+  std::vector<repose::Label> shown;
+  for (const repose::Label& label : labels.labels())
+    if (label.layer == layer) shown.push_back(label);
+  for (const int value : present)
+    if (value != 0 && !labels.find(value, layer)) {
+      repose::Label l;
+      l.value = value;
+      l.layer = layer;
+      l.name = std::to_string(value);
+      l.color = repose::LabelTable::defaultColor(value);
+      shown.push_back(l);
+    }
   auto lut = vtkSmartPointer<vtkLookupTable>::New();
   lut->IndexedLookupOn();
-  vtkIdType count = 0;
-  for (const repose::Label& label : labels.labels()) count += label.layer == layer;
-  lut->SetNumberOfTableValues(count);
+  lut->SetNumberOfTableValues(vtkIdType(shown.size()));
   vtkIdType index = 0;
-  for (const repose::Label& label : labels.labels()) {
-    if (label.layer != layer) continue;
+  for (const repose::Label& label : shown) {
     lut->SetTableValue(index++, label.color[0], label.color[1], label.color[2], 1.0);
     // Annotations are matched to table values by order in indexed mode.
     lut->SetAnnotation(vtkVariant(label.value), label.name);

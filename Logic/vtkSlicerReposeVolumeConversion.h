@@ -40,9 +40,14 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeVolumeConversion {
   // Label table alone: stored in / read from the image's field data (empty if absent).
   static void SetLabelTable(vtkImageData* image, const repose::LabelTable& labels);
   static repose::LabelTable GetLabelTable(vtkImageData* image);
-  // An indexed lookup table for display: one annotated colour per label of `layer`.
+  // An indexed lookup table for display: one annotated colour per label of `layer`, and for each
+  // value of `present` the table does not name its own distinct colour
+  // (repose::LabelTable::defaultColor) and its number as the name, so a label map read with no
+  // colour table (or an incomplete one) does not draw every label in the lookup's one "unknown"
+  // colour.
   static vtkSmartPointer<vtkLookupTable> ToLookupTable(const repose::LabelTable& labels,
-                                                       int layer = 0);
+                                                       int layer = 0,
+                                                       const std::vector<int>& present = {});
 
   // VTK_UNSIGNED_CHAR, VTK_UNSIGNED_SHORT, VTK_SHORT, VTK_INT, VTK_FLOAT.
   static int ToVTKScalarType(repose::ScalarType type);

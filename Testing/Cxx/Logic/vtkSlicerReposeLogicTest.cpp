@@ -11,12 +11,15 @@
 #include <gtest/gtest.h>
 
 #include <vtkImageData.h>
+#include <vtkLookupTable.h>
 #include <vtkMatrix3x3.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
 
+#include <array>
 #include <cstring>
+#include <set>
 #include <fstream>
 
 namespace {
@@ -163,4 +166,53 @@ TEST(vtkSlicerReposeLogic, FollowsParameterNode) {
   logic->SetParameterNode(nullptr);
   node->SetInputSegmentationPath(path);  // no longer observed
   EXPECT_EQ(logic->GetVolumePath(), nifti);
+}
+
+// A label map with no colour table (a NIfTI from another tool): every label present gets its own
+// colour and its number as the name in the display's lookup table, not the table's one colour
+// for unknown values (every label drawn the same dark red); a label the table names keeps its
+// colour and name.
+TEST(vtkSlicerReposeLogic, EveryLabelPresentHasItsOwnColourWithOrWithoutAColourTable) {
+  repose::test::ScratchDir dir;
+  repose::VolumeGeometry g;
+  g.dims = {8, 8, 4};
+  repose::Volume v(g, repose::ScalarType::UInt8);
+  v.setLabelMap(true);
+  const std::vector<int> values = {1, 2, 3, 7, 200};
+  for (std::int64_t i = 0; i < v.numVoxels(); ++i)
+    v.data<std::uint8_t>()[i] =
+        std::uint8_t(i % 3 == 0 ? 0 : values[std::size_t(i) % values.size()]);
+  repose::Label named;
+  named.value = 7;
+  named.name = "liver";
+  named.color = {0.1, 0.2, 0.3};
+  v.labels().set(named);
+  const std::string path = dir.file("no_table.nii.gz");
+  repose::writeVolume(v, path);
+
+  vtkNew<vtkSlicerReposeLogic> logic;
+  ASSERT_TRUE(logic->LoadVolume(path)) << logic->GetLastErrorMessage();
+  vtkLookupTable* lut = logic->GetVolumeLookupTable();
+  ASSERT_TRUE(lut);
+  std::set<std::array<double, 3>> colours;
+  for (const int value : values) {
+    const vtkIdType index = lut->GetAnnotatedValueIndex(vtkVariant(value));
+    ASSERT_GE(index, 0) << value;
+    double rgba[4];
+    lut->GetTableValue(index, rgba);
+    colours.insert({rgba[0], rgba[1], rgba[2]});
+    EXPECT_EQ(lut->GetAnnotation(index), value == 7 ? "liver" : std::to_string(value));
+  }
+  EXPECT_EQ(colours.size(), values.size());  // distinct
+  double liver[4];  // the named label keeps its own colour (as the file stores it, 8 bits)
+  lut->GetTableValue(lut->GetAnnotatedValueIndex(vtkVariant(7)), liver);
+  EXPECT_NEAR(liver[0], 0.1, 1.0 / 255);
+  EXPECT_NEAR(liver[1], 0.2, 1.0 / 255);
+  EXPECT_NEAR(liver[2], 0.3, 1.0 / 255);
+  EXPECT_LT(lut->GetAnnotatedValueIndex(vtkVariant(0)), 0);  // background is not a label
+  // The same for the lookup the views build from a node's label map.
+  vtkSmartPointer<vtkLookupTable> fromImage =
+      vtkSlicerReposeLogic::GetLabelLookupTable(logic->GetVolumeImageData());
+  ASSERT_TRUE(fromImage);
+  EXPECT_EQ(fromImage->GetNumberOfAnnotatedValues(), vtkIdType(values.size()));
 }
