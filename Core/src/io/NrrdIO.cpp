@@ -2,6 +2,7 @@
 // `space origin`, converted to RAS; a 4D .seg.nrrd with a leading list axis becomes layers.
 #include "repose/io/NrrdIO.h"
 
+#include "NrrdGzipData.h"
 #include "ReaderCommon.h"
 #include "SegNrrdFields.h"
 #include "repose/io/AtomicOutput.h"
@@ -234,19 +235,46 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
     std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
                                                                      &nrrdIoStateNix);
     nio->skipData = AIR_TRUE;
+    // The data file kept open at the data (the header file itself for attached data), so gzip
+    // data can be inflated here rather than by teem (NrrdGzipData.h).
+    nio->keepNrrdDataFileOpen = AIR_TRUE;
+    // Closes the kept file however this block is left once the header was read. After a failed
+    // load teem has closed what it opened (the pointer may be left dangling): not touched then.
+    struct KeptFile {
+      NrrdIoState* nio;
+      bool loaded = false;
+      ~KeptFile() {
+        if (loaded && nio->dataFile) std::fclose(nio->dataFile);
+        nio->dataFile = nullptr;
+      }
+    } kept{nio.get()};
+    bool inflated = false;
     if (nrrdLoad(nrrd.get(), path.c_str(), nio.get()) != 0) {
       takeBiffMessage();  // a header teem cannot read is reported by the full read below
     } else {
+      kept.loaded = true;
       const std::int64_t voxels = checkedVoxelCount(path, *nrrd);
       io::DiskType t;
       const double memBytes = diskTypeFromNrrd(nrrd->type, t)
                                   ? double(scalarSize(io::memoryTypeFor(t)))
                                   : double(nrrdElementSize(nrrd.get()));
       io::checkReadMemory(path, voxels, double(nrrdElementSize(nrrd.get())) + memBytes, options);
+      // One data file, no skips, gzip: ours. Anything else (several data files, line or byte
+      // skips, other encodings) stays with teem's full read below.
+      const bool oneFile = !nio->dataFNArr || nio->dataFNArr->len <= 1;
+      if (nio->encoding == nrrdEncodingGzip && nio->dataFile && oneFile && nio->lineSkip == 0 &&
+          nio->byteSkip == 0 && !nio->dataFSkip && voxels > 0) {
+        const std::size_t element = nrrdElementSize(nrrd.get());
+        const bool swap =
+            element > 1 && nio->endian != airEndianUnknown && nio->endian != airMyEndian();
+        nrrd->data =
+            io::readGzipVoxels(nio->dataFile, std::size_t(voxels) * element, element, swap, path);
+        inflated = true;
+      }
     }
-    nrrd.reset(nrrdNew());
+    if (!inflated) nrrd.reset(nrrdNew());
   }
-  if (nrrdLoad(nrrd.get(), path.c_str(), nullptr) != 0) {
+  if (!nrrd->data && nrrdLoad(nrrd.get(), path.c_str(), nullptr) != 0) {
     std::string message = takeBiffMessage();
     if (message.find("fread got only") != std::string::npos ||
         message.find("but received") != std::string::npos)

@@ -1,0 +1,20 @@
+// The gzip-encoded voxels of a NRRD whose header teem has read, inflated through a zlib stream of
+// our own that is released on every path. teem's gzip reader keeps its stream (about 50 KB) when
+// the data are short or corrupt: a workbench or a batch script fed file after file would grow by
+// that much with every bad file.
+#pragma once
+
+#include <cstddef>
+#include <cstdio>
+#include <string>
+
+namespace repose::io {
+
+// Reads `bytes` bytes of voxels from `file`, positioned at the data (gzip members, one or several
+// back to back; a zlib stream is accepted too), into a buffer from malloc (teem frees a Nrrd's data
+// with free). With `swap`, elements of `elementSize` bytes are turned to the host's byte order.
+// Throws repose::Error naming `path` when the data end early or do not inflate.
+void* readGzipVoxels(std::FILE* file, std::size_t bytes, std::size_t elementSize, bool swap,
+                     const std::string& path);
+
+}  // namespace repose::io
