@@ -6,6 +6,7 @@
 // displacement field and writes report.json with the quality checks of docs/QUALITY.md.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "FolderClaim.h"
 #include "InputChecks.h"
 #include "MemoryBudget.h"
 #include "SlicerModuleXml.h"
@@ -227,6 +228,13 @@ int runPose(const Args& args) {
       throw UsageError{"--out names an input"};
   if (!fs::exists(fs::absolute(outDir).parent_path()))
     throw Error(outDir + ": its parent folder does not exist");
+  // One run at a time into this output folder and this scene: a second run refuses at once,
+  // instead of interleaving its frames or its rig files with the first's.
+  const FolderClaim outClaim(outDir);
+  std::optional<FolderClaim> sceneClaim;
+  if (p.has("scene") && !outClaim.holds(p.get("scene"))) sceneClaim.emplace(p.get("scene"));
+  for (const std::string& name : outClaim.staleRemoved())
+    say("removed " + (fs::path(outDir) / name).string() + ", left by a run that was killed");
   const double budget = parseMemoryBudget(p.get("memory"));
   const int threads = static_cast<int>(p.getInt("threads"));
   RigSettings& rs = request.settings;

@@ -2,9 +2,14 @@
 128 + the signal with one line on stderr, and leaves the output folder as it found it (no output,
 no temporary folder)."""
 import signal
+import socket
 import subprocess
 
 import pytest
+
+from conftest import REPO
+
+ELBOW = REPO / "bench" / "poses" / "elbow90.pose.json"
 
 
 @pytest.fixture(scope="module")
@@ -56,3 +61,71 @@ def test_sigterm_during_warp_leaves_no_output(bin_dir, rig, tmp_path):
                "--cage", rig / "cage.obj", "--posed-cage", rig / "cage.obj",
                "--out", tmp_path / "posed.nii.gz", "--transform-out", tmp_path / "field.nrrd"],
               tmp_path, signal.SIGTERM)
+
+
+def start_pose(bin_dir, rig, out, *extra):
+    """`repose pose` of the phantom's elbow into `out`, returned once its first progress line
+    shows the run under way."""
+    process = subprocess.Popen(
+        [str(bin_dir / "repose"), "pose", "--input", rig / "G.nii.gz", "--parts",
+         rig / "S.nii.gz", "--pose", ELBOW, "--out", out,
+         "--slicer-progress", *map(str, extra)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for line in process.stdout:
+        if line.startswith("<filter-progress>"):
+            break
+    assert process.poll() is None, "the pose ended before the test could act on it"
+    return process
+
+
+def temporaries(folder):
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith(".repose-tmp-"))
+
+
+def test_a_second_pose_into_the_same_folder_refuses_and_the_first_finishes(bin_dir, rig,
+                                                                             tmp_path):
+    out, scene = tmp_path / "out", tmp_path / "scene"
+    first = start_pose(bin_dir, rig, out, "--scene", scene)
+    # Into the same output folder, and into the same scene from another output folder: each
+    # refuses at once, naming the folder and the run that holds it, and writes nothing.
+    for args in (["--out", out], ["--out", tmp_path / "other", "--scene", scene]):
+        second = subprocess.run(
+            [str(bin_dir / "repose"), "pose", "--input", rig / "G.nii.gz", "--parts",
+             rig / "S.nii.gz", "--pose", ELBOW, *map(str, args)],
+            capture_output=True, text=True, timeout=60)
+        assert second.returncode != 0
+        lines = second.stderr.strip().splitlines()
+        assert len(lines) == 1 and "another Repose run (process %d)" % first.pid in lines[0], \
+            second.stderr
+        assert not (tmp_path / "other").exists()
+    _, stderr = first.communicate(timeout=600)
+    assert first.returncode == 0, stderr
+    assert (out / "report.json").is_file() and (out / "posed_G.nii.gz").is_file()
+    assert not (out / ".repose.lock").exists() and not (scene / ".repose.lock").exists()
+    assert temporaries(out) == []
+
+
+def test_a_killed_pose_blocks_nothing_and_its_temporaries_go_with_the_next_run(bin_dir, rig,
+                                                                                 tmp_path):
+    out = tmp_path / "out"
+    killed = start_pose(bin_dir, rig, out)
+    killed.kill()  # SIGKILL: no handler runs, the lock file and any temporary folder stay
+    killed.communicate(timeout=60)
+    assert not (out / "report.json").exists() and not (out / "posed_G.nii.gz").exists()
+    # What a kill in the middle of writing a frame leaves: the run's temporary folder with part of
+    # a file (named as AtomicOutput names it: host, the dead process, six characters).
+    host = socket.gethostname().replace("-", "_").replace("/", "_")
+    stale = out / (".repose-tmp-%s-%d-abc123" % (host, killed.pid))
+    stale.mkdir()
+    (stale / "posed_G.nii.gz").write_bytes(b"\x1f\x8b partial")
+    # Another host's (a shared file system) is not ours to judge.
+    foreign = out / (".repose-tmp-otherhost-%d-abc123" % killed.pid)
+    foreign.mkdir()
+    result = subprocess.run(
+        [str(bin_dir / "repose"), "pose", "--input", rig / "G.nii.gz", "--parts",
+         rig / "S.nii.gz", "--pose", ELBOW, "--out", out],
+        capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr
+    assert "removed %s, left by a run that was killed" % stale in result.stdout
+    assert temporaries(out) == [foreign.name]
+    assert (out / "report.json").is_file() and not (out / ".repose.lock").exists()

@@ -6,6 +6,7 @@
 #include "repose/util/Error.h"
 #include "repose/util/Interrupt.h"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -18,6 +19,47 @@ namespace fs = std::filesystem;
 
 namespace repose {
 
+namespace {
+
+const std::string kTempPrefix = ".repose-tmp-";
+
+std::string hostName() {
+  char name[256] = {0};
+  if (::gethostname(name, sizeof name - 1) != 0) return "host";
+  std::string host(name);
+  for (char& c : host)  // the name is parsed back from the right, at '-'
+    if (c == '/' || c == '-') c = '_';
+  return host.empty() ? "host" : host;
+}
+
+}  // namespace
+
+std::vector<std::string> removeStaleTemporaries(const std::string& folder) {
+  std::vector<std::string> removed;
+  std::error_code ec;
+  const std::string host = hostName();
+  for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(kTempPrefix, 0) != 0 || !it->is_directory(ec)) continue;
+    // kTempPrefix + HOST + "-" + PID + "-" + six characters of mkdtemp.
+    const std::size_t last = name.rfind('-');
+    const std::size_t before =
+        last == std::string::npos || last == 0 ? std::string::npos : name.rfind('-', last - 1);
+    if (before == std::string::npos || before < kTempPrefix.size()) continue;
+    if (name.compare(kTempPrefix.size(), before - kTempPrefix.size(), host) != 0) continue;
+    const std::string digits = name.substr(before + 1, last - before - 1);
+    if (digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    std::error_code removeError;
+    fs::remove_all(it->path(), removeError);
+    if (!removeError) removed.push_back(name);
+  }
+  return removed;
+}
+
 AtomicOutput::AtomicOutput(const std::string& finalPath) : finalPath_(finalPath) {
   const fs::path target(finalPath);
   if (target.filename().empty()) throwFileError(finalPath, "output path names no file");
@@ -26,7 +68,9 @@ AtomicOutput::AtomicOutput(const std::string& finalPath) : finalPath_(finalPath)
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) throwFileError(finalPath, "output folder does not exist");
   if (fs::is_directory(target, ec)) throwFileError(finalPath, "output path is a folder");
-  std::string pattern = (folder / ".repose-tmp-XXXXXX").string();
+  removeStaleTemporaries(folder.string());
+  std::string pattern =
+      (folder / (kTempPrefix + hostName() + "-" + std::to_string(::getpid()) + "-XXXXXX")).string();
   std::vector<char> buf(pattern.begin(), pattern.end());
   buf.push_back('\0');
   if (!::mkdtemp(buf.data()))

@@ -235,6 +235,34 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
 // Runs the scan over slabs of output slices on all cores. Each slab is written by one thread,
 // tets in index order, so overlapping (folded) tets resolve the same way on every run; then the
 // shell pass writes the voxels of the slab still uncovered.
+//
+// `write(k, j, i0, i1, rest0, step, tet)` writes a row interval. A writer that batches its
+// writes has worker(): each thread then writes through its own worker object, in order, and
+// calls its flush() when its work items are done (every voxel is in one work item, so a worker's
+// late writes race with no other thread).
+template <class W, class = void>
+struct HasWorker : std::false_type {};
+template <class W>
+struct HasWorker<W, std::void_t<decltype(std::declval<W&>().worker())>> : std::true_type {};
+
+template <class Write>
+struct DirectWorker {
+  Write& write;
+  template <class... Args>
+  void operator()(Args&&... args) {
+    write(std::forward<Args>(args)...);
+  }
+  void flush() {}
+};
+
+template <class Write>
+auto workerOf(Write& write) {
+  if constexpr (HasWorker<Write>::value)
+    return write.worker();
+  else
+    return DirectWorker<Write>{write};
+}
+
 template <class Write>
 void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& options,
              const std::string& stage, RasterReport* report, double frameSign, Write&& write,
@@ -242,8 +270,8 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // Only slices [kBegin, kEnd) are scanned (the out-of-core path's slab), in the full grid's
   // coordinates, so a slab's voxels get exactly the values the whole grid would.
   if (kEnd < 0) kEnd = in.dims[2];
-  const Eigen::MatrixX4i& T = *in.tets;
-  const Eigen::Index nt = T.rows();
+  const Eigen::Index nt = in.tets->rows();
+  const std::int64_t nx = in.dims[0];
   // Each tet's box in j and k (grown for the shell if it has an outer face), to skip it cheaply
   // outside a work item. Only tets whose box meets the grid are kept: for a live slice, the few
   // crossing it, found with plain comparisons first since every tet is looked at.
@@ -252,22 +280,31 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   Eigen::MatrixX4i ghostTets;
   const ScanInput ghostIn =
       withRims ? raster::ghostScanInput(in, shell.ghosts, ghostTets) : ScanInput();
-  // Outcodes (Cohen-Sutherland) of the vertices against the scanned rows and slices, grown by
-  // the largest box growth and one voxel more (so rounding cannot reject a tet the box test below
-  // keeps): a tet whose four vertices share a bit lies wholly on one side, found from four bytes.
-  // A live slice keeps a few thousand of 200K tets, and the box test is then run on those only.
+  // Outcodes (Cohen-Sutherland) of the vertices against the scanned rows and slices: a tet whose
+  // four vertices share a bit lies wholly on one side, found from four bytes. Bits 0-3 use the
+  // bounds grown by the largest box growth and one voxel more (so rounding cannot reject a tet the
+  // box test below keeps), for tets that grow (an outer face's shell, a piece's rim); bits 4-7 the
+  // exact bounds, for the rest. A live slice keeps a few thousand of 200K tets.
   double gyMax = 0, gzMax = 0;
   if (withShell) gyMax = shell.boxGrowth[1], gzMax = shell.boxGrowth[2];
   if (withRims)
     gyMax = std::max(gyMax, shell.pieceGrowth[1]), gzMax = std::max(gzMax, shell.pieceGrowth[2]);
   const double zBelow = double(kBegin) - gzMax - 1, zAbove = double(kEnd - 1) + gzMax + 1;
   const double yBelow = -gyMax - 1, yAbove = double(in.dims[1] - 1) + gyMax + 1;
+  const double zFirst = double(kBegin), zLast = double(kEnd - 1), yLast = double(in.dims[1] - 1);
   std::vector<std::uint8_t> outcode(in.out.size());
   for (std::size_t v = 0; v < in.out.size(); ++v) {
     const double y = in.out[v].y(), z = in.out[v].z();
     outcode[v] =
-        std::uint8_t((z < zBelow) | (z > zAbove) << 1 | (y < yBelow) << 2 | (y > yAbove) << 3);
+        std::uint8_t((z < zBelow) | (z > zAbove) << 1 | (y < yBelow) << 2 | (y > yAbove) << 3 |
+                     (z < zFirst) << 4 | (z > zLast) << 5 | (y < 0) << 6 | (y > yLast) << 7);
   }
+  // On a grid one slice thick (a live slice) a tet that does not grow holds voxels only where
+  // its cross-section with the slice's plane does: its rows are those the section spans, and it
+  // is dropped when the section holds no voxel centre. The section's corners are rounded, so the
+  // bounds are widened by kSectionSlack voxels (the scan decides the voxels themselves exactly).
+  const bool onePlane = kEnd - kBegin == 1;
+  constexpr double kSectionSlack = 1e-6;
   // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
   struct Candidates {
     std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;
@@ -280,11 +317,13 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
       [&](std::int64_t pb, std::int64_t pe) {
         for (std::int64_t part = pb; part < pe; ++part) {
           Candidates& c = parts[static_cast<std::size_t>(part)];
-          for (Eigen::Index t = nt * part / selectThreads; t < nt * (part + 1) / selectThreads;
-               ++t) {
+          const Eigen::Index tEnd = nt * (part + 1) / selectThreads;
+          for (Eigen::Index t = nt * part / selectThreads; t < tEnd; ++t) {
             const raster::TetVertices v = raster::tetVertices(in, t);
+            const bool grows =
+                (withShell && shell.outer[t]) || (withRims && shell.pieceFaces[std::size_t(t)]);
             if (outcode[std::size_t(v[0])] & outcode[std::size_t(v[1])] &
-                outcode[std::size_t(v[2])] & outcode[std::size_t(v[3])])
+                outcode[std::size_t(v[2])] & outcode[std::size_t(v[3])] & (grows ? 0x0F : 0xF0))
               continue;
             double gy = 0, gz = 0;  // box growth for the shell and the piece's rim
             if (withShell && shell.outer[t]) gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
@@ -295,9 +334,38 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - gz;
             const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + gz;
             if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
-            const double ylo = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - gy;
-            const double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + gy;
-            if (yhi < 0 || ylo > double(in.dims[1] - 1)) continue;
+            double ylo = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - gy;
+            double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + gy;
+            if (onePlane && !grows) {
+              // The section of the tet with the plane z = kBegin: its vertices on the plane and
+              // the crossings of its edges.
+              const Eigen::Vector3d* p[4] = {&p0, &p1, &p2, &p3};
+              double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo;
+              ylo = xlo, yhi = -xlo;
+              for (int a = 0; a < 4; ++a) {
+                const double za = p[a]->z() - zFirst;
+                if (za == 0) {
+                  xlo = std::min(xlo, p[a]->x()), xhi = std::max(xhi, p[a]->x());
+                  ylo = std::min(ylo, p[a]->y()), yhi = std::max(yhi, p[a]->y());
+                }
+                for (int b = a + 1; b < 4; ++b) {
+                  const double zb = p[b]->z() - zFirst;
+                  if (!((za < 0 && zb > 0) || (za > 0 && zb < 0))) continue;
+                  const double u = za / (za - zb);
+                  const double x = p[a]->x() + u * (p[b]->x() - p[a]->x());
+                  const double y = p[a]->y() + u * (p[b]->y() - p[a]->y());
+                  xlo = std::min(xlo, x), xhi = std::max(xhi, x);
+                  ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+                }
+              }
+              const double slack = kSectionSlack * (1 + std::max(std::abs(xlo), std::abs(xhi)));
+              xlo = std::max(xlo - slack, 0.0), xhi = std::min(xhi + slack, double(nx - 1));
+              if (!(raster::ceilToInt(xlo) <= raster::floorToInt(xhi))) continue;
+              const double ySlack = kSectionSlack * (1 + std::max(std::abs(ylo), std::abs(yhi)));
+              ylo -= ySlack, yhi += ySlack;
+            }
+            if (yhi < 0 || ylo > yLast || raster::ceilToInt(ylo) > raster::floorToInt(yhi))
+              continue;
             c.tet.push_back(static_cast<std::int32_t>(t));
             c.vertices.push_back(v);
             c.kmin.push_back(std::int32_t(std::max(kBegin, raster::ceilToInt(zlo))));
@@ -312,6 +380,10 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // the bone keeps its voxels: soft tissue is what a bend squeezes.
   std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax;
   std::vector<raster::TetVertices> vertices;
+  std::size_t total = 0;
+  for (const Candidates& c : parts) total += c.tet.size();
+  for (auto* list : {&candidates, &jmin, &jmax, &kmin, &kmax}) list->reserve(total);
+  vertices.reserve(total);
   const bool withPieces = in.pieces && !in.pieces->empty();
   for (const int pass : {0, 1}) {
     if (pass == 1 && !withPieces) break;
@@ -331,7 +403,24 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   const bool bands = depth < 2 * threads;
   const std::int64_t split = bands ? in.dims[1] : depth;
   const std::int64_t slabs = std::max<std::int64_t>(1, std::min<std::int64_t>(split, 8 * threads));
-  const std::int64_t nx = in.dims[0];
+  // Each work item's candidates, in candidate order: a live slice's bands each meet a few
+  // hundred of the thousands of tets it keeps.
+  std::vector<std::vector<std::int32_t>> itemCandidates(static_cast<std::size_t>(slabs));
+  {
+    auto itemOf = [&](std::int64_t x) {
+      std::int64_t item = std::min(slabs - 1, x * slabs / split);
+      while (item + 1 < slabs && split * (item + 1) / slabs <= x) ++item;
+      while (item > 0 && split * item / slabs > x) --item;
+      return item;
+    };
+    for (std::size_t c = 0; c < candidates.size(); ++c) {
+      const std::int64_t lo = bands ? jmin[c] : kmin[c] - kBegin,
+                         hi = bands ? jmax[c] : kmax[c] - kBegin;
+      if (lo > hi) continue;
+      for (std::int64_t item = itemOf(lo), last = itemOf(hi); item <= last; ++item)
+        itemCandidates[std::size_t(item)].push_back(std::int32_t(c));
+    }
+  }
   std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0}, nextSlab{0};
   std::atomic<bool> stop{false};
   std::mutex progressMutex;
@@ -342,6 +431,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
       [&](std::int64_t, std::int64_t) {
         std::int64_t localWrites = 0, localShell = 0;
         std::vector<std::uint8_t> covered;
+        auto sink = workerOf(write);
         for (std::int64_t slab; !stop && (slab = nextSlab++) < slabs;) {
           const std::int64_t s0 = split * slab / slabs, s1 = split * (slab + 1) / slabs;
           const std::int64_t k0 = kBegin + (bands ? 0 : s0), k1 = bands ? kEnd : kBegin + s1;
@@ -352,13 +442,15 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           if (withShell || withRims)
             covered.assign(static_cast<std::size_t>(nx * rows * (k1 - k0)), 0);
           ScanTet s;
-          for (std::size_t c = 0; c < candidates.size(); ++c) {
+          const std::vector<std::int32_t>& mine = itemCandidates[std::size_t(slab)];
+          for (const std::int32_t c : mine) {
             const std::int32_t t = candidates[c];
             if (kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
                 !raster::prepareTet(in, vertices[c], s))
               continue;
             const std::uint8_t mark = withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
-            raster::scanTet(s, k0, k1, j0, j1,
+            raster::scanTet(s, k0, k1, std::max<std::int64_t>(j0, jmin[c]),
+                            std::min<std::int64_t>(j1, jmax[c] + 1),
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
                               localWrites += i1 - i0 + 1;
@@ -366,7 +458,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                                 std::fill_n(
                                     covered.begin() + (((k - k0) * rows + (j - j0)) * nx + i0),
                                     i1 - i0 + 1, mark);
-                              write(k, j, i0, i1, rest0, step, t);
+                              sink(k, j, i0, i1, rest0, step, t);
                             });
           }
           // Writes, over soft tissue, the voxels of the prepared region `s` whose rest label is
@@ -380,14 +472,15 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                                 const Eigen::Vector3d p = rest0 + double(a - i0) * step;
                                 if (cv[a] == 2 || !shell.rimTakes(t, p, *shell.tetParts)) continue;
                                 cv[a] = 2;
-                                write(k, j, a, a, p, step, t);
+                                sink(k, j, a, a, p, step, t);
                               }
                             });
           };
           // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
           // follows its surface to within a voxel) move with the piece, over the soft tissue
           // that covered them.
-          for (std::size_t c = 0; c < candidates.size() && withRims; ++c) {
+          for (std::size_t n = 0; n < mine.size() && withRims; ++n) {
+            const std::int32_t c = mine[n];
             const std::int32_t t = candidates[c];
             const unsigned rim = shell.pieceFaces[std::size_t(t)];
             if (!rim || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
@@ -406,7 +499,8 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
               continue;
             scanRim(t);
           }
-          for (std::size_t c = 0; c < candidates.size() && withShell; ++c) {
+          for (std::size_t n = 0; n < mine.size() && withShell; ++n) {
+            const std::int32_t c = mine[n];
             const std::int32_t t = candidates[c];
             if (!shell.outer[t] || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
                 !raster::prepareShell(in, vertices[c], shell.outer[t], shell.mm, shell.normalToMm,
@@ -428,14 +522,16 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                                 while (b + 1 <= i1 && free(b + 1)) ++b;
                                 std::fill(c + a, c + b + 1, std::uint8_t(1));
                                 localShell += b - a + 1;
-                                write(k, j, a, b, Eigen::Vector3d(rest0 + double(a - i0) * step),
-                                      step, t);
+                                sink(k, j, a, b, Eigen::Vector3d(rest0 + double(a - i0) * step),
+                                     step, t);
                                 a = b + 1;
                               }
                             });
           }
-          const double fraction = double(++done) / double(slabs);
+          // Counted under the lock: counted before it, a thread could report 15/16 after
+          // another reported 16/16, and the last progress a user sees would not be the end.
           std::lock_guard<std::mutex> lock(progressMutex);
+          const double fraction = double(++done) / double(slabs);
           try {
             reportProgress(options.progress, fraction, stage);
           } catch (...) {
@@ -443,6 +539,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             throw;
           }
         }
+        sink.flush();
         writes += localWrites;
         shellWrites += localShell;
       },
@@ -868,15 +965,52 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
         at = aroundPiece(at);
       return at;
     };
+    // Each thread notes (output voxel, input voxel) pairs and copies them in batches, the input
+    // voxels prefetched a few copies ahead: the voxels a slice or a slab samples lie scattered
+    // over G, and copying each as it is found waits on memory once per voxel.
+    constexpr std::size_t kBatch = 4096;
+    struct Copies {
+      decltype(sourceOf)& source;
+      const std::vector<const T*>& src;
+      const std::vector<T*>& dst;
+      std::int64_t plane, nx;
+      std::vector<std::int64_t> to, from;
+      void operator()(std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                      Eigen::Vector3d p, const Eigen::Vector3d& step, std::int32_t tet) {
+        const std::int64_t row = k * plane + j * nx;
+        for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+          to.push_back(row + i);
+          from.push_back(source(i, j, k, p, tet));
+        }
+        if (to.size() >= kBatch) flush();
+      }
+      void flush() {
+        constexpr std::size_t kAhead = 16;
+        const std::size_t n = to.size();
+        for (std::size_t c = 0; c < std::min(n, kAhead); ++c)
+          if (from[c] >= 0) __builtin_prefetch(src[0] + from[c]);
+        for (std::size_t c = 0; c < n; ++c) {
+          if (c + kAhead < n && from[c + kAhead] >= 0)
+            __builtin_prefetch(src[0] + from[c + kAhead]);
+          for (std::size_t l = 0; l < src.size(); ++l)
+            dst[l][to[c]] = from[c] >= 0 ? src[l][from[c]] : T(0);
+        }
+        to.clear(), from.clear();
+      }
+    };
+    struct LabelWriter {
+      decltype(sourceOf)& source;
+      const std::vector<const T*>& src;
+      const std::vector<T*>& dst;
+      std::int64_t plane, nx;
+      Copies worker() const {
+        Copies c{source, src, dst, plane, nx, {}, {}};
+        c.to.reserve(kBatch + 1024), c.from.reserve(kBatch + 1024);
+        return c;
+      }
+    };
     runScan(in, shell, options, "rasterize labels", report, frameSign(output),
-            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1, Eigen::Vector3d p,
-                const Eigen::Vector3d& step, std::int32_t tet) {
-              const std::int64_t row = k * plane + j * nx;
-              for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-                const std::int64_t at = sourceOf(i, j, k, p, tet);
-                for (int l = 0; l < layers; ++l) dst[l][row + i] = at >= 0 ? src[l][at] : T(0);
-              }
-            });
+            LabelWriter{sourceOf, src, dst, plane, nx});
     if (options.preserveLabelVolumes) {
       if constexpr (std::is_integral_v<T>) {
         if (layers == 1)

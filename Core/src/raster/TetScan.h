@@ -95,17 +95,31 @@ struct Plane {
   bool accepts(double i, double j, double k) const { return sign(i, j, k) == side; }
 };
 
-// One deformed tet ready to scan.
-struct ScanTet {
-  std::array<Plane, 4> faces;
-  Eigen::Matrix3d A;                   // d(rest input IJK) / d(output IJK)
-  Eigen::Vector3d q0, r0;              // vertex 0: output and rest positions
-  std::array<std::int64_t, 3> lo, hi;  // voxel-centre bounding box, clipped to the grid
-  double signedVolume = 0;             // in output IJK units; < 0 for a tet turned inside out
-};
-
 // A tet's four vertex indices, in the mesh's order.
 using TetVertices = std::array<int, 4>;
+
+// One deformed tet ready to scan. The map back to rest positions is made when the scan first
+// finds a voxel inside (mapToRest): most tets a live slice prepares hold none, and the rest
+// positions are the second half of the vertex data a tet reads.
+struct ScanTet {
+  std::array<Plane, 4> faces;
+  Eigen::Matrix3d D;                   // output edges from vertex 0 (columns)
+  Eigen::Matrix3d A;                   // d(rest input IJK) / d(output IJK), once mapped
+  Eigen::Vector3d q0, r0;              // vertex 0: output and rest positions, once mapped
+  std::array<std::int64_t, 3> lo, hi;  // voxel-centre bounding box, clipped to the grid
+  double signedVolume = 0;             // in output IJK units; < 0 for a tet turned inside out
+  const std::vector<Eigen::Vector3d>* rest = nullptr;
+  TetVertices v{0, 0, 0, 0};
+  bool mapped = false;
+  void mapToRest() {
+    if (mapped) return;
+    Eigen::Matrix3d R;
+    for (int c = 0; c < 3; ++c) R.col(c) = (*rest)[v[c + 1]] - (*rest)[v[0]];
+    A = R * D.inverse();
+    r0 = (*rest)[v[0]];
+    mapped = true;
+  }
+};
 
 inline TetVertices tetVertices(const ScanInput& in, Eigen::Index t) {
   const Eigen::MatrixX4i& T = *in.tets;
@@ -118,38 +132,36 @@ inline TetVertices tetVertices(const ScanInput& in, Eigen::Index t) {
 // are scattered cache misses.
 inline bool prepareTet(const ScanInput& in, const TetVertices& v, ScanTet& s,
                        const std::array<double, 3>& boxGrowth = {0, 0, 0}) {
-  Eigen::Matrix3d D, R;
+  const Eigen::Vector3d &p0 = in.out[v[0]], &p1 = in.out[v[1]], &p2 = in.out[v[2]],
+                        &p3 = in.out[v[3]];
   for (int c = 0; c < 3; ++c) {
-    D.col(c) = in.out[v[c + 1]] - in.out[v[0]];
-    R.col(c) = in.rest[v[c + 1]] - in.rest[v[0]];
-  }
-  s.signedVolume = D.determinant() / 6;
-  if (!(s.signedVolume != 0) || !std::isfinite(s.signedVolume)) return false;
-  for (int c = 0; c < 3; ++c) {
-    double mn = in.out[v[0]][c], mx = mn;
-    for (int k = 1; k < 4; ++k)
-      mn = std::min(mn, in.out[v[k]][c]), mx = std::max(mx, in.out[v[k]][c]);
+    const double mn = std::min(std::min(p0[c], p1[c]), std::min(p2[c], p3[c]));
+    const double mx = std::max(std::max(p0[c], p1[c]), std::max(p2[c], p3[c]));
     s.lo[c] = std::max<std::int64_t>(0, ceilToInt(mn - boxGrowth[c]));
     s.hi[c] = std::min<std::int64_t>(in.dims[c] - 1, floorToInt(mx + boxGrowth[c]));
     if (s.lo[c] > s.hi[c]) return false;
   }
+  s.D.col(0) = p1 - p0, s.D.col(1) = p2 - p0, s.D.col(2) = p3 - p0;
+  s.signedVolume = s.D.determinant() / 6;
+  if (!(s.signedVolume != 0) || !std::isfinite(s.signedVolume)) return false;
   // Face f is opposite vertex f; its plane from the other three in increasing index order.
   for (int f = 0; f < 4; ++f) {
-    std::array<int, 3> w;
-    for (int k = 0, n = 0; k < 4; ++k)
-      if (k != f) w[n++] = v[k];
-    std::sort(w.begin(), w.end());
-    const Eigen::Vector3d &a = in.out[w[0]], &b = in.out[w[1]], &c = in.out[w[2]];
+    int a = v[f == 0 ? 1 : 0], b = v[f <= 1 ? 2 : 1], c = v[f <= 2 ? 3 : 2];
+    if (a > b) std::swap(a, b);
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+    const Eigen::Vector3d &pa = in.out[a], &pb = in.out[b], &pc = in.out[c];
     Plane& p = s.faces[f];
-    p.n = (b - a).cross(c - a);
-    p.d = (p.n.x() * a.x() + p.n.y() * a.y()) + p.n.z() * a.z();
+    p.n = (pb - pa).cross(pc - pa);
+    p.d = (p.n.x() * pa.x() + p.n.y() * pa.y()) + p.n.z() * pa.z();
     const double opposite = p.at(in.out[v[f]].x(), in.out[v[f]].y(), in.out[v[f]].z());
     if (opposite == 0) return false;  // flat in floating point
     p.side = opposite > 0 ? 1 : -1;
   }
-  s.A = R * D.inverse();
-  s.q0 = in.out[v[0]];
-  s.r0 = in.rest[v[0]];
+  s.q0 = p0;
+  s.rest = &in.rest;
+  s.v = v;
+  s.mapped = false;
   return true;
 }
 
@@ -189,11 +201,10 @@ inline bool inside(const ScanTet& s, double i, double j, double k) {
 // with k in [k0, k1) and j in [j0, j1); rest0 is the rest position (input IJK) of voxel i0 and
 // step its change per voxel along i.
 template <class Span>
-void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0, std::int64_t j1,
+void scanTet(ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0, std::int64_t j1,
              Span&& span) {
   const std::int64_t kb = std::max(k0, s.lo[2]), ke = std::min(k1 - 1, s.hi[2]);
   const std::int64_t jb = std::max(j0, s.lo[1]), je = std::min(j1 - 1, s.hi[1]);
-  const Eigen::Vector3d step = s.A.col(0);
   // Along a row each face's signed value is slope * i + c(j, k); the real interval is where all
   // four are positive. A rounded root more than kSettle from a whole number decides like the exact
   // predicate (the rounding error is ~1e-12 voxel); only an end within kSettle of a voxel centre is
@@ -245,8 +256,9 @@ void scanTet(const ScanTet& s, std::int64_t k0, std::int64_t k1, std::int64_t j0
         i1 = std::min(i1, s.hi[0]);
       }
       if (i0 > i1) continue;
+      s.mapToRest();
       const Eigen::Vector3d x{double(i0), dj, dk};
-      span(k, j, i0, i1, Eigen::Vector3d(s.r0 + s.A * (x - s.q0)), step);
+      span(k, j, i0, i1, Eigen::Vector3d(s.r0 + s.A * (x - s.q0)), Eigen::Vector3d(s.A.col(0)));
     }
 }
 

@@ -144,6 +144,18 @@ TEST(Rasterizer, EveryCentreHasOneOwnerOnScaledAndShiftedMeshes) {
         }
     EXPECT_EQ(wrong, 0) << "cell " << c.cell.transpose() << ", shift " << c.shift.transpose();
     EXPECT_GT(onAFace, inside / 10) << "the case must put many centres on faces";
+    // A grid one slice thick takes its tets from their cross-sections with the plane, which
+    // here pass through vertices, edges and faces: each plane equals that of the full grid.
+    const std::int64_t area = grid.dims[0] * grid.dims[1];
+    for (std::int64_t k = 0; k < grid.dims[2]; ++k) {
+      VolumeGeometry plane = grid;
+      plane.dims[2] = 1;
+      plane.ijkToRas.block<3, 1>(0, 3) = grid.voxelToRas(0, 0, double(k));
+      const Volume one = rasterizeCoverage(box, box.vertices, plane);
+      EXPECT_TRUE(
+          std::equal(one.data<std::uint8_t>(), one.data<std::uint8_t>() + area, count + k * area))
+          << "plane " << k << ", cell " << c.cell.transpose() << ", shift " << c.shift.transpose();
+    }
     ++cases;
   }
   EXPECT_EQ(cases, 5);
@@ -492,6 +504,45 @@ TEST(Rasterizer, SlicesEqualTheFullOutputOnAnyNumberOfThreads) {
                       [](std::uint8_t v) { return v != 0; }) > 0;
   }
   EXPECT_GE(planes, 2);  // the test looked at the body, not only at empty planes
+}
+
+// The same with the output's slices stacked front to back (k along A, as a coronal view's
+// planes are): a slice keeps only the tets whose cross-section with its plane holds a voxel
+// centre, over the rows that section spans: every third coronal plane of the full output of a
+// flexed elbow and of a shifted rest mesh comes out voxel for voxel. (Planes through vertices,
+// edges and faces: Rasterizer.EveryCentreHasOneOwnerOnScaledAndShiftedMeshes.)
+TEST(Rasterizer, CoronalSlicesEqualTheFullOutputOnOneAndTwoThreads) {
+  const PhantomScene& s = phantomScene();
+  const Eigen::MatrixX3d raised = s.deformation->deform(phantomElbowFlexion(s.phantom, s.cage, 60));
+  const Eigen::MatrixX3d shifted = s.mesh.vertices.rowwise() + Eigen::RowVector3d(4, 8, -6);
+  for (const Eigen::MatrixX3d* deformed : {&raised, &shifted}) {
+    const VolumeGeometry axial = deformedGrid(s.organs.geometry(), *deformed);
+    // The same voxels with j and k swapped: k runs along A.
+    VolumeGeometry full = axial;
+    full.dims = {axial.dims[0], axial.dims[2], axial.dims[1]};
+    full.ijkToRas.col(1) = axial.ijkToRas.col(2);
+    full.ijkToRas.col(2) = axial.ijkToRas.col(1);
+    const Volume out = rasterizeLabels(s.organs, s.mesh, *deformed, full);
+    const std::int64_t n = full.dims[0] * full.dims[1];
+    std::int64_t body = 0;
+    for (std::int64_t k = 0; k < full.dims[2]; k += 3) {
+      VolumeGeometry plane = full;
+      plane.dims[2] = 1;
+      plane.ijkToRas.block<3, 1>(0, 3) = full.voxelToRas(0, 0, double(k));
+      for (const int threads : {1, 2}) {
+        RasterOptions o;
+        o.threads = threads;
+        const Volume slice = rasterizeLabels(s.organs, s.mesh, *deformed, plane, o);
+        ASSERT_TRUE(std::equal(slice.data<std::uint8_t>(), slice.data<std::uint8_t>() + n,
+                               out.data<std::uint8_t>() + k * n))
+            << "plane " << k << " on " << threads << " threads";
+      }
+      body +=
+          std::count_if(out.data<std::uint8_t>() + k * n, out.data<std::uint8_t>() + (k + 1) * n,
+                        [](std::uint8_t v) { return v != 0; });
+    }
+    EXPECT_GT(body, 1000);  // the planes went through the body
+  }
 }
 
 // Out of core: the input read in place through a small slice cache, the output written in slabs;

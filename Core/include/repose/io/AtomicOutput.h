@@ -1,5 +1,7 @@
 // Safe output files: everything is written inside a hidden temporary folder beside the target
-// and moved into place only on commit(), so a failure or a kill never leaves a partial file.
+// (.repose-tmp-HOST-PID-XXXXXX) and moved into place only on commit(), so a failure or a kill
+// never leaves a partial file at the target. What a kill leaves in the temporary folder is removed
+// by the next output into the same folder (removeStaleTemporaries).
 #pragma once
 
 #include <string>
@@ -40,6 +42,12 @@ void commitTogether(const std::vector<AtomicOutput*>& outputs);
 
 // Writes `text` to `path` through an AtomicOutput: the whole file or nothing. Throws repose::Error.
 void writeTextFileAtomically(const std::string& path, const std::string& text);
+
+// Removes from `folder` the temporary folders of runs that were killed before they could clean
+// up: those named for a process of this host that no longer exists. A folder of a live process,
+// of another host (a shared file system) or of an older Repose (no process in its name) is left.
+// Returns the names removed. AtomicOutput calls it on its target's folder.
+std::vector<std::string> removeStaleTemporaries(const std::string& folder);
 
 // Throws repose::Error if output names the same file as input (an input is never overwritten).
 void refuseOverwritingInput(const std::string& input, const std::string& output);
