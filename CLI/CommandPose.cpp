@@ -270,7 +270,13 @@ int runPose(const Args& args) {
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
   const std::string key = job.sceneKey();
   std::optional<RigGeometry> fromScene;
-  if (p.has("scene")) fromScene = readSceneRig(p.get("scene"), key);
+  if (p.has("scene")) {
+    std::string why;
+    fromScene = readSceneRig(p.get("scene"), key, &why);
+    if (!why.empty())
+      std::cerr << "repose pose: note: the scene's rig is built again and saved over it: " << why
+                << std::endl;
+  }
   const bool reused = fromScene.has_value();
   RigGeometry geometry;
   std::string rigCoordinates;

@@ -8,15 +8,59 @@
 #include "repose/util/Error.h"
 
 #include <nlohmann/json.hpp>
+#include <zlib.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 namespace repose {
 
 namespace fs = std::filesystem;
 namespace sc = scene_schema;
 using nlohmann::json;
+
+namespace {
+
+// "SIZE:CRC32" of a file's bytes (sc::kFileStamps), "" when it cannot be read.
+std::string fileStamp(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return "";
+  uLong crc = crc32(0L, Z_NULL, 0);
+  std::uintmax_t size = 0;
+  std::vector<char> buffer(1 << 20);
+  while (in) {
+    in.read(buffer.data(), std::streamsize(buffer.size()));
+    const std::streamsize n = in.gcount();
+    if (n <= 0) break;
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(buffer.data()), uInt(n));
+    size += std::uintmax_t(n);
+  }
+  if (in.bad()) return "";
+  char hex[16];
+  std::snprintf(hex, sizeof hex, "%08lx", static_cast<unsigned long>(crc));
+  return std::to_string(size) + ":" + hex;
+}
+
+// The first rig file of the scene that is missing or differs from its stamp in scene.json, as
+// "FILE: what"; "" when all match or the scene records none.
+std::string editedRigFile(const fs::path& scene, const json& doc) {
+  const auto stamps = doc.find(sc::kFileStamps);
+  if (stamps == doc.end() || !stamps->is_object()) return "";
+  for (const auto& [name, stamp] : stamps->items()) {
+    if (!stamp.is_string()) continue;
+    const fs::path file = fs::path(name).is_absolute() ? fs::path(name) : scene / name;
+    std::error_code ec;
+    if (!fs::exists(file, ec)) return file.string() + ": missing";
+    if (fileStamp(file) != stamp.get<std::string>())
+      return file.string() +
+             ": changed since the scene was saved (not the file scene.json records)";
+  }
+  return "";
+}
+
+}  // namespace
 
 std::string sceneRigKey(const std::string& partsPath, const std::vector<LimbSeparation>& cuts,
                         const RigSettings& settings) {
@@ -99,10 +143,13 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
          {{sc::kCageRole, cage}, {sc::kSegmentationRole, seg}, {sc::kTransferMeshRole, mesh}}},
         {sc::pose::kFile, poseFile},
         {sc::pose::kCurrentFrame, 0}}});
+  json stamps = json::object();
+  for (const char* name : {"cage.vtk", "tm.vtu"}) stamps[name] = fileStamp(scene / name);
   const json doc = {{sc::kFormatKey, sc::kFormat},
                     {sc::kVersionKey, sc::kVersion},
                     {sc::kNodes, nodes},
-                    {sc::kBuiltFor, key.empty() ? json() : json::parse(key)}};
+                    {sc::kBuiltFor, key.empty() ? json() : json::parse(key)},
+                    {sc::kFileStamps, stamps}};
   writeTextFileAtomically((scene / sc::kDocument).string(), doc.dump(2) + "\n");
 }
 
@@ -167,6 +214,9 @@ SceneContents readSceneFolder(const std::string& folder) {
   if (cageFile.empty() || meshFile.empty())
     throw Error(json + ": no cage and transfer mesh (the rig was never built)");
   if (poseFile.empty()) throw Error(json + ": no pose node");
+  const std::string edited = editedRigFile(scene, doc);
+  if (!edited.empty())
+    throw Error(edited + "; build the rig again (repose pose --scene " + folder + ")");
   out.geometry.cage = readTriangleMesh(cageFile);
   out.geometry.mesh = readTransferMesh(meshFile);
   out.geometry.coordinatesFile = greenCoordinatesFileFor(meshFile);
@@ -176,17 +226,24 @@ SceneContents readSceneFolder(const std::string& folder) {
   return out;
 }
 
-std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::string& key) {
+std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::string& key,
+                                        std::string* why) {
   const fs::path scene = folder;
   if (!fs::exists(scene / sc::kDocument)) return std::nullopt;
+  auto notReused = [&](const std::string& reason) -> std::optional<RigGeometry> {
+    if (why) *why = reason;
+    return std::nullopt;  // built again (and written over)
+  };
   json doc;
   try {
     doc = readSceneJson(scene);
-  } catch (const Error&) {
-    return std::nullopt;  // not ours: built again (and written over)
+  } catch (const Error& e) {
+    return notReused(e.what());
   }
   const auto builtFor = doc.find(sc::kBuiltFor);
-  if (builtFor == doc.end() || *builtFor != json::parse(key, nullptr, false)) return std::nullopt;
+  if (builtFor == doc.end() || *builtFor != json::parse(key, nullptr, false))
+    return notReused((scene / sc::kDocument).string() +
+                     ": built for another body-part map or other settings");
   std::string cageFile, meshFile;
   for (const json& node : nodesOf(doc)) {
     if (stringOf(node, sc::kClass) == sc::cage::kClassName)
@@ -194,7 +251,12 @@ std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::st
     if (stringOf(node, sc::kClass) == sc::transfer_mesh::kClassName)
       meshFile = fileOf(scene, node, sc::transfer_mesh::kFile);
   }
-  if (cageFile.empty() || meshFile.empty()) return std::nullopt;
+  if (cageFile.empty() || meshFile.empty())
+    return notReused((scene / sc::kDocument).string() + ": no cage and transfer mesh");
+  for (const std::string& file : {cageFile, meshFile})
+    if (!fs::exists(file)) return notReused(file + ": missing");
+  const std::string edited = editedRigFile(scene, doc);
+  if (!edited.empty()) return notReused(edited);
   return RigGeometry{readTriangleMesh(cageFile), readTransferMesh(meshFile),
                      greenCoordinatesFileFor(meshFile)};
 }

@@ -37,11 +37,15 @@ struct SceneContents {
 };
 
 // Reads a scene folder: the first segmentation's inputs, its cage, transfer mesh and pose.
-// Throws repose::Error naming the folder or file and the problem.
+// Throws repose::Error naming the folder or file and the problem, also when a rig file differs
+// from what scene.json recorded when it was written (edited or replaced by hand).
 SceneContents readSceneFolder(const std::string& folder);
 
 // The scene's cage and transfer mesh when the folder holds a scene built for `key`; nullopt when
-// there is no scene there or it was built for another S or other settings.
-std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::string& key);
+// there is no scene there, or it was built for another S or other settings, or scene.json is not
+// a Repose scene, or a rig file is missing or differs from what scene.json recorded. Except when
+// there is no scene at all, `why` (if given) then says why it is not reused, in one line.
+std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::string& key,
+                                        std::string* why = nullptr);
 
 }  // namespace repose

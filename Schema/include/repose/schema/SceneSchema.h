@@ -17,6 +17,10 @@ inline constexpr char kNodes[] = "nodes";  // an array of node objects
 // The rig key a folder's cage and mesh were built for (Core's SceneFolder.h: sceneRigKey); a
 // scene the workbench saved has none, so `repose pose --scene` builds the rig again there.
 inline constexpr char kBuiltFor[] = "built_for";
+// File name (as its node names it) -> "SIZE:CRC32" (decimal size, hex CRC-32 of the bytes) of the
+// rig files the command line wrote, so a file replaced or edited by hand later is noticed; a
+// scene the workbench saved has none, and its files are taken as they are.
+inline constexpr char kFileStamps[] = "file_stamps";
 
 // Members of every node. Files are relative to the scene folder unless absolute.
 inline constexpr char kClass[] = "class";
