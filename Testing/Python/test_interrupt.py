@@ -129,3 +129,39 @@ def test_a_killed_pose_blocks_nothing_and_its_temporaries_go_with_the_next_run(b
     assert "removed %s, left by a run that was killed" % stale in result.stdout
     assert temporaries(out) == [foreign.name]
     assert (out / "report.json").is_file() and not (out / ".repose.lock").exists()
+
+
+def full_disk():
+    """In the child: files may grow to 30 KB only, and a write beyond fails with EFBIG (the
+    signal the kernel sends then, SIGXFSZ, is ignored, as a full disk sends none)."""
+    import resource
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (30000, 30000))
+
+
+@pytest.mark.parametrize("name", ["posed.nii.gz", "posed.nii", "posed.nrrd", "posed.seg.nrrd",
+                                  "posed.nhdr"])
+def test_a_full_disk_gives_one_line_and_leaves_nothing(bin_dir, rig, tmp_path, name):
+    """Every writer, the detached NRRD too (teem freed its data file name twice on this path),
+    stops with one line naming the file, and leaves the folder as it was: no partial file, no
+    temporary folder."""
+    before = sorted(p.name for p in tmp_path.iterdir())
+    r = subprocess.run([str(bin_dir / "repose"), "convert", rig / "G.nii.gz", tmp_path / name],
+                       preexec_fn=full_disk, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 1, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(
+        "repose convert: error: %s: " % (tmp_path / name)), r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_a_full_disk_during_a_pose_leaves_no_frame_and_no_folder(bin_dir, rig, tmp_path):
+    out = tmp_path / "out"
+    r = subprocess.run(
+        [str(bin_dir / "repose"), "pose", "--input", rig / "G.nii.gz", "--parts",
+         rig / "S.nii.gz", "--pose", ELBOW, "--out", out],
+        preexec_fn=full_disk, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 1, r.stderr
+    lines = [l for l in r.stderr.strip().splitlines() if "warning" not in l]
+    assert len(lines) == 1 and "error: " in lines[0] and str(out) in lines[0], r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # the folder it made is gone too

@@ -34,6 +34,19 @@ std::string hostName() {
 
 }  // namespace
 
+std::string makeTemporaryFolder(const std::string& folder, const std::string& target) {
+  removeStaleTemporaries(folder);
+  const std::string pattern =
+      (fs::path(folder) / (kTempPrefix + hostName() + "-" + std::to_string(::getpid()) + "-XXXXXX"))
+          .string();
+  std::vector<char> buf(pattern.begin(), pattern.end());
+  buf.push_back('\0');
+  if (!::mkdtemp(buf.data()))
+    throwFileError(target,
+                   std::string("cannot write in the output folder: ") + std::strerror(errno));
+  return buf.data();
+}
+
 std::vector<std::string> removeStaleTemporaries(const std::string& folder) {
   std::vector<std::string> removed;
   std::error_code ec;
@@ -68,15 +81,7 @@ AtomicOutput::AtomicOutput(const std::string& finalPath) : finalPath_(finalPath)
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) throwFileError(finalPath, "output folder does not exist");
   if (fs::is_directory(target, ec)) throwFileError(finalPath, "output path is a folder");
-  removeStaleTemporaries(folder.string());
-  std::string pattern =
-      (folder / (kTempPrefix + hostName() + "-" + std::to_string(::getpid()) + "-XXXXXX")).string();
-  std::vector<char> buf(pattern.begin(), pattern.end());
-  buf.push_back('\0');
-  if (!::mkdtemp(buf.data()))
-    throwFileError(finalPath,
-                   std::string("cannot write in the output folder: ") + std::strerror(errno));
-  tempDir_ = buf.data();
+  tempDir_ = makeTemporaryFolder(folder.string(), finalPath);
   tempPath_ = (fs::path(tempDir_) / target.filename()).string();
 }
 

@@ -351,6 +351,15 @@ bool endsWith(const std::string& s, const std::string& suffix) {
          s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// After nrrdSave failed. When writing a detached data file fails (a full disk), teem frees the
+// data file's name on its error path but leaves it in the I/O state's list, which
+// nrrdIoStateNix would free a second time (heap corruption: the .nhdr disk-full test). The
+// list's elements are no longer freed by the list; the one name it holds is already freed.
+[[noreturn]] void failedSave(NrrdIoState* nio, const std::string& path) {
+  if (nio->dataFNArr) airArrayPointerCB(nio->dataFNArr, nullptr, nullptr);
+  throwFileError(path, takeBiffMessage());
+}
+
 }  // namespace
 
 void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions& options) {
@@ -413,8 +422,7 @@ void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions
   nio->encoding =
       options.compress && nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
   nio->zlibLevel = 1;  // label maps compress well even at the fastest level
-  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0)
-    throwFileError(path, takeBiffMessage());
+  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0) failedSave(nio.get(), path);
   output.commit();
   reportProgress(options.progress, 1.0, "writing");
 }
@@ -457,8 +465,7 @@ void writeDisplacementFieldNrrd(const std::vector<float>& rasVectors, const Volu
       nrrd->measurementFrame[r][c] = r < 3 && c < 3 ? (r == c ? 1.0 : 0.0) : AIR_NAN;
   nio->encoding = nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
   nio->zlibLevel = 1;
-  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0)
-    throwFileError(path, takeBiffMessage());
+  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0) failedSave(nio.get(), path);
   output.commit();
 }
 

@@ -324,10 +324,7 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
   if (!fs::exists(dir.parent_path())) throw Error(folder + ": its parent folder does not exist");
   // The frame's files are one result: written into a hidden folder beside `folder` and moved in
   // together at the end, so an error, a Cancel or an interrupt never leaves half a frame.
-  std::string pattern = (dir.parent_path() / ".repose-tmp-XXXXXX").string();
-  if (!::mkdtemp(pattern.data()))
-    throwFileError(folder, "cannot write in the output folder's parent");
-  const fs::path temp(pattern);
+  const fs::path temp = makeTemporaryFolder(dir.parent_path().string(), folder);
   struct RemoveOnExit {
     fs::path path;
     ~RemoveOnExit() {
@@ -335,35 +332,52 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
       fs::remove_all(path, ignored);
     }
   } cleanup{temp};
+  // A writer's error names the file where the user will look for it, not in the hidden folder.
+  const auto named = [&](const Error& e) {
+    std::string message = e.what();
+    const std::string hidden = temp.string();
+    for (std::size_t at; (at = message.find(hidden)) != std::string::npos;)
+      message.replace(at, hidden.size(), dir.string());
+    return Error(message);
+  };
   const bool nifti = files != LabelMapFiles::SegNrrd;
   const bool seg = files != LabelMapFiles::Nifti;
-  for (const auto& [map, stem] : {std::pair{&frame.organs, "posed_G"}, {&frame.parts, "posed_S"}}) {
-    if (nifti) {
-      writeVolume(*map, (temp / (std::string(stem) + ".nii.gz")).string());
-      writeColorTable(*map, (temp / (std::string(stem) + ".ctbl")).string());
+  std::string written;
+  try {
+    for (const auto& [map, stem] :
+         {std::pair{&frame.organs, "posed_G"}, {&frame.parts, "posed_S"}}) {
+      if (nifti) {
+        writeVolume(*map, (temp / (std::string(stem) + ".nii.gz")).string());
+        writeColorTable(*map, (temp / (std::string(stem) + ".ctbl")).string());
+      }
+      if (seg) writeVolume(*map, (temp / (std::string(stem) + ".seg.nrrd")).string());
     }
-    if (seg) writeVolume(*map, (temp / (std::string(stem) + ".seg.nrrd")).string());
+    if (frame.image) writeVolume(*frame.image, (temp / "posed_image.nii.gz").string());
+    writeDisplacementFieldNrrd(frame.field, frame.grid, (temp / "transform.nrrd").string());
+    // The report names the files this write made, whatever the frame's report said before.
+    nlohmann::json report = nlohmann::json::parse(frame.reportJson);
+    report["outputs"] = outputFiles(files);
+    if (frame.image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
+    if (!options.sceneInputLabels.empty()) {
+      // Written as it will lie in `dir`: the frame's files relative to it.
+      SlicerSceneFiles scene;
+      scene.inputLabels = fs::absolute(options.sceneInputLabels).string();
+      scene.posedLabels = (dir / (nifti ? "posed_G.nii.gz" : "posed_G.seg.nrrd")).string();
+      if (nifti) scene.colorTable = (dir / "posed_G.ctbl").string();
+      scene.transform = (dir / "transform.nrrd").string();
+      scene.cage = options.sceneCage;
+      scene.transferMesh = options.sceneTransferMesh;
+      writeTextFileAtomically((temp / "scene.mrml").string(),
+                              formatSlicerScene(scene, dir.string()));
+      report["outputs"]["slicer_scene"] = "scene.mrml";
+    }
+    written = report.dump();
+    writeTextFileAtomically((temp / "report.json").string(), report.dump(2) + "\n");
+  } catch (const Cancelled&) {
+    throw;
+  } catch (const Error& e) {
+    throw named(e);
   }
-  if (frame.image) writeVolume(*frame.image, (temp / "posed_image.nii.gz").string());
-  writeDisplacementFieldNrrd(frame.field, frame.grid, (temp / "transform.nrrd").string());
-  // The report names the files this write made, whatever the frame's report said before.
-  nlohmann::json report = nlohmann::json::parse(frame.reportJson);
-  report["outputs"] = outputFiles(files);
-  if (frame.image) report["outputs"]["posed_image"] = "posed_image.nii.gz";
-  if (!options.sceneInputLabels.empty()) {
-    // Written as it will lie in `dir`: the frame's files relative to it.
-    SlicerSceneFiles scene;
-    scene.inputLabels = fs::absolute(options.sceneInputLabels).string();
-    scene.posedLabels = (dir / (nifti ? "posed_G.nii.gz" : "posed_G.seg.nrrd")).string();
-    if (nifti) scene.colorTable = (dir / "posed_G.ctbl").string();
-    scene.transform = (dir / "transform.nrrd").string();
-    scene.cage = options.sceneCage;
-    scene.transferMesh = options.sceneTransferMesh;
-    writeTextFileAtomically((temp / "scene.mrml").string(), formatSlicerScene(scene, dir.string()));
-    report["outputs"]["slicer_scene"] = "scene.mrml";
-  }
-  const std::string written = report.dump();
-  writeTextFileAtomically((temp / "report.json").string(), report.dump(2) + "\n");
   throwIfInterrupted();
   std::error_code ec;
   if (!fs::exists(dir)) {

@@ -43,6 +43,12 @@ void commitTogether(const std::vector<AtomicOutput*>& outputs);
 // Writes `text` to `path` through an AtomicOutput: the whole file or nothing. Throws repose::Error.
 void writeTextFileAtomically(const std::string& path, const std::string& text);
 
+// Makes a temporary folder in `folder` named as AtomicOutput names its own
+// (.repose-tmp-HOST-PID-XXXXXX), after removing the stale ones there; returns its path. Throws
+// repose::Error naming `target` when it cannot be made. For outputs of several files moved in
+// by their writer (a posed frame).
+std::string makeTemporaryFolder(const std::string& folder, const std::string& target);
+
 // Removes from `folder` the temporary folders of runs that were killed before they could clean
 // up: those named for a process of this host that no longer exists. A folder of a live process,
 // of another host (a shared file system) or of an older Repose (no process in its name) is left.
