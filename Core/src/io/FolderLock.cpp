@@ -19,7 +19,9 @@ namespace repose {
 
 FolderLock::FolderLock(const std::string& folder) {
   std::error_code ec;
-  if (!fs::is_directory(folder, ec)) throwFileError(folder, "output folder does not exist");
+  if (!fs::is_directory(folder, ec))
+    throwFileError(folder,
+                   fs::exists(folder, ec) ? "not a folder" : "output folder does not exist");
   path_ = (fs::path(folder) / kFileName).string();
   // The holder removes the file before it lets go, so a lock taken on a file that is no longer
   // the one at the path (removed, perhaps made again, in between) is no lock: try again.

@@ -67,6 +67,8 @@ TEST(FolderLock, ASecondLockRefusesNamingTheHolderAndTheFolderIsFreeAfterwards) 
   EXPECT_FALSE(fs::exists(fs::path(folder) / FolderLock::kFileName));  // nothing left behind
   EXPECT_EQ(errorOf(folder), "");
   EXPECT_NE(errorOf(dir.file("missing")).find("output folder does not exist"), std::string::npos);
+  std::ofstream(dir.file("a file")) << "x";
+  EXPECT_EQ(errorOf(dir.file("a file")), dir.file("a file") + ": not a folder");
 }
 
 // Another process holds the lock, then is killed: the kernel lets go, and the lock file it left
