@@ -1,6 +1,7 @@
 """SIGINT and SIGTERM during long commands: the command stops at its next progress point, exits
 128 + the signal with one line on stderr, and leaves the output folder as it found it (no output,
 no temporary folder)."""
+import json
 import signal
 import socket
 import subprocess
@@ -165,3 +166,45 @@ def test_a_full_disk_during_a_pose_leaves_no_frame_and_no_folder(bin_dir, rig, t
     lines = [l for l in r.stderr.strip().splitlines() if "warning" not in l]
     assert len(lines) == 1 and "error: " in lines[0] and str(out) in lines[0], r.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # the folder it made is gone too
+
+
+def test_a_kill_while_out_of_core_slabs_are_written_leaves_the_previous_output(bin_dir, rig,
+                                                                                tmp_path):
+    """SIGKILL while the out-of-core path writes its slabs: the previous output stays as it was,
+    nothing partial sits at the target, and the next run into the folder removes what the
+    killed run left (its temporary folder with part of the file)."""
+    repose = str(bin_dir / "repose")
+    tm = rig / "tm.vtu"
+    if not tm.exists():
+        subprocess.run([repose, "mesh", "--parts", rig / "S.nii.gz", "--cage", rig / "cage.obj",
+                        "--size-mm", "8.5", "--out", tm], check=True, capture_output=True)
+    out = tmp_path / "posed.nii.gz"
+    warp = [repose, "warp", "--input", rig / "G.nii.gz", "--mesh", tm, "--cage",
+            rig / "cage.obj", "--posed-cage", rig / "cage.obj", "--out", out]
+    first = subprocess.run(warp + ["--memory", "4G", "--json"], capture_output=True, text=True,
+                           check=True)
+    previous = out.read_bytes()
+    # A budget a third of the volumes above what the mesh and cage took: out of core, in slabs.
+    summary = json.loads(first.stdout)
+    budget = (summary["memory_in_use_before_volumes_bytes"]
+              + summary["memory_volumes_need_in_core_bytes"] / 3)
+    process = subprocess.Popen(warp + ["--memory", "%dK" % (budget // 1024), "--slicer-progress"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    out_of_core, slabs = False, 0
+    for line in process.stdout:
+        out_of_core = out_of_core or "rasterize labels (out of core)" in line
+        slabs += out_of_core and line.startswith("<filter-progress>")
+        if slabs == 3:
+            break
+    assert out_of_core and slabs == 3, "the budget must force the out-of-core path"
+    process.send_signal(signal.SIGSTOP)  # held mid-slabs while the folder is looked at
+    assert process.poll() is None, "the warp ended before the kill"
+    stale = temporaries(tmp_path)
+    # The slab writer's own temporary folder sits in the run's: the part written so far.
+    assert len(stale) == 1 and list((tmp_path / stale[0]).rglob("posed.nii.gz")), stale
+    process.kill()
+    process.communicate(timeout=60)
+    assert out.read_bytes() == previous
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["posed.nii.gz", stale[0]])
+    subprocess.run(warp + ["--memory", "4G"], check=True, capture_output=True)
+    assert temporaries(tmp_path) == []

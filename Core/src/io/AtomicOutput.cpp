@@ -1,6 +1,8 @@
 // Temporary folder beside the target, renamed into place on commit; see AtomicOutput.h.
 #include "repose/io/AtomicOutput.h"
 
+#include "CommitJournal.h"
+
 #include <fstream>
 
 #include "repose/util/Error.h"
@@ -66,6 +68,10 @@ std::vector<std::string> removeStaleTemporaries(const std::string& folder) {
       continue;
     const pid_t pid = static_cast<pid_t>(std::stol(digits));
     if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    if (const auto moved = io::recoverKilledCommit(it->path())) {
+      removed.push_back(name + " (its " + std::to_string(*moved) + " files moved into place)");
+      continue;
+    }
     std::error_code removeError;
     fs::remove_all(it->path(), removeError);
     if (!removeError) removed.push_back(name);
@@ -99,11 +105,21 @@ void AtomicOutput::commit() {
 
 void commitTogether(const std::vector<AtomicOutput*>& outputs) {
   throwIfInterrupted();
+  std::vector<std::string> folders;
+  std::vector<CommitStep> steps;
   for (AtomicOutput* o : outputs)
-    if (o && !o->committed_) o->move();
+    if (o && !o->committed_) {
+      folders.push_back(o->tempDir_);
+      const std::vector<CommitStep> own = o->steps();
+      steps.insert(steps.end(), own.begin(), own.end());
+    }
+  if (steps.empty()) return;
+  commitFiles(folders, steps, outputs.front()->finalPath_);
+  for (AtomicOutput* o : outputs)
+    if (o) o->committed_ = true;
 }
 
-void AtomicOutput::move() {
+std::vector<CommitStep> AtomicOutput::steps() const {
   const fs::path folder = fs::path(finalPath_).parent_path().empty()
                               ? fs::path(".")
                               : fs::path(finalPath_).parent_path();
@@ -114,10 +130,13 @@ void AtomicOutput::move() {
     if (entry.path() != fs::path(tempPath_)) files.push_back(entry.path());
   if (fs::exists(tempPath_, ec)) files.push_back(tempPath_);
   if (files.empty()) throwFileError(finalPath_, "nothing was written");
-  for (const fs::path& f : files) {
-    fs::rename(f, folder / f.filename(), ec);
-    if (ec) throwFileError(finalPath_, "cannot move the output into place: " + ec.message());
-  }
+  std::vector<CommitStep> steps;
+  for (const fs::path& f : files) steps.push_back({f.string(), (folder / f.filename()).string()});
+  return steps;
+}
+
+void AtomicOutput::move() {
+  commitFiles({tempDir_}, steps(), finalPath_);
   committed_ = true;
 }
 

@@ -3,6 +3,8 @@
 #include "repose/io/NrrdIO.h"
 
 #include "NrrdGzipData.h"
+#include "NrrdHeaderCheck.h"
+#include "NrrdLoad.h"
 #include "ReaderCommon.h"
 #include "SegNrrdFields.h"
 #include "repose/io/AtomicOutput.h"
@@ -13,7 +15,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <map>
 #include <memory>
 
@@ -153,51 +154,6 @@ std::map<std::string, std::string> keyValues(const Nrrd& nrrd) {
   return kv;
 }
 
-// teem (Debian 12's libteem) formats a field's text into a fixed-size stack buffer when it cannot
-// parse it: a field value of ~1,000-1,900 characters smashes its stack (found by
-// Testing/Fuzz/FuzzSegNrrd). Real field lines are a few hundred characters at most (sizes, space
-// directions of a 3D volume); key:=value pairs and comments are stored, not parsed, and may be
-// long (Slicer's segment tags). So field lines are checked before teem reads the header, split
-// and classified exactly as teem does (every case below was a campaign finding):
-// - a line ends at "\n", "\r" or "\r\n" (a lone "\r" inside a long key:=value line made its
-//   tail a field line to teem);
-// - a line is a key:=value pair only when its first ':' is followed by '=' ("a:b ... :=c" is a
-//   field to teem, and an unparseable one);
-// - teem reads a line as C text, up to its first NUL ("key\0...:=value" is a field to it): a
-//   header is text, and a NUL byte in it is corruption.
-constexpr std::size_t kMaxFieldLine = 800;
-
-void checkNrrdFieldLine(const std::string& path, std::size_t n, const std::string& line) {
-  if (line.find('\0') != std::string::npos)
-    throwFileError(path, "header line " + std::to_string(n) +
-                             " holds a NUL byte: not a NRRD header (corrupt file)");
-  if (n == 1 || line[0] == '#') return;
-  const std::size_t colon = line.find(':');
-  if (colon != std::string::npos && colon + 1 < line.size() && line[colon + 1] == '=') return;
-  if (line.size() > kMaxFieldLine)
-    throwFileError(path, "header line " + std::to_string(n) + " (" +
-                             line.substr(0, std::min<std::size_t>(colon, 40)) + ") is " +
-                             std::to_string(line.size()) +
-                             " characters long: not a NRRD field (corrupt header)");
-}
-
-void checkNrrdFieldLines(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  std::size_t n = 1;
-  for (int c = in.get(); c != std::char_traits<char>::eof(); c = in.get()) {
-    if (c != '\n' && c != '\r') {
-      line.push_back(char(c));
-      continue;
-    }
-    if (c == '\r' && in.peek() == '\n') in.get();  // "\r\n" is one line end
-    if (line.empty()) return;                      // end of an attached header
-    checkNrrdFieldLine(path, n++, line);
-    line.clear();
-  }
-  if (!line.empty()) checkNrrdFieldLine(path, n, line);  // a detached header's last line
-}
-
 // The header's voxel count, refused above 2^40 voxels (also where the product of the sizes would
 // overflow): no scanner or phantom comes near it, and teem would allocate a wrapped-around size.
 std::int64_t checkedVoxelCount(const std::string& path, const Nrrd& nrrd) {
@@ -225,7 +181,7 @@ std::int64_t checkedVoxelCount(const std::string& path, const Nrrd& nrrd) {
 Volume readNrrd(const std::string& path, const ReadOptions& options) {
   io::requireReadableFile(path);
   reportProgress(options.progress, 0.0, "reading");
-  checkNrrdFieldLines(path);
+  io::checkNrrdHeader(path);
   NrrdPtr nrrd(nrrdNew());
   {
     // teem allocates the voxels as it reads them, at the product of the header's sizes, which can
@@ -249,7 +205,7 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
       }
     } kept{nio.get()};
     bool inflated = false;
-    if (nrrdLoad(nrrd.get(), path.c_str(), nio.get()) != 0) {
+    if (io::loadNrrd(nrrd.get(), path, nio.get()) != 0) {
       takeBiffMessage();  // a header teem cannot read is reported by the full read below
     } else {
       kept.loaded = true;
@@ -274,7 +230,9 @@ Volume readNrrd(const std::string& path, const ReadOptions& options) {
     }
     if (!inflated) nrrd.reset(nrrdNew());
   }
-  if (!nrrd->data && nrrdLoad(nrrd.get(), path.c_str(), nullptr) != 0) {
+  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> fullRead(nrrdIoStateNew(),
+                                                                        &nrrdIoStateNix);
+  if (!nrrd->data && io::loadNrrd(nrrd.get(), path, fullRead.get()) != 0) {
     std::string message = takeBiffMessage();
     if (message.find("fread got only") != std::string::npos ||
         message.find("but received") != std::string::npos)

@@ -385,17 +385,19 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
     if (ec) throwFileError(folder, "cannot move the frame into place: " + ec.message());
     return written;
   }
-  // An existing folder (a re-run): its files are replaced one by one, the report last; ours that
-  // this frame does not write are removed (a report never sits beside another run's files).
+  // An existing folder (a re-run): its files are replaced, the report last, and ours that this
+  // frame does not write are removed (a report never sits beside another run's files), as one
+  // commit that a kill cannot leave half done (commitFiles).
+  std::vector<CommitStep> steps;
   for (const char* name :
        {"posed_G.nii.gz", "posed_G.ctbl", "posed_G.seg.nrrd", "posed_S.nii.gz", "posed_S.ctbl",
         "posed_S.seg.nrrd", "posed_image.nii.gz", "transform.nrrd", "scene.mrml", "report.json"}) {
     if (fs::exists(temp / name))
-      fs::rename(temp / name, dir / name, ec);
+      steps.push_back({(temp / name).string(), (dir / name).string()});
     else if (fs::exists(dir / name))
-      fs::remove(dir / name, ec);
-    if (ec) throwFileError((dir / name).string(), "cannot move into place: " + ec.message());
+      steps.push_back({"", (dir / name).string()});
   }
+  commitFiles({temp.string()}, steps, folder);
   return written;
 }
 

@@ -137,3 +137,69 @@ TEST(AtomicOutput, NamesItsTemporaryFolderForTheHostAndTheProcess) {
   EXPECT_EQ(name.rfind(".repose-tmp-" + hostName() + "-" + std::to_string(::getpid()) + "-", 0), 0u)
       << name;
 }
+
+namespace {
+
+// In a child process: three outputs of one run committed together over an earlier run's files,
+// the child killed (SIGKILL, no handler) right after commit step `killAfter` (0: the journal
+// written; 1-3: that many files moved), or before the commit begins with killAfter < 0.
+void killedCommit(const fs::path& folder, int killAfter) {
+  const pid_t child = ::fork();
+  if (child == 0) {
+    static int at;
+    at = killAfter;
+    detail::commitStepHook = [](std::size_t step) {
+      if (int(step) == at) ::kill(::getpid(), SIGKILL);
+    };
+    AtomicOutput a((folder / "posed_G.nii.gz").string()), b((folder / "posed_S.nii.gz").string()),
+        c((folder / "report.json").string());
+    for (AtomicOutput* o : {&a, &b, &c}) std::ofstream(o->tempPath()) << "new";
+    if (killAfter < 0) ::kill(::getpid(), SIGKILL);
+    commitTogether({&a, &b, &c});
+    ::_exit(3);  // not reached: killed at its step
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL) << killAfter;
+}
+
+std::string contentOf(const fs::path& file) {
+  std::ifstream in(file);
+  return std::string((std::istreambuf_iterator<char>(in)), {});
+}
+
+}  // namespace
+
+// SIGKILL in the middle of publishing a run's outputs: the folder may show a mix for as long as
+// no Repose run comes (the renames are microseconds apart), and the next output into the folder
+// finishes the killed commit from its journal before anything else, so the outputs are all the
+// killed run's; killed before its journal, they are all the earlier run's.
+TEST(AtomicOutput, AKillDuringTheFinalRenamesIsFinishedByTheNextRunNeverLeftMixed) {
+  const std::vector<std::string> names{"posed_G.nii.gz", "posed_S.nii.gz", "report.json"};
+  for (const int killAfter : {-1, 0, 1, 2}) {
+    ScratchDir dir;
+    const fs::path folder = dir.file("out");
+    fs::create_directory(folder);
+    for (const std::string& n : names) std::ofstream(folder / n) << "old";
+    killedCommit(folder, killAfter);
+    std::size_t moved = 0;
+    for (const std::string& n : names) moved += contentOf(folder / n) == "new";
+    EXPECT_EQ(moved, std::size_t(std::max(killAfter, 0))) << killAfter;
+    // The next run into the folder (here a small text file of its own).
+    const std::vector<std::string> removed = removeStaleTemporaries(folder.string());
+    const std::string expectedAll = killAfter < 0 ? "old" : "new";
+    for (const std::string& n : names) EXPECT_EQ(contentOf(folder / n), expectedAll) << killAfter;
+    // Reported: the folders of the run's three outputs, the commit named once it was decided.
+    ASSERT_FALSE(removed.empty()) << killAfter;
+    const bool finished = std::any_of(removed.begin(), removed.end(), [&](const std::string& r) {
+      return r.find("(its " + std::to_string(3 - std::max(killAfter, 0)) +
+                    " files moved into place)") != std::string::npos;
+    });
+    EXPECT_EQ(finished, killAfter >= 0) << killAfter;
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(folder)) left.push_back(e.path().filename());
+    std::sort(left.begin(), left.end());
+    EXPECT_EQ(left, (std::vector<std::string>{"posed_G.nii.gz", "posed_S.nii.gz", "report.json"}))
+        << killAfter;
+  }
+}

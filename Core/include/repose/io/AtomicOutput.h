@@ -4,10 +4,17 @@
 // by the next output into the same folder (removeStaleTemporaries).
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
 namespace repose {
+
+// One step of a commit: the file `from` (in a temporary folder) renamed to `to`, or with `from`
+// empty, the file `to` removed (an output of an earlier run that this one does not write).
+struct CommitStep {
+  std::string from, to;
+};
 
 class AtomicOutput {
  public:
@@ -28,6 +35,7 @@ class AtomicOutput {
 
  private:
   friend void commitTogether(const std::vector<AtomicOutput*>& outputs);
+  std::vector<CommitStep> steps() const;  // what move() does: companions first, main file last
   void move();
   std::string finalPath_;
   std::string tempDir_;
@@ -37,8 +45,21 @@ class AtomicOutput {
 
 // Several outputs of one run (a posed map, its image, its transform) as one unit: an interrupted
 // run publishes none of them; otherwise all are moved into place, with no interruption point
-// between two of them.
+// between two of them, and even a SIGKILL between two of them leaves no mix (commitFiles).
 void commitTogether(const std::vector<AtomicOutput*>& outputs);
+
+// Applies `steps` in order as one unit that even SIGKILL cannot leave half done. A journal of
+// the steps is written into the first of `temporaryFolders` before the first step: a run killed
+// before it leaves every target as it was; one killed after it is finished by the next output
+// into the folder (removeStaleTemporaries). The caller removes its temporary folders afterwards.
+// A step that fails (not a kill) throws repose::Error naming its file, `target` for the journal.
+void commitFiles(const std::vector<std::string>& temporaryFolders,
+                 const std::vector<CommitStep>& steps, const std::string& target);
+namespace detail {
+// For tests only: called after the journal is written (0) and after each step (1, 2, ...), e.g.
+// to kill the process there.
+extern void (*commitStepHook)(std::size_t step);
+}  // namespace detail
 
 // Writes `text` to `path` through an AtomicOutput: the whole file or nothing. Throws repose::Error.
 void writeTextFileAtomically(const std::string& path, const std::string& text);
@@ -52,7 +73,10 @@ std::string makeTemporaryFolder(const std::string& folder, const std::string& ta
 // Removes from `folder` the temporary folders of runs that were killed before they could clean
 // up: those named for a process of this host that no longer exists. A folder of a live process,
 // of another host (a shared file system) or of an older Repose (no process in its name) is left.
-// Returns the names removed. AtomicOutput calls it on its target's folder.
+// A run killed in the middle of a commit (commitFiles) has its commit finished first: the files
+// it had decided to publish are moved into place. Returns the names removed, each followed by
+// " (its N files moved into place)" when a commit was finished. AtomicOutput calls it on its
+// target's folder.
 std::vector<std::string> removeStaleTemporaries(const std::string& folder);
 
 // Throws repose::Error if output names the same file as input (an input is never overwritten).

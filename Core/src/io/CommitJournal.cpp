@@ -1,0 +1,135 @@
+// All-or-nothing commits of several files (AtomicOutput.h, CommitJournal.h).
+#include "CommitJournal.h"
+
+#include "repose/io/AtomicOutput.h"
+#include "repose/util/Error.h"
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace repose {
+
+namespace detail {
+void (*commitStepHook)(std::size_t step) = nullptr;
+}
+
+namespace {
+
+const char* const kJournal = ".repose-commit";        // in the first folder: the decision
+const char* const kMember = ".repose-commit-member";  // in the others: the first folder's path
+
+void hook(std::size_t step) {
+  if (detail::commitStepHook) detail::commitStepHook(step);
+}
+
+// Written whole or not at all (a rename within the folder), so a kill never leaves half a
+// journal that would read as a decision.
+void writeWhole(const fs::path& path, const std::string& text, const std::string& target) {
+  const fs::path part = path.string() + ".part";
+  {
+    std::ofstream f(part, std::ios::binary);
+    f << text;
+    if (!f.flush()) throwFileError(target, "cannot write in the output folder");
+  }
+  std::error_code ec;
+  fs::rename(part, path, ec);
+  if (ec) throwFileError(target, "cannot write in the output folder: " + ec.message());
+}
+
+// A step done again after a kill is harmless: a file already moved is no longer in its
+// temporary folder, and a removed file is gone.
+std::size_t apply(const CommitStep& step, std::error_code& ec) {
+  if (step.from.empty()) {
+    fs::remove(step.to, ec);
+    return 0;
+  }
+  if (!fs::exists(step.from, ec)) return 0;
+  fs::rename(step.from, step.to, ec);
+  return ec ? 0 : 1;
+}
+
+struct Journal {
+  std::vector<std::string> folders;
+  std::vector<CommitStep> steps;
+};
+
+std::optional<Journal> readJournal(const fs::path& folder) {
+  std::ifstream in(folder / kJournal, std::ios::binary);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    Journal journal;
+    journal.folders = j.at("folders").get<std::vector<std::string>>();
+    for (const auto& s : j.at("steps"))
+      journal.steps.push_back({s.at("from").get<std::string>(), s.at("to").get<std::string>()});
+    return journal;
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;  // not ours, or damaged otherwise than by a kill: not a decision
+  }
+}
+
+}  // namespace
+
+void commitFiles(const std::vector<std::string>& folders, const std::vector<CommitStep>& steps,
+                 const std::string& target) {
+  std::error_code ec;
+  // One rename alone is atomic already.
+  if (steps.size() == 1) {
+    apply(steps[0], ec);
+    if (ec) throwFileError(steps[0].to, "cannot move the output into place: " + ec.message());
+    return;
+  }
+  if (folders.empty()) throw Error("commitFiles: no temporary folder");
+  for (std::size_t k = 1; k < folders.size(); ++k)
+    writeWhole(fs::path(folders[k]) / kMember, folders[0], target);
+  nlohmann::json j;
+  j["folders"] = folders;
+  j["steps"] = nlohmann::json::array();
+  for (const CommitStep& s : steps) j["steps"].push_back({{"from", s.from}, {"to", s.to}});
+  const fs::path journal = fs::path(folders[0]) / kJournal;
+  writeWhole(journal, j.dump(), target);
+  hook(0);
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    apply(steps[i], ec);
+    if (ec) {
+      // Not a kill: this run reports it, and its temporary folders go with it.
+      fs::remove(journal, ec);
+      throwFileError(steps[i].to, "cannot move the output into place: " + ec.message());
+    }
+    hook(i + 1);
+  }
+  // Done: the journal goes first, so what is left of the folders is plain leftovers.
+  fs::remove(journal, ec);
+}
+
+namespace io {
+
+std::optional<std::size_t> recoverKilledCommit(const fs::path& folder) {
+  fs::path first = folder;
+  std::error_code ec;
+  if (!fs::exists(folder / kJournal, ec)) {
+    std::ifstream member(folder / kMember, std::ios::binary);
+    if (!member) return std::nullopt;
+    std::string path((std::istreambuf_iterator<char>(member)), {});
+    first = path;
+  }
+  const std::optional<Journal> journal = readJournal(first);
+  if (!journal) return std::nullopt;
+  std::size_t moved = 0;
+  for (const CommitStep& step : journal->steps) {
+    moved += apply(step, ec);
+    if (ec) return moved;  // left as it is, for a later run to finish (the same files, once)
+  }
+  fs::remove(first / kJournal, ec);
+  for (const std::string& f : journal->folders) fs::remove_all(f, ec);
+  fs::remove_all(folder, ec);
+  return moved;
+}
+
+}  // namespace io
+}  // namespace repose
