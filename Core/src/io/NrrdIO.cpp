@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <memory>
 
@@ -318,6 +319,27 @@ bool endsWith(const std::string& s, const std::string& suffix) {
   throwFileError(path, takeBiffMessage());
 }
 
+// teem writes the header (attached, or a detached .nhdr naming its data file); gzip data are
+// written by Repose (writeGzipVoxels): teem's gzip writer kept its zlib stream when the write
+// failed on a full disk.
+void saveNrrd(Nrrd* nrrd, NrrdIoState* nio, const std::string& file, const std::string& path,
+              bool gzip) {
+  nio->encoding = gzip ? nrrdEncodingGzip : nrrdEncodingRaw;
+  nio->skipData = gzip ? AIR_TRUE : AIR_FALSE;
+  if (nrrdSave(file.c_str(), nrrd, nio) != 0) failedSave(nio, path);
+  if (!gzip) return;
+  std::string dataPath = file;
+  if (nio->detachedHeader) {
+    if (!nio->dataFNArr || nio->dataFNArr->len != 1 || !nio->dataFN[0])
+      throwFileError(path, "teem named no data file for the detached header");
+    const std::filesystem::path named(nio->dataFN[0]);
+    dataPath = named.is_absolute() ? named.string()
+                                   : (std::filesystem::path(file).parent_path() / named).string();
+  }
+  io::writeGzipVoxels(dataPath, !nio->detachedHeader, nrrd->data,
+                      nrrdElementNumber(nrrd) * nrrdElementSize(nrrd), path);
+}
+
 }  // namespace
 
 void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions& options) {
@@ -377,10 +399,7 @@ void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions
     for (const auto& [key, value] : segnrrd::formatSegments(volume))
       nrrdKeyValueAdd(nrrd.get(), key.c_str(), value.c_str());
 
-  nio->encoding =
-      options.compress && nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
-  nio->zlibLevel = 1;  // label maps compress well even at the fastest level
-  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0) failedSave(nio.get(), path);
+  saveNrrd(nrrd.get(), nio.get(), output.tempPath(), path, options.compress);
   output.commit();
   reportProgress(options.progress, 1.0, "writing");
 }
@@ -421,9 +440,7 @@ void writeDisplacementFieldNrrd(const std::vector<float>& rasVectors, const Volu
   for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r)
     for (int c = 0; c < NRRD_SPACE_DIM_MAX; ++c)
       nrrd->measurementFrame[r][c] = r < 3 && c < 3 ? (r == c ? 1.0 : 0.0) : AIR_NAN;
-  nio->encoding = nrrdEncodingGzip->available() ? nrrdEncodingGzip : nrrdEncodingRaw;
-  nio->zlibLevel = 1;
-  if (nrrdSave(output.tempPath().c_str(), nrrd.get(), nio.get()) != 0) failedSave(nio.get(), path);
+  saveNrrd(nrrd.get(), nio.get(), output.tempPath(), path, true);
   output.commit();
 }
 
