@@ -104,7 +104,7 @@ bench-micro: build
 # The soak tests' long runs (Testing/Soak, docs/RELIABILITY.md): 500 cycles of open, live posing,
 # 50 edits, export and close through the Logic and through the Python module, a corrupt file
 # every tenth cycle; resident memory must grow less than 1 KiB a cycle after 100 cycles of
-# warm-up. About 25 minutes for both (they run side by side); `make test` runs 50 cycles of each.
+# warm-up. About 30 minutes (they run side by side); `make test` runs short versions.
 .PHONY: soak
 SOAK_DIR ?= $(BUILD_DIR)/soak
 soak: build

@@ -362,7 +362,13 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           f->reportJson = job->completeReport(f->reportJson, true, *rig);  // the scene's nodes' rig
           // Written here, on the worker: past the rasterization nothing can cancel the job, and
           // the files are atomic, so a cancelled export still leaves the folder as it was.
-          if (!outputFolder.empty()) repose::writePosedFrame(*f, outputFolder);
+          // Locked like `repose pose --out`: a run of it writing there refuses, and so does this.
+          if (!outputFolder.empty()) {
+            repose::FrameWriteOptions wo;
+            wo.labelMapFiles = f->labelMapFiles;
+            wo.lockFolder = true;
+            repose::writePosedFrame(*f, outputFolder, wo);
+          }
           repose::reportProgress(progress, 1, "posed");
           return [=] {
             auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();

@@ -151,6 +151,31 @@ def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose):
     assert field.shape == frame.organs.shape + (3,) and np.isfinite(field).all()
 
 
+def test_a_frame_write_refuses_a_folder_another_run_writes_into(tmp_path, phantom, elbow_rig):
+    """PosedFrame.write takes the folder's lock as `repose pose --out` does: while another run
+    holds it (here this test, with flock as FolderLock takes it), the write refuses with one line
+    naming the folder and the holder, and leaves the folder as it was; then it writes."""
+    import fcntl
+    frame = elbow_rig.pose_frame(phantom["organs"], phantom["parts"])
+    out = tmp_path / "out"
+    frame.write(str(out))
+    before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+    with open(out / ".repose.lock", "w") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        held.write("%d\n" % os.getpid())
+        held.flush()
+        with pytest.raises(rp.Error) as refused:
+            frame.write(str(out))
+        message = str(refused.value)
+        assert "\n" not in message and message.startswith(str(out)), message
+        assert "another Repose run (process %d) is writing here" % os.getpid() in message
+        after = {p.name: p.stat().st_mtime_ns for p in out.iterdir() if p.name != ".repose.lock"}
+        assert after == before
+    os.unlink(out / ".repose.lock")
+    frame.write(str(out))
+    assert sorted(p.name for p in out.iterdir()) == sorted(before)
+
+
 def test_the_posed_image_background_is_the_images_minimum_unless_given(phantom, elbow_rig):
     g, s = phantom["organs"], phantom["parts"]
     # A CT padded outside its field of view: its minimum (-3024) is what the default takes.

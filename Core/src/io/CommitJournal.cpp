@@ -85,12 +85,18 @@ void commitFiles(const std::vector<std::string>& folders, const std::vector<Comm
     return;
   }
   if (folders.empty()) throw Error("commitFiles: no temporary folder");
+  // Absolute paths: the run that finishes a killed commit may work in another folder.
+  const auto absolute = [](const std::string& p) {
+    return p.empty() ? p : fs::absolute(p).lexically_normal().string();
+  };
   for (std::size_t k = 1; k < folders.size(); ++k)
-    writeWhole(fs::path(folders[k]) / kMember, folders[0], target);
+    writeWhole(fs::path(folders[k]) / kMember, absolute(folders[0]), target);
   nlohmann::json j;
-  j["folders"] = folders;
+  j["folders"] = nlohmann::json::array();
+  for (const std::string& f : folders) j["folders"].push_back(absolute(f));
   j["steps"] = nlohmann::json::array();
-  for (const CommitStep& s : steps) j["steps"].push_back({{"from", s.from}, {"to", s.to}});
+  for (const CommitStep& s : steps)
+    j["steps"].push_back({{"from", absolute(s.from)}, {"to", absolute(s.to)}});
   const fs::path journal = fs::path(folders[0]) / kJournal;
   writeWhole(journal, j.dump(), target);
   hook(0);

@@ -4,6 +4,7 @@
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/ColorTableIO.h"
+#include "repose/io/FolderLock.h"
 #include "repose/io/NrrdIO.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/mesh/VolumePrediction.h"
@@ -23,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <limits>
 #include <map>
 #include <stdlib.h>
@@ -322,6 +324,10 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
   fs::path dir = fs::absolute(fs::path(folder)).lexically_normal();
   if (!dir.has_filename()) dir = dir.parent_path();  // "OUT/frame/"
   if (!fs::exists(dir.parent_path())) throw Error(folder + ": its parent folder does not exist");
+  // A folder made by this write appears whole (one rename), and a second writer's rename then
+  // fails; an existing one is locked first, when asked.
+  std::optional<FolderLock> lock;
+  if (options.lockFolder && fs::is_directory(dir)) lock.emplace(dir.string());
   // The frame's files are one result: written into a hidden folder beside `folder` and moved in
   // together at the end, so an error, a Cancel or an interrupt never leaves half a frame.
   const fs::path temp = makeTemporaryFolder(dir.parent_path().string(), folder);

@@ -142,8 +142,10 @@ namespace {
 
 // In a child process: three outputs of one run committed together over an earlier run's files,
 // the child killed (SIGKILL, no handler) right after commit step `killAfter` (0: the journal
-// written; 1-3: that many files moved), or before the commit begins with killAfter < 0.
-void killedCommit(const fs::path& folder, int killAfter) {
+// written; 1-3: that many files moved), or before the commit begins with killAfter < 0. With
+// `relative`, the child works in the folder and names its outputs relative to it, as a command
+// run there does; the run that finishes the commit works elsewhere.
+void killedCommit(const fs::path& folder, int killAfter, bool relative) {
   const pid_t child = ::fork();
   if (child == 0) {
     static int at;
@@ -151,8 +153,10 @@ void killedCommit(const fs::path& folder, int killAfter) {
     detail::commitStepHook = [](std::size_t step) {
       if (int(step) == at) ::kill(::getpid(), SIGKILL);
     };
-    AtomicOutput a((folder / "posed_G.nii.gz").string()), b((folder / "posed_S.nii.gz").string()),
-        c((folder / "report.json").string());
+    fs::path in = folder;
+    if (relative && ::chdir(folder.c_str()) == 0) in = "";
+    AtomicOutput a((in / "posed_G.nii.gz").string()), b((in / "posed_S.nii.gz").string()),
+        c((in / "report.json").string());
     for (AtomicOutput* o : {&a, &b, &c}) std::ofstream(o->tempPath()) << "new";
     if (killAfter < 0) ::kill(::getpid(), SIGKILL);
     commitTogether({&a, &b, &c});
@@ -176,12 +180,13 @@ std::string contentOf(const fs::path& file) {
 // killed run's; killed before its journal, they are all the earlier run's.
 TEST(AtomicOutput, AKillDuringTheFinalRenamesIsFinishedByTheNextRunNeverLeftMixed) {
   const std::vector<std::string> names{"posed_G.nii.gz", "posed_S.nii.gz", "report.json"};
-  for (const int killAfter : {-1, 0, 1, 2}) {
+  for (const auto& [killAfter, relative] : std::vector<std::pair<int, bool>>{
+           {-1, false}, {0, false}, {1, false}, {2, false}, {1, true}}) {
     ScratchDir dir;
     const fs::path folder = dir.file("out");
     fs::create_directory(folder);
     for (const std::string& n : names) std::ofstream(folder / n) << "old";
-    killedCommit(folder, killAfter);
+    killedCommit(folder, killAfter, relative);
     std::size_t moved = 0;
     for (const std::string& n : names) moved += contentOf(folder / n) == "new";
     EXPECT_EQ(moved, std::size_t(std::max(killAfter, 0))) << killAfter;
@@ -191,9 +196,10 @@ TEST(AtomicOutput, AKillDuringTheFinalRenamesIsFinishedByTheNextRunNeverLeftMixe
     for (const std::string& n : names) EXPECT_EQ(contentOf(folder / n), expectedAll) << killAfter;
     // Reported: the folders of the run's three outputs, the commit named once it was decided.
     ASSERT_FALSE(removed.empty()) << killAfter;
+    const std::string note =
+        "(its " + std::to_string(3 - std::max(killAfter, 0)) + " files moved into place)";
     const bool finished = std::any_of(removed.begin(), removed.end(), [&](const std::string& r) {
-      return r.find("(its " + std::to_string(3 - std::max(killAfter, 0)) +
-                    " files moved into place)") != std::string::npos;
+      return r.find(note) != std::string::npos;
     });
     EXPECT_EQ(finished, killAfter >= 0) << killAfter;
     std::vector<std::string> left;

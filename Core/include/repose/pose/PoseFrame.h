@@ -95,6 +95,11 @@ struct FrameWriteOptions {
   // the posed one, the field, the cage and the transfer mesh (pose/SlicerSceneMrml.h). Absolute
   // paths of G, the cage and the mesh; empty: no scene.mrml.
   std::string sceneInputLabels, sceneCage, sceneTransferMesh;
+  // Hold the folder's FolderLock while the frame is written into an existing folder, so that a
+  // `repose pose` writing there refuses, and this write refuses while one does (callers that
+  // hold no lock of their own: Python, the workbench). The command line locks its --out for the
+  // whole run instead.
+  bool lockFolder = false;
 };
 // The same, with the label maps and the scene as `options` say (not frame.labelMapFiles).
 // Both return report.json's text as written (its "outputs" name the files written).
