@@ -107,14 +107,16 @@ void commitTogether(const std::vector<AtomicOutput*>& outputs) {
   throwIfInterrupted();
   std::vector<std::string> folders;
   std::vector<CommitStep> steps;
+  std::string target;  // named by an error writing the journal: the first output's
   for (AtomicOutput* o : outputs)
     if (o && !o->committed_) {
+      if (target.empty()) target = o->finalPath_;
       folders.push_back(o->tempDir_);
       const std::vector<CommitStep> own = o->steps();
       steps.insert(steps.end(), own.begin(), own.end());
     }
   if (steps.empty()) return;
-  commitFiles(folders, steps, outputs.front()->finalPath_);
+  commitFiles(folders, steps, target);
   for (AtomicOutput* o : outputs)
     if (o) o->committed_ = true;
 }
