@@ -8,10 +8,10 @@
 // first (malloc_trim), so that a sample counts what the process holds, not what the allocator
 // keeps for reuse. The program runs itself with one malloc arena (glibc.malloc.arena_max=1):
 // with an arena per thread, what malloc_trim could not return from the worker threads' arenas
-// swung resident memory by 5 MB from cycle to cycle (measured: 11.5-17 MB anonymous memory
-// around 6 MB in use), which would drown a growth of 1 KB a cycle; a leak holds memory in any
-// arena. The slope of a least-squares line through the samples after warm-up is the growth per
-// cycle; the program exits 1 when it is above --max-slope-kb. It prints JSON.
+// swung resident memory by megabytes from cycle to cycle, several times the heap in use, which
+// would drown a growth of 1 KB a cycle; a leak holds memory in any arena. The slope of a
+// least-squares line through the samples after warm-up is the growth per cycle; the program exits 1
+// when it is above --max-slope-kb. It prints JSON.
 //
 //   ReposeLogicSoak [--cycles 500] [--warmup 100] [--edits 50] [--voxel-mm 8] [--pixels 128]
 //                   [--max-slope-kb 1] [--work DIR] [--series FILE]
