@@ -306,25 +306,58 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   const bool onePlane = kEnd - kBegin == 1;
   constexpr double kSectionSlack = 1e-6;
   // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
+  // Per candidate: its box's rows and slices (grown for a growing tet), and the rows the tet
+  // itself is scanned over (mjmin > mjmax: none, a growing tet that only its shell brings to
+  // the scanned region).
   struct Candidates {
-    std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax;
+    std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax, mjmin, mjmax;
     std::vector<raster::TetVertices> vertices;
   };
   const int selectThreads = resolveThreads(options.threads);
   std::vector<Candidates> parts(static_cast<std::size_t>(selectThreads));
+  const std::uint8_t* outerFaces = withShell ? shell.outer.data() : nullptr;
+  const std::uint8_t* rimFaces = withRims ? shell.pieceFaces.data() : nullptr;
+  auto growsAt = [outerFaces, rimFaces](Eigen::Index t) {
+    return (outerFaces && outerFaces[t]) || (rimFaces && rimFaces[t]);
+  };
   parallelFor(
       selectThreads, selectThreads,
       [&](std::int64_t pb, std::int64_t pe) {
         for (std::int64_t part = pb; part < pe; ++part) {
           Candidates& c = parts[static_cast<std::size_t>(part)];
-          const Eigen::Index tEnd = nt * (part + 1) / selectThreads;
-          for (Eigen::Index t = nt * part / selectThreads; t < tEnd; ++t) {
-            const raster::TetVertices v = raster::tetVertices(in, t);
-            const bool grows =
-                (withShell && shell.outer[t]) || (withRims && shell.pieceFaces[std::size_t(t)]);
-            if (outcode[std::size_t(v[0])] & outcode[std::size_t(v[1])] &
-                outcode[std::size_t(v[2])] & outcode[std::size_t(v[3])] & (grows ? 0x0F : 0xF0))
-              continue;
+          const Eigen::Index tBegin = nt * part / selectThreads,
+                             tEnd = nt * (part + 1) / selectThreads;
+          // First the outcodes alone, in a loop that does nothing else and has no branch: all
+          // but one in ten tets of a live slice stop here, scattered over the mesh. The vertex
+          // indices of those kept are copied here: read again below, each was a cache miss.
+          const std::size_t span = static_cast<std::size_t>(tEnd - tBegin) + 1;
+          std::vector<std::int32_t> hits(span);
+          std::vector<raster::TetVertices> hitVertices(span);
+          {
+            const std::uint8_t* oc = outcode.data();
+            const int *T0 = in.tets->col(0).data(), *T1 = in.tets->col(1).data(),
+                      *T2 = in.tets->col(2).data(), *T3 = in.tets->col(3).data();
+            std::size_t n = 0;
+            for (Eigen::Index t = tBegin; t < tEnd; ++t) {
+              const raster::TetVertices v{T0[t], T1[t], T2[t], T3[t]};
+              const unsigned shared = oc[v[0]] & oc[v[1]] & oc[v[2]] & oc[v[3]];
+              hits[n] = std::int32_t(t), hitVertices[n] = v;
+              n += !(shared & (growsAt(t) ? 0x0Fu : 0xF0u));
+            }
+            hits.resize(n), hitVertices.resize(n);
+          }
+          for (auto* list : {&c.tet, &c.jmin, &c.jmax, &c.kmin, &c.kmax, &c.mjmin, &c.mjmax})
+            list->reserve(hits.size());
+          c.vertices.reserve(hits.size());
+          for (std::size_t h = 0; h < hits.size(); ++h) {
+            // The vertices of the tets a few ahead are fetched while this one is worked on.
+            constexpr std::size_t kAhead = 8;
+            if (h + kAhead < hits.size())
+              for (const int u : hitVertices[h + kAhead])
+                __builtin_prefetch(&in.out[std::size_t(u)]);
+            const std::int32_t t = hits[h];
+            const raster::TetVertices& v = hitVertices[h];
+            const bool grows = growsAt(t);
             double gy = 0, gz = 0;  // box growth for the shell and the piece's rim
             if (withShell && shell.outer[t]) gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
             if (withRims && shell.pieceFaces[std::size_t(t)])
@@ -334,19 +367,28 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - gz;
             const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + gz;
             if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
-            double ylo = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y())) - gy;
-            double yhi = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y())) + gy;
-            if (onePlane && !grows) {
+            const double ymin = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y()));
+            const double ymax = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y()));
+            const double ylo = ymin - gy, yhi = ymax + gy;
+            if (yhi < 0 || ylo > yLast || raster::ceilToInt(ylo) > raster::floorToInt(yhi))
+              continue;
+            // The rows of the tet itself: none when its four vertices share an exact bound
+            // (only a growing tet gets this far then).
+            double mylo = ymin, myhi = ymax;
+            const bool reaches = !(outcode[std::size_t(v[0])] & outcode[std::size_t(v[1])] &
+                                   outcode[std::size_t(v[2])] & outcode[std::size_t(v[3])] & 0xF0);
+            if (!reaches) mylo = 1, myhi = 0;
+            if (onePlane && reaches) {
               // The section of the tet with the plane z = kBegin: its vertices on the plane and
               // the crossings of its edges.
               const Eigen::Vector3d* p[4] = {&p0, &p1, &p2, &p3};
               double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo;
-              ylo = xlo, yhi = -xlo;
+              mylo = xlo, myhi = -xlo;
               for (int a = 0; a < 4; ++a) {
                 const double za = p[a]->z() - zFirst;
                 if (za == 0) {
                   xlo = std::min(xlo, p[a]->x()), xhi = std::max(xhi, p[a]->x());
-                  ylo = std::min(ylo, p[a]->y()), yhi = std::max(yhi, p[a]->y());
+                  mylo = std::min(mylo, p[a]->y()), myhi = std::max(myhi, p[a]->y());
                 }
                 for (int b = a + 1; b < 4; ++b) {
                   const double zb = p[b]->z() - zFirst;
@@ -355,34 +397,40 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                   const double x = p[a]->x() + u * (p[b]->x() - p[a]->x());
                   const double y = p[a]->y() + u * (p[b]->y() - p[a]->y());
                   xlo = std::min(xlo, x), xhi = std::max(xhi, x);
-                  ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+                  mylo = std::min(mylo, y), myhi = std::max(myhi, y);
                 }
               }
               const double slack = kSectionSlack * (1 + std::max(std::abs(xlo), std::abs(xhi)));
               xlo = std::max(xlo - slack, 0.0), xhi = std::min(xhi + slack, double(nx - 1));
-              if (!(raster::ceilToInt(xlo) <= raster::floorToInt(xhi))) continue;
-              const double ySlack = kSectionSlack * (1 + std::max(std::abs(ylo), std::abs(yhi)));
-              ylo -= ySlack, yhi += ySlack;
+              const double ySlack = kSectionSlack * (1 + std::max(std::abs(mylo), std::abs(myhi)));
+              mylo -= ySlack, myhi += ySlack;
+              if (!(raster::ceilToInt(xlo) <= raster::floorToInt(xhi))) mylo = 1, myhi = 0;
             }
-            if (yhi < 0 || ylo > yLast || raster::ceilToInt(ylo) > raster::floorToInt(yhi))
-              continue;
-            c.tet.push_back(static_cast<std::int32_t>(t));
+            const std::int64_t mj0 = std::max<std::int64_t>(0, raster::ceilToInt(mylo)),
+                               mj1 = std::min(in.dims[1] - 1, raster::floorToInt(myhi));
+            if (!grows && mj0 > mj1) continue;
+            c.tet.push_back(t);
             c.vertices.push_back(v);
             c.kmin.push_back(std::int32_t(std::max(kBegin, raster::ceilToInt(zlo))));
             c.kmax.push_back(std::int32_t(std::min(kEnd - 1, raster::floorToInt(zhi))));
-            c.jmin.push_back(std::int32_t(std::max<std::int64_t>(0, raster::ceilToInt(ylo))));
-            c.jmax.push_back(std::int32_t(std::min(in.dims[1] - 1, raster::floorToInt(yhi))));
+            // A tet that does not grow is handed to the work items by its own rows.
+            c.jmin.push_back(
+                std::int32_t(grows ? std::max<std::int64_t>(0, raster::ceilToInt(ylo)) : mj0));
+            c.jmax.push_back(
+                std::int32_t(grows ? std::min(in.dims[1] - 1, raster::floorToInt(yhi)) : mj1));
+            c.mjmin.push_back(std::int32_t(mj0));
+            c.mjmax.push_back(std::int32_t(mj1));
           }
         }
       },
       1);
   // Tets of whole pieces (bones, organs) go last, so where a fold of soft tissue overlaps a bone
   // the bone keeps its voxels: soft tissue is what a bend squeezes.
-  std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax;
+  std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax, mjmin, mjmax;
   std::vector<raster::TetVertices> vertices;
   std::size_t total = 0;
   for (const Candidates& c : parts) total += c.tet.size();
-  for (auto* list : {&candidates, &jmin, &jmax, &kmin, &kmax}) list->reserve(total);
+  for (auto* list : {&candidates, &jmin, &jmax, &kmin, &kmax, &mjmin, &mjmax}) list->reserve(total);
   vertices.reserve(total);
   const bool withPieces = in.pieces && !in.pieces->empty();
   for (const int pass : {0, 1}) {
@@ -394,6 +442,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
         vertices.push_back(c.vertices[n]);
         jmin.push_back(c.jmin[n]), jmax.push_back(c.jmax[n]);
         kmin.push_back(c.kmin[n]), kmax.push_back(c.kmax[n]);
+        mjmin.push_back(c.mjmin[n]), mjmax.push_back(c.mjmax[n]);
       }
   }
   // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
@@ -407,17 +456,18 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // hundred of the thousands of tets it keeps.
   std::vector<std::vector<std::int32_t>> itemCandidates(static_cast<std::size_t>(slabs));
   {
-    auto itemOf = [&](std::int64_t x) {
-      std::int64_t item = std::min(slabs - 1, x * slabs / split);
-      while (item + 1 < slabs && split * (item + 1) / slabs <= x) ++item;
-      while (item > 0 && split * item / slabs > x) --item;
-      return item;
-    };
+    // The work item of each row or slice, as a table: two 64-bit divisions per candidate had
+    // cost a millisecond per slice.
+    std::vector<std::int32_t> itemOf(static_cast<std::size_t>(split));
+    for (std::int64_t item = 0; item < slabs; ++item)
+      std::fill(itemOf.begin() + split * item / slabs, itemOf.begin() + split * (item + 1) / slabs,
+                std::int32_t(item));
     for (std::size_t c = 0; c < candidates.size(); ++c) {
       const std::int64_t lo = bands ? jmin[c] : kmin[c] - kBegin,
                          hi = bands ? jmax[c] : kmax[c] - kBegin;
       if (lo > hi) continue;
-      for (std::int64_t item = itemOf(lo), last = itemOf(hi); item <= last; ++item)
+      for (std::int32_t item = itemOf[std::size_t(lo)], last = itemOf[std::size_t(hi)];
+           item <= last; ++item)
         itemCandidates[std::size_t(item)].push_back(std::int32_t(c));
     }
   }
@@ -445,12 +495,12 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           const std::vector<std::int32_t>& mine = itemCandidates[std::size_t(slab)];
           for (const std::int32_t c : mine) {
             const std::int32_t t = candidates[c];
-            if (kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareTet(in, vertices[c], s))
+            if (kmax[c] < k0 || kmin[c] >= k1 || mjmax[c] < j0 || mjmin[c] >= j1 ||
+                mjmin[c] > mjmax[c] || !raster::prepareTet(in, vertices[c], s))
               continue;
             const std::uint8_t mark = withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
-            raster::scanTet(s, k0, k1, std::max<std::int64_t>(j0, jmin[c]),
-                            std::min<std::int64_t>(j1, jmax[c] + 1),
+            raster::scanTet(s, k0, k1, std::max<std::int64_t>(j0, mjmin[c]),
+                            std::min<std::int64_t>(j1, mjmax[c] + 1),
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
                               localWrites += i1 - i0 + 1;
