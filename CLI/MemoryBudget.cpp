@@ -37,13 +37,6 @@ double parseMemoryBudget(const std::string& text) {
   return v * scale;
 }
 
-std::string gib(double bytes) {
-  std::ostringstream s;
-  s.precision(3);
-  s << bytes / (1024.0 * 1024 * 1024) << " GiB";
-  return s.str();
-}
-
 ReadOptions readOptionsWithin(double budget, bool progress) {
   ReadOptions r;
   if (progress) r.progress = terminalProgress();

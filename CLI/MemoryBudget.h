@@ -17,7 +17,6 @@ void declareMemoryOption(ArgParser& p, const std::string& aboveIt);
 
 // "512M", "1G", "2.5G", "300K", or bytes; empty: half the physical memory. Throws UsageError.
 double parseMemoryBudget(const std::string& text);
-std::string gib(double bytes);
 
 // Read options for a volume read in core under `budget`: the reader refuses, naming the file and
 // the numbers, when its estimate exceeds what the budget leaves beyond the process's peak so far.

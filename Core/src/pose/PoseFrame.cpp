@@ -172,12 +172,6 @@ void checkFrameMemory(const VolumeGeometry& grid, double bytesPerVoxel, double b
   if (budget <= 0) return;  // physical memory unknown: no limit rather than refusing every job
   const double need = double(grid.numVoxels()) * bytesPerVoxel, inUse = residentBytes();
   if (inUse + need <= budget) return;
-  auto gib = [](double bytes) {
-    std::ostringstream s;
-    s.precision(3);
-    s << bytes / 1073741824.0 << " GiB";
-    return s.str();
-  };
   throw Error(what + " needs " + gib(need) + " for " + std::to_string(grid.numVoxels()) +
               " output voxels beyond the " + gib(inUse) +
               " in use, more than the memory budget of " + gib(budget) + " (" + hint + ")");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
 
 namespace repose {
@@ -50,6 +51,13 @@ double memoryLeftWithin(double budget) {
   if (budget <= 0) return 0;  // physical memory unknown: no limit rather than refusing every read
   // A peak from an earlier, finished job does not count against this read: the resident set now.
   return std::max(1.0, budget - residentBytes());
+}
+
+std::string gib(double bytes) {
+  std::ostringstream s;
+  s.precision(3);
+  s << bytes / (1024.0 * 1024 * 1024) << " GiB";
+  return s.str();
 }
 
 }  // namespace repose

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -175,4 +176,31 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
       << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1);
   EXPECT_FALSE(std::filesystem::exists(dir.file("c")));
+}
+
+// `--memory` holds for the posed frame as for the reads: a budget the inputs fit in but the
+// posed volumes do not (4 mm phantom: 2.5M input voxels, 4M output voxels at 14 bytes each beside
+// the ~100 MB the rig holds) refuses the frame before allocating it, in one line with the numbers
+// and the way out, and leaves no output folder; a budget that holds it poses the same job.
+TEST(PoseCommand, AFrameBeyondTheMemoryBudgetIsRefusedWithTheNumbersAndNothingWritten) {
+  ScratchDir dir("pose_budget");
+  ASSERT_EQ(
+      runCommand("repose", "phantom --voxel 4 --out " + shellQuote(dir.path().string())).exitCode,
+      0);
+  const std::string job = "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                          shellQuote(dir.file("S.nii.gz")) + " --pose " +
+                          shellQuote(suitePoseFile("elbow90")) + " --joint-rings 0 --json";
+  const CommandResult refused =
+      runCommand("repose", job + " --memory 64M --out " + shellQuote(dir.file("small")));
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_TRUE(refused.out.empty()) << refused.out;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  for (const char* part : {"repose pose: error: ", "small: frame elbow90 needs ", " output voxels",
+                           "more than the memory budget of 0.0625 GiB", "repose warp"})
+    EXPECT_NE(refused.err.find(part), std::string::npos) << part << " in: " << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("small")));
+  const CommandResult posed =
+      runCommand("repose", job + " --memory 4G --out " + shellQuote(dir.file("enough")));
+  ASSERT_EQ(posed.exitCode, 0) << posed.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("enough/posed_G.nii.gz")));
 }

@@ -4,6 +4,8 @@
 // a header that claims tens of gigabytes is refused with the numbers instead of attempted.
 #pragma once
 
+#include <string>
+
 namespace repose {
 
 double physicalMemoryBytes();
@@ -16,5 +18,8 @@ double memoryBudgetByDefault();
 // long-lived process: the budget less the resident set now, at least 1 byte (0 is ReadOptions'
 // "no limit"), or 0 when the physical memory is unknown.
 double memoryLeftWithin(double budget = 0);
+
+// "1.25 GiB": bytes in GiB to three significant digits, as the budget errors give them.
+std::string gib(double bytes);
 
 }  // namespace repose
