@@ -9,6 +9,7 @@
 
 #include <Eigen/LU>
 #include <algorithm>
+#include <memory>
 #include <array>
 #include <atomic>
 #include <map>
@@ -331,28 +332,28 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           // but one in ten tets of a live slice stop here, scattered over the mesh. The vertex
           // indices of those kept are copied here: read again below, each was a cache miss.
           const std::size_t span = static_cast<std::size_t>(tEnd - tBegin) + 1;
-          std::vector<std::int32_t> hits(span);
-          std::vector<raster::TetVertices> hitVertices(span);
+          // Not zeroed: only the first `kept` entries are ever read.
+          const std::unique_ptr<std::int32_t[]> hits(new std::int32_t[span]);
+          const std::unique_ptr<raster::TetVertices[]> hitVertices(new raster::TetVertices[span]);
+          std::size_t kept = 0;
           {
             const std::uint8_t* oc = outcode.data();
             const int *T0 = in.tets->col(0).data(), *T1 = in.tets->col(1).data(),
                       *T2 = in.tets->col(2).data(), *T3 = in.tets->col(3).data();
-            std::size_t n = 0;
             for (Eigen::Index t = tBegin; t < tEnd; ++t) {
               const raster::TetVertices v{T0[t], T1[t], T2[t], T3[t]};
               const unsigned shared = oc[v[0]] & oc[v[1]] & oc[v[2]] & oc[v[3]];
-              hits[n] = std::int32_t(t), hitVertices[n] = v;
-              n += !(shared & (growsAt(t) ? 0x0Fu : 0xF0u));
+              hits[kept] = std::int32_t(t), hitVertices[kept] = v;
+              kept += !(shared & (growsAt(t) ? 0x0Fu : 0xF0u));
             }
-            hits.resize(n), hitVertices.resize(n);
           }
           for (auto* list : {&c.tet, &c.jmin, &c.jmax, &c.kmin, &c.kmax, &c.mjmin, &c.mjmax})
-            list->reserve(hits.size());
-          c.vertices.reserve(hits.size());
-          for (std::size_t h = 0; h < hits.size(); ++h) {
+            list->reserve(kept);
+          c.vertices.reserve(kept);
+          for (std::size_t h = 0; h < kept; ++h) {
             // The vertices of the tets a few ahead are fetched while this one is worked on.
             constexpr std::size_t kAhead = 8;
-            if (h + kAhead < hits.size())
+            if (h + kAhead < kept)
               for (const int u : hitVertices[h + kAhead])
                 __builtin_prefetch(&in.out[std::size_t(u)]);
             const std::int32_t t = hits[h];
