@@ -76,19 +76,23 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
   this->VolumeIJKToRASMatrix = nullptr;
   this->VolumeLookupTable = nullptr;
   this->VolumeLabelNames.clear();
+  this->VolumeLabelNote.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath = path;  // before the node is told, so its Modified does not reload
   this->LastErrorMessage.clear();
   try {
     if (path.empty()) throw repose::Error("no input file given");
-    const repose::Volume volume = held ? vtkSlicerReposeVolumeConversion::FromImageData(held)
-                                       : vtkSlicerReposeLogicRead::ReadVolume(path);
+    repose::Volume volume = held ? vtkSlicerReposeVolumeConversion::FromImageData(held)
+                                 : vtkSlicerReposeLogicRead::ReadVolume(path);
+    for (const repose::Label& l : volume.labels().labels())
+      this->VolumeLabelNames.push_back({l.layer, l.value, l.name});
+    // The display's names and colours of labels the file left without (the file's names above).
+    this->VolumeLabelNote =
+        vtkSlicerReposeLogicRead::NameLabels(volume, this->TissueTablePath, path);
     this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
                                  : vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =
         vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);
-    for (const repose::Label& l : volume.labels().labels())
-      this->VolumeLabelNames.push_back({l.layer, l.value, l.name});
     std::vector<int> present;  // layer 0's values, coloured even when the table lacks them
     if (volume.isLabelMap()) {
       const std::vector<repose::LabelCount> counts = repose::countLabels(volume);
@@ -116,6 +120,7 @@ void vtkSlicerReposeLogic::ClearVolume() {
   this->VolumeIJKToRASMatrix = nullptr;
   this->VolumeLookupTable = nullptr;
   this->VolumeLabelNames.clear();
+  this->VolumeLabelNote.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath.clear();
   this->LastErrorMessage.clear();
@@ -152,6 +157,13 @@ std::string vtkSlicerReposeLogic::GetVolumeSummary() const {
   else
     out << "Labels: " << this->VolumeLabelsPresent << " present, " << this->VolumeLabelNames.size()
         << " named";
+  if (!this->VolumeLabelNote.empty()) {
+    // The note without its leading "<path>: " (the box names the file already).
+    const std::size_t colon = this->VolumeLabelNote.find(": ", this->VolumePath.size());
+    out << "\nNames: "
+        << (colon == std::string::npos ? this->VolumeLabelNote
+                                       : this->VolumeLabelNote.substr(colon + 2));
+  }
   return out.str();
 }
 

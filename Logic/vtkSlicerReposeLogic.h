@@ -55,7 +55,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   vtkImageData* GetVolumeImageData() const { return this->VolumeImageData; }
   vtkMatrix4x4* GetVolumeIJKToRASMatrix() const { return this->VolumeIJKToRASMatrix; }
   vtkLookupTable* GetVolumeLookupTable() const { return this->VolumeLookupTable; }
-  // The names of its label table (the file's), by layer and value.
+  // The names of its label table (the file's), by layer and value. The display names (and the
+  // lookup table) also hold what the tissue table or the label convention names of the rest.
   struct LabelName {
     int layer = 0, value = 0;
     std::string name;
@@ -103,6 +104,14 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // Long steps run one at a time on a worker thread; the nodes they make are added to the scene
   // by WaitForJob/PollJob on the calling thread, and only when the step finished, so a cancelled
   // or failed job leaves the scene and the output folder as they were.
+  // `repose rig` as a job: the body-part map S, the skeleton and the tissue table made from the
+  // bones of the organ map at `labelsPath` (its label convention told from its names or IDs; the
+  // parameter node's image, when set, gives the body's outline), written to `folder` as
+  // S.nii.gz, skeleton.json, tissues.csv and rig.json (all four or none). When it finishes, the
+  // parameter node's body-part map is folder/S.nii.gz and the tissue table folder/tissues.csv;
+  // GetLastRigSummary says what was found.
+  bool StartRigFromOrganMap(const std::string& labelsPath, const std::string& folder);
+  const std::string& GetLastRigSummary() const { return this->LastRigSummary; }
   // Cage and transfer mesh of the segmentation's S (separations from the pose, settings from the
   // parameter node when one is set), referenced by the pose node.
   bool StartBuildRig(vtkMRMLReposeSegmentationNode* segmentation, vtkMRMLReposePoseNode* pose);
@@ -222,6 +231,11 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::vector<std::pair<int, std::string>> GetLiveBodyParts() const;
   // The centre of the rest body's box (where the views' slices start).
   std::array<double, 3> GetLiveRestCenter() const;
+  // The data probe's input side: the live segmentation's G (at rest, as read) at a RAS point, the
+  // nearest voxel's label; -1 outside its grid or without a live pose. And a label's display name
+  // (the file's, else the tissue table's or the label convention's, else its number).
+  int GetLiveRestLabelAt(double r, double a, double s) const;
+  std::string GetLiveLabelName(int value) const;
   // The live frame's labels of G on the slice plane through `positionMm` (orientation 0 axial,
   // 1 coronal, 2 sagittal), square pixels, `pixels` across the box's larger in-plane side and as
   // many as the box needs across the other: a one-voxel-thick label image on RAS axes (what the
@@ -286,6 +300,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
 
   vtkSmartPointer<vtkMRMLReposeScene> Scene;
   std::string TissueTablePath;
+  std::string LastRigSummary;
+  std::string VolumeLabelNote;  // where the labels' names came from, when not from the file
   std::string LastRefinementSummary;
   std::vector<int> RefinementVertices;
   std::vector<double> RefinementErrors;

@@ -295,6 +295,25 @@ std::array<double, 3> vtkSlicerReposeLogic::GetLiveRestCenter() const {
   return {c.x(), c.y(), c.z()};
 }
 
+int vtkSlicerReposeLogic::GetLiveRestLabelAt(double r, double a, double s) const {
+  if (!this->Live || !this->Live->Labels) return -1;
+  const repose::Volume& G = *this->Live->Labels;
+  const Eigen::Vector3d ijk = G.geometry().rasToVoxel(Eigen::Vector3d(r, a, s));
+  std::int64_t at[3];
+  for (int k = 0; k < 3; ++k) {
+    at[k] = std::llround(ijk[k]);
+    if (!std::isfinite(ijk[k]) || at[k] < 0 || at[k] >= G.dims()[std::size_t(k)]) return -1;
+  }
+  return int(G.valueAsDouble(G.index(at[0], at[1], at[2])));
+}
+
+std::string vtkSlicerReposeLogic::GetLiveLabelName(int value) const {
+  if (this->Live && this->Live->Labels)
+    if (const repose::Label* l = this->Live->Labels->labels().find(value); l && !l->name.empty())
+      return l->name;
+  return std::to_string(value);
+}
+
 std::array<double, 6> vtkSlicerReposeLogic::GetLiveBounds() const {
   if (!this->Live) return {0, 0, 0, 0, 0, 0};
   const LiveSession& l = *this->Live;

@@ -26,6 +26,7 @@
 #include <repose/pose/PoseRig.h>
 #include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
+#include <repose/rig/Rig.h>
 #include <repose/schema/SceneSchema.h>
 #include <repose/util/Error.h>
 
@@ -116,8 +117,10 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
                                                                      const std::string& image) {
   return this->Guarded<vtkMRMLReposeSegmentationNode*>(
       nullptr, [&]() -> vtkMRMLReposeSegmentationNode* {
-        const repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels);
+        repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels);
         if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
+        // Names and colours the file left out, so the views and the probe tell labels apart.
+        vtkSlicerReposeLogicRead::NameLabels(G, this->TissueTablePath, labels);
         auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
         node->SetName(stemOf(labels));
         node->SetLabelMap(Conversion::ToImageData(G));
@@ -125,9 +128,13 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
              {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
               std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
           if (path.empty()) continue;
-          const repose::Volume v = vtkSlicerReposeLogicRead::ReadVolume(path);
+          repose::Volume v = vtkSlicerReposeLogicRead::ReadVolume(path);
           if (v.dims() != G.dims() || !v.geometry().ijkToRas.isApprox(G.geometry().ijkToRas, 1e-6))
             throw repose::Error(path + ": not on the grid of " + labels);
+          // An S without part names (a NIfTI `repose rig` wrote, then converted) gets the rig's
+          // names, so the panel's part list is not empty.
+          if (setter == &vtkMRMLReposeSegmentationNode::SetBodyPartMap)
+            repose::nameBodyPartsByRigConvention(v, path);
           (node->*setter)(Conversion::ToImageData(v));
         }
         // The joints pose files name: the skeleton beside S, as `repose pose` finds it.
@@ -243,6 +250,50 @@ std::shared_ptr<const repose::PoseJob> vtkSlicerReposeLogic::PoseJobFor(
     request.settings.meshMm = this->ParameterNode->GetTransferMeshSizeMm();
   }
   return std::make_shared<const repose::PoseJob>(pose, G, S, std::move(request));
+}
+
+bool vtkSlicerReposeLogic::StartRigFromOrganMap(const std::string& labelsPath,
+                                                const std::string& folder) {
+  return this->Guarded<bool>(false, [&]() -> bool {
+    if (this->Job->IsRunning()) throw repose::Error("another job is running");
+    if (labelsPath.empty()) throw repose::Error("choose a segmentation first");
+    if (folder.empty()) throw repose::Error("no folder given for the rig");
+    auto G =
+        std::make_shared<const repose::Volume>(vtkSlicerReposeLogicRead::ReadVolume(labelsPath));
+    if (!G->isLabelMap()) throw repose::Error(labelsPath + ": not a label map (float voxels)");
+    const std::string imagePath = this->ParameterNode ? this->ParameterNode->GetImagePath() : "";
+    std::shared_ptr<const repose::Volume> image;
+    if (!imagePath.empty())
+      image =
+          std::make_shared<const repose::Volume>(vtkSlicerReposeLogicRead::ReadVolume(imagePath));
+    vtkSmartPointer<vtkMRMLReposeParametersNode> parameters = this->ParameterNode;
+    this->Job->Start(
+        "rig from organ map",
+        [=](const repose::ProgressFn& progress) -> vtkSlicerReposeJob::Commit {
+          repose::RigOptions options;
+          options.source = labelsPath;
+          options.image = image.get();
+          options.imageSource = imagePath;
+          options.progress = progress;
+          auto rig = std::make_shared<const repose::RigResult>(repose::rigBody(*G, options));
+          repose::writeRigFolder(*rig, folder, labelsPath);
+          return [=] {
+            std::ostringstream summary;
+            summary << rig->convention.name << " convention, " << rig->skeleton.joints.size()
+                    << " joints";
+            if (!rig->missing.empty())
+              summary << ", " << rig->missing.size() << " not made (" << rig->missing.front()
+                      << (rig->missing.size() > 1 ? ", ..." : "") << ")";
+            if (!rig->warnings.empty())
+              summary << "; " << rig->warnings.size()
+                      << (rig->warnings.size() == 1 ? " warning" : " warnings") << " in rig.json";
+            this->LastRigSummary = summary.str();
+            this->TissueTablePath = folder + "/tissues.csv";
+            if (parameters) parameters->SetBodyPartMapPath(folder + "/S.nii.gz");
+          };
+        });
+    return true;
+  });
 }
 
 bool vtkSlicerReposeLogic::StartRefineMesh(vtkMRMLReposePoseNode* poseNode, int iterations) {

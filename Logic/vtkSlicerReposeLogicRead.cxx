@@ -1,10 +1,12 @@
 #include "vtkSlicerReposeLogicRead.h"
 
 #include <repose/io/VolumeIO.h>
+#include <repose/rig/LabelConvention.h>
 #include <repose/util/Error.h>
 #include <repose/util/Memory.h>
 
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 namespace vtkSlicerReposeLogicRead {
@@ -16,6 +18,19 @@ repose::Volume ReadVolume(const std::string& path) {
       "the workbench reads within half the physical memory; free memory, or use the command "
       "line's --memory";
   return repose::readVolume(path, options);
+}
+
+std::string NameLabels(repose::Volume& labels, const std::string& tissuesPath,
+                       const std::string& source) {
+  std::optional<repose::TissueTable> tissues;
+  if (!tissuesPath.empty()) {
+    try {
+      tissues = repose::readTissueTable(tissuesPath);
+    } catch (const repose::Error&) {
+      // The pose job reports a broken table; names then come from the convention.
+    }
+  }
+  return repose::completeLabelNamesAndColors(labels, tissues ? &*tissues : nullptr, source);
 }
 
 std::string ReadText(const std::string& path) {

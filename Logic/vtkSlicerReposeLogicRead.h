@@ -13,6 +13,11 @@ namespace vtkSlicerReposeLogicRead {
 
 // Throws repose::Error naming the file, as repose::readVolume does.
 repose::Volume ReadVolume(const std::string& path);
+// Names and colours for G's labels the file left without (repose::completeLabelNamesAndColors),
+// the names from the tissue table at `tissuesPath` when one is set and reads, else from the label
+// convention G follows. Returns the one-line note ("" when the file named every label).
+std::string NameLabels(repose::Volume& labels, const std::string& tissuesPath,
+                       const std::string& source);
 // A small text file (a pose, a skeleton, scene.json) whole; repose::Error "path: cannot open".
 std::string ReadText(const std::string& path);
 

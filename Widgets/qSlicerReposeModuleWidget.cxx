@@ -16,6 +16,7 @@
 #include <vtkSmartPointer.h>
 
 #include <QApplication>
+#include <QDir>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QSignalBlocker>
@@ -23,6 +24,7 @@
 #include <QTimer>
 
 #include <cmath>
+#include <cstring>
 #include <optional>
 
 namespace {}  // namespace
@@ -34,9 +36,26 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   unsigned long LogicObserverTag = 0;
   unsigned long NodeObserverTag = 0;
   QTimer JobTimer;
-  enum class Step { None, Rig, Refine, Live, Export } RunningStep = Step::None;
+  enum class Step { None, OrganRig, Rig, Refine, Live, Export } RunningStep = Step::None;
   QString JobStatus = "Idle.";
   bool Updating = false;
+
+  // A button's job as the panel shows it: not started, "Error: " and the unmet precondition
+  // (`missing`, when not empty) or the logic's message; started, the timer polls `step` and the
+  // status says what runs. Returns `started`.
+  bool showJobStart(bool started, const QString& missing, Step step, const QString& status) {
+    if (started) {
+      this->RunningStep = step;
+      this->JobStatus = status;
+      this->JobTimer.start();
+    } else {
+      this->JobStatus =
+          "Error: " + (!missing.isEmpty()
+                           ? missing
+                           : QString::fromStdString(this->Logic->GetLastErrorMessage()));
+    }
+    return started;
+  }
 };
 
 qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
@@ -45,6 +64,7 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   d->setupUi(this);
   d->JobTimer.setInterval(100);
   connect(&d->JobTimer, &QTimer::timeout, this, &qSlicerReposeModuleWidget::onJobTimer);
+  d->JobStatusLabel->setWordWrap(true);  // "Rigged (...)", errors: whole, not cut at the edge
   connect(d->InputPathLineEdit, &QLineEdit::editingFinished, this,
           &qSlicerReposeModuleWidget::onInputPathEditingFinished);
   connect(d->InputBrowseButton, &QToolButton::clicked, this,
@@ -129,6 +149,8 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   connect(d->NewGroupButton, &QPushButton::clicked, this,
           &qSlicerReposeModuleWidget::newGroupFromSelection);
   connect(d->BuildRigButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::buildRig);
+  connect(d->RigFromOrganMapButton, &QPushButton::clicked, this,
+          &qSlicerReposeModuleWidget::rigFromOrganMap);
   connect(d->ExportButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::exportPose);
   connect(d->CancelButton, &QPushButton::clicked, this, &qSlicerReposeModuleWidget::cancelJob);
   this->updateWidgetFromMRML();
@@ -247,24 +269,46 @@ bool qSlicerReposeModuleWidget::buildRig() {
   return true;
 }
 
+QString qSlicerReposeModuleWidget::rigFolder() const {
+  Q_D(const qSlicerReposeModuleWidget);
+  if (!d->ParameterNode) return {};
+  const QString out = QString::fromStdString(d->ParameterNode->GetOutputFolder());
+  if (!out.isEmpty()) return QDir(out).filePath("rig");
+  const QFileInfo g(QString::fromStdString(d->ParameterNode->GetInputSegmentationPath()));
+  if (g.fileName().isEmpty()) return {};
+  QString stem = g.fileName();
+  for (const char* ext : {".nii.gz", ".seg.nrrd", ".nii", ".nrrd", ".nhdr", ".mha", ".mhd"})
+    if (stem.endsWith(ext)) {
+      stem.chop(int(std::strlen(ext)));
+      break;
+    }
+  return g.dir().filePath(stem + "_rig");
+}
+
+bool qSlicerReposeModuleWidget::rigFromOrganMap() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return false;
+  const std::string labels = d->ParameterNode->GetInputSegmentationPath();
+  const QString folder = this->rigFolder();
+  const bool started = d->showJobStart(
+      !labels.empty() && d->Logic->StartRigFromOrganMap(labels, folder.toStdString()),
+      labels.empty() ? "choose a segmentation first" : "",
+      qSlicerReposeModuleWidgetPrivate::Step::OrganRig,
+      "Rigging from the organ map into " + folder + "...");
+  this->updateWidgetFromMRML();
+  return started;
+}
+
 bool qSlicerReposeModuleWidget::exportPose() {
   Q_D(qSlicerReposeModuleWidget);
   if (!d->Logic || !d->ParameterNode) return false;
   const std::string folder = d->ParameterNode->GetOutputFolder();
-  bool ok =
-      !folder.empty() && this->activePose() && d->Logic->StartApplyPose(this->activePose(), folder);
-  if (!ok) {
-    d->JobStatus =
-        "Error: " + (folder.empty() ? QString("choose an output folder first")
-                                    : QString::fromStdString(d->Logic->GetLastErrorMessage()));
-    this->updateWidgetFromMRML();
-    return false;
-  }
-  d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Export;
-  d->JobStatus = "Exporting at full resolution...";
-  d->JobTimer.start();
+  const bool started = d->showJobStart(
+      !folder.empty() && this->activePose() && d->Logic->StartApplyPose(this->activePose(), folder),
+      folder.empty() ? "choose an output folder first" : "",
+      qSlicerReposeModuleWidgetPrivate::Step::Export, "Exporting at full resolution...");
   this->updateWidgetFromMRML();
-  return true;
+  return started;
 }
 
 void qSlicerReposeModuleWidget::cancelJob() {
@@ -316,6 +360,11 @@ void qSlicerReposeModuleWidget::onJobTimer() {
     } else {
       d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
     }
+  } else if (status == vtkSlicerReposeLogic::JobSucceeded && finished == Step::OrganRig) {
+    d->JobStatus = "Rigged (" + QString::fromStdString(d->Logic->GetLastRigSummary()) +
+                   "): body parts from " +
+                   QString::fromStdString(d->ParameterNode->GetBodyPartMapPath()) +
+                   "; build the cage and mesh next.";
   } else if (status == vtkSlicerReposeLogic::JobSucceeded) {
     d->JobStatus =
         finished == Step::Live
@@ -592,6 +641,8 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
     d->JobTimer.start();
   }
   d->BuildRigButton->setEnabled(ready && !running);
+  d->RigFromOrganMapButton->setEnabled(
+      d->ParameterNode && !d->ParameterNode->GetInputSegmentationPath().empty() && !running);
   d->RefineMeshButton->setEnabled(live && !running);
   d->ExportButton->setEnabled(ready && !running && pose != nullptr);
   d->CancelButton->setEnabled(running);

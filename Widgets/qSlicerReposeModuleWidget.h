@@ -40,6 +40,12 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   // The buttons, as a user presses them (and tests do). Each starts a job and returns at once;
   // false with the reason in jobStatusText() when it cannot start.
   bool buildRig();  // cage and mesh, then live posing
+  // "Rig from organ map": S, joints and tissue table from G's bones (a job), written to
+  // rigFolder() and then the body-part map.
+  bool rigFromOrganMap();
+  // Where the rig goes: the output folder's rig/ when an output folder is set, else
+  // <G's folder>/<G's name>_rig beside the segmentation (never into an input file).
+  QString rigFolder() const;
   bool exportPose();
   void cancelJob();
   // Runs the job timer's step until no job is left (tests and scripts; the GUI never blocks).

@@ -8,6 +8,7 @@
 #include <vtkPointData.h>
 
 #include <QPainter>
+#include <QMouseEvent>
 #include <QWheelEvent>
 
 #include <algorithm>
@@ -19,6 +20,7 @@ qSlicerReposeSliceView::qSlicerReposeSliceView(int orientation, QWidget* parent)
   this->setObjectName(this->viewName() + "SliceView");
   this->setMinimumSize(120, 120);
   this->setAttribute(Qt::WA_OpaquePaintEvent);
+  this->setMouseTracking(true);  // the data probe follows the pointer without a button down
 }
 
 QString qSlicerReposeSliceView::viewName() const {
@@ -48,6 +50,54 @@ void qSlicerReposeSliceView::setLabelOpacity(double opacity) {
 void qSlicerReposeSliceView::setWindowLevel(double window, double level) {
   this->Window = window;
   this->Level = level;
+}
+
+void qSlicerReposeSliceView::mouseMoveEvent(QMouseEvent* event) {
+  double ras[3];
+  if (this->rasAtWidgetPoint(event->localPos(), ras))
+    emit this->probed(ras[0], ras[1], ras[2]);
+  else
+    emit this->probeLeft();
+  QWidget::mouseMoveEvent(event);
+}
+
+void qSlicerReposeSliceView::leaveEvent(QEvent* event) {
+  emit this->probeLeft();
+  QWidget::leaveEvent(event);
+}
+
+QRectF qSlicerReposeSliceView::imageRect() const {
+  if (this->Image.isNull()) return {};
+  // Fit the slice with its physical aspect into the area below the bar.
+  const QRect area = this->rect().adjusted(2, BarHeight + 2, -2, -2);
+  const double w = this->Width, h = this->Height * this->AspectMm;
+  const double scale = std::min(area.width() / w, area.height() / h);
+  const QSizeF size(w * scale, h * scale);
+  return {area.x() + (area.width() - size.width()) / 2,
+          area.y() + (area.height() - size.height()) / 2, size.width(), size.height()};
+}
+
+bool qSlicerReposeSliceView::rasAtWidgetPoint(const QPointF& at, double ras[3]) const {
+  const QRectF target = this->imageRect();
+  if (target.isEmpty() || !target.contains(at)) return false;
+  // Image pixel (x, y) covers [x, x+1) x [y, y+1) of the drawn rectangle; its centre is the
+  // slice's voxel (w-1-x, h-1-y) (the image is drawn mirrored, see setSlice).
+  const double x = (at.x() - target.x()) / target.width() * this->Width - 0.5;
+  const double y = (at.y() - target.y()) / target.height() * this->Height - 0.5;
+  const double ijk[3] = {this->Width - 1 - x, this->Height - 1 - y, 0};
+  this->Shown->TransformContinuousIndexToPhysicalPoint(ijk, ras);
+  return true;
+}
+
+QPointF qSlicerReposeSliceView::widgetPointOfRas(double r, double a, double s) const {
+  const QRectF target = this->imageRect();
+  if (target.isEmpty() || !this->Shown) return {-1, -1};
+  const double ras[3] = {r, a, s};
+  double ijk[3];
+  this->Shown->TransformPhysicalPointToContinuousIndex(ras, ijk);
+  const double x = this->Width - 1 - ijk[0] + 0.5, y = this->Height - 1 - ijk[1] + 0.5;
+  return {target.x() + x / this->Width * target.width(),
+          target.y() + y / this->Height * target.height()};
 }
 
 void qSlicerReposeSliceView::wheelEvent(QWheelEvent* event) {
@@ -135,7 +185,7 @@ int qSlicerReposeSliceView::labelsShown() const {
 void qSlicerReposeSliceView::paintEvent(QPaintEvent*) {
   QPainter painter(this);
   painter.fillRect(this->rect(), Qt::black);
-  const int bar = 18;
+  const int bar = BarHeight;
   painter.fillRect(QRect(0, 0, this->width(), bar), this->viewColor());
   painter.setPen(Qt::black);
   painter.drawText(QRect(6, 0, this->width() - 12, bar), Qt::AlignVCenter | Qt::AlignLeft,
@@ -147,13 +197,7 @@ void qSlicerReposeSliceView::paintEvent(QPaintEvent*) {
     painter.drawText(this->rect().adjusted(0, bar, 0, 0), Qt::AlignCenter, "no live pose");
     return;
   }
-  // Fit the slice with its physical aspect into the area below the bar.
-  const QRect area = this->rect().adjusted(2, bar + 2, -2, -2);
-  const double w = this->Width, h = this->Height * this->AspectMm;
-  const double scale = std::min(area.width() / w, area.height() / h);
-  const QSizeF size(w * scale, h * scale);
-  const QRectF target(area.x() + (area.width() - size.width()) / 2,
-                      area.y() + (area.height() - size.height()) / 2, size.width(), size.height());
+  const QRectF target = this->imageRect();
   painter.setRenderHint(QPainter::SmoothPixmapTransform, false);  // labels stay crisp
   painter.drawImage(target, this->Image);
   painter.setPen(this->viewColor());

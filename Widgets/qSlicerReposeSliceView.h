@@ -45,10 +45,19 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
   int labelsShown() const;
   // The label shown at a RAS point of the plane (nearest pixel; -1 off the slice).
   int labelAtRas(double r, double a, double s) const;
+  // The RAS point under a widget position (false off the drawn slice), and the widget position
+  // where a RAS point of the plane is drawn (what the data probe and its tests use).
+  bool rasAtWidgetPoint(const QPointF& at, double ras[3]) const;
+  QPointF widgetPointOfRas(double r, double a, double s) const;
 
   QSize sizeHint() const override { return {320, 320}; }
 
  signals:
+  // The pointer moved over the drawn slice, to this RAS point (mouse tracking: no button
+  // needed), or left it.
+  void probed(double r, double a, double s);
+  void probeLeft();
+
   // The mouse wheel turned over the view: this many slices on (positive: towards superior,
   // anterior or the patient's left... as the plane's normal axis increases).
   void scrolled(int steps);
@@ -56,8 +65,13 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
  protected:
   void paintEvent(QPaintEvent* event) override;
   void wheelEvent(QWheelEvent* event) override;
+  void mouseMoveEvent(QMouseEvent* event) override;
+  void leaveEvent(QEvent* event) override;
 
  private:
+  QRectF imageRect() const;  // where the slice is drawn in the widget (aspect kept)
+  static constexpr int BarHeight = 18;
+
   int Orientation;
   double PositionMm = 0;
   double LabelOpacity = 0.8;

@@ -25,6 +25,7 @@
 #include <vtkTextProperty.h>
 
 #include <QGridLayout>
+#include <QLabel>
 #include <QPainter>
 
 #include <array>
@@ -55,6 +56,9 @@ class qSlicerReposeViewsWidgetPrivate {
   vtkSmartPointer<vtkTextActor> Timing;  // "frame … ms, slices … ms" in the 3D view's corner
   vtkSmartPointer<vtkLookupTable> Lookup;
   vtkMRMLReposePoseNode* LookupFor = nullptr;
+  QLabel* Probe = nullptr;  // the data probe line under the views
+  int ProbeView = -1;       // the view the pointer is over (-1: none)
+  double ProbeRas[3] = {0, 0, 0};
 };
 
 qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
@@ -116,11 +120,27 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
       this->setSlicePosition(o, std::clamp(d->Positions[o] + steps * step, lo, hi));
     });
   }
-  // Slicer's Four-Up: Red | 3D over Yellow | Green.
+  // Slicer's Four-Up: Red | 3D over Yellow | Green; the probe line below.
   grid->addWidget(d->Slices[0], 0, 0);
   grid->addWidget(d->View3D, 0, 1);
   grid->addWidget(d->Slices[2], 1, 0);
   grid->addWidget(d->Slices[1], 1, 1);
+  d->Probe = new QLabel(this);
+  d->Probe->setObjectName("DataProbe");
+  d->Probe->setTextFormat(Qt::PlainText);
+  d->Probe->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  d->Probe->setMinimumHeight(d->Probe->fontMetrics().height() + 6);
+  grid->addWidget(d->Probe, 2, 0, 1, 2);
+  grid->setRowStretch(0, 1);
+  grid->setRowStretch(1, 1);
+  for (int o = 0; o < 3; ++o) {
+    connect(d->Slices[o], &qSlicerReposeSliceView::probed, this,
+            [this, o](double r, double a, double s) { this->probe(o, r, a, s); });
+    connect(d->Slices[o], &qSlicerReposeSliceView::probeLeft, this, [d] {
+      d->ProbeView = -1;
+      d->Probe->clear();
+    });
+  }
 }
 
 qSlicerReposeViewsWidget::~qSlicerReposeViewsWidget() {
@@ -196,6 +216,8 @@ void qSlicerReposeViewsWidget::refresh() {
   d->SliceMilliseconds = 0;
   if (!pose) {
     d->Timing->VisibilityOff();
+    d->ProbeView = -1;
+    d->Probe->clear();
     for (qSlicerReposeSliceView* view : d->Slices) view->setSlice(nullptr, nullptr);
     d->CameraResetFor = nullptr;
     if (d->CageInteraction) d->CageInteraction->update();
@@ -243,6 +265,12 @@ void qSlicerReposeViewsWidget::refresh() {
                           .toUtf8()
                           .constData());
   d->Timing->VisibilityOn();
+  // A still pointer over a slice: what is under it changes with the frame and with the slice's
+  // position (the wheel).
+  if (const int o = d->ProbeView; o >= 0) {
+    d->ProbeRas[o == 0 ? 2 : o == 1 ? 1 : 0] = d->Positions[o];
+    this->probe(o, d->ProbeRas[0], d->ProbeRas[1], d->ProbeRas[2]);
+  }
   if (d->CameraResetFor != pose) {
     d->CameraResetFor = pose;
     vtkCamera* camera = d->Renderer->GetActiveCamera();
@@ -254,6 +282,45 @@ void qSlicerReposeViewsWidget::refresh() {
   if (d->CageInteraction) d->CageInteraction->update();
   d->RenderWindow->Render();
   d->View3D->update();
+}
+
+QString qSlicerReposeViewsWidget::probeText() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->Probe->text();
+}
+
+namespace {
+// Slicer's way of writing a RAS position: each axis by the side it points to (R/L, A/P, S/I).
+QString rasText(double r, double a, double s) {
+  auto axis = [](double v, char positive, char negative) {
+    return QString("%1 %2").arg(v < 0 ? negative : positive).arg(std::fabs(v), 0, 'f', 1);
+  };
+  return axis(r, 'R', 'L') + "  " + axis(a, 'A', 'P') + "  " + axis(s, 'S', 'I');
+}
+}  // namespace
+
+QString qSlicerReposeViewsWidget::probe(int orientation, double r, double a, double s) {
+  Q_D(qSlicerReposeViewsWidget);
+  if (orientation < 0 || orientation > 2 || !d->Logic || !d->Logic->GetLivePose()) {
+    d->ProbeView = -1;
+    d->Probe->clear();
+    return {};
+  }
+  d->ProbeView = orientation;
+  d->ProbeRas[0] = r, d->ProbeRas[1] = a, d->ProbeRas[2] = s;
+  auto label = [&](int value) {
+    if (value < 0) return QString("outside");
+    if (value == 0) return QString("0 (background)");
+    return QString("%1 %2").arg(value).arg(
+        QString::fromStdString(d->Logic->GetLiveLabelName(value)));
+  };
+  const qSlicerReposeSliceView* view = d->Slices[orientation];
+  const QString text =
+      QString("%1 (%2)  %3   posed: %4   input: %5")
+          .arg(view->viewName(), view->orientationName().toLower(), rasText(r, a, s),
+               label(view->labelAtRas(r, a, s)), label(d->Logic->GetLiveRestLabelAt(r, a, s)));
+  d->Probe->setText(text);
+  return text;
 }
 
 QImage qSlicerReposeViewsWidget::renderViews() {

@@ -2,7 +2,9 @@
 // view on top, Yellow (sagittal) and Green (coronal) below. The 3D view draws the posed cage as a
 // wireframe with its vertices and the posed body surface; the slice views draw the live frame's
 // labels, recomputed from the Logic on every change of the live pose (a handle moved, undo, a
-// keyframe), so they follow a drag.
+// keyframe), so they follow a drag. Under the views, a data probe line (as Slicer's Data Probe)
+// says what is under the pointer in a slice view: the RAS position, the posed label and the input
+// label there, each by name and value.
 #pragma once
 
 #include "qSlicerReposeModuleWidgetsExport.h"
@@ -39,6 +41,11 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeViewsWidget : public QWi
   // Logic change). The slices' rasterization time of the last refresh, all three, in ms.
   void refresh();
   double lastSliceMilliseconds() const;
+
+  // The probe line: what it shows now ("" with the pointer off the slices), and what it shows
+  // with the pointer at a RAS point of a view's plane (the same text; also shown).
+  QString probeText() const;
+  QString probe(int orientation, double r, double a, double s);
 
   // The four views as one picture (the 3D view read back from its framebuffer).
   QImage renderViews();

@@ -110,7 +110,6 @@ int main(int argc, char** argv) {
     fail("no movable group \"" + group + "\" in the scene's pose (--group NAME)");
   const std::array<double, 3> axis = rest->axis, pivot = rest->pivot,
                               translation = rest->translation;
-  const double restAngle = rest->angleDeg;
 
   const std::array<double, 6> box = logic->GetLiveBounds();
   const std::array<double, 3> centre{(box[0] + box[1]) / 2, (box[2] + box[3]) / 2,

@@ -72,7 +72,7 @@ LabelTable labelsFromPython(const py::object& labels) {
       Label l;
       l.value = k.cast<int>();
       l.name = v.cast<std::string>();
-      l.color = LabelTable::defaultColor(l.value);
+      l.color = LabelTable::defaultColor(l.value, l.name);
       l.colorGenerated = true;
       table.set(l);
     }
@@ -83,7 +83,7 @@ LabelTable labelsFromPython(const py::object& labels) {
     Label l;
     l.value = d["value"].cast<int>();
     l.name = d.contains("name") ? d["name"].cast<std::string>() : std::string();
-    l.color = LabelTable::defaultColor(l.value);
+    l.color = LabelTable::defaultColor(l.value, l.name);
     l.colorGenerated = true;
     if (d.contains("color")) {
       const auto c = d["color"].cast<std::vector<double>>();

@@ -11,7 +11,9 @@
 #include "qSlicerReposeViewsWidget.h"
 #include "vtkMRMLReposeParametersNode.h"
 #include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeVolumeConversion.h"
 
 #include <QVTKOpenGLNativeWidget.h>
 #include <repose/io/AtomicOutput.h>
@@ -30,6 +32,7 @@
 
 #include <QDir>
 #include <QComboBox>
+#include <QMouseEvent>
 #include <QWheelEvent>
 #include <QHBoxLayout>
 #include <QPushButton>
@@ -42,6 +45,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 
 namespace {
@@ -89,11 +93,18 @@ struct Session {
   qSlicerReposeViewsWidget* views = new qSlicerReposeViewsWidget;
   std::pair<repose::Volume, repose::Volume> volumes;
 
-  explicit Session(double voxelMm) {
+  // `icrp`: a user's own segmentation, as a converted ICRP 110 array arrives: the arms resting on
+  // the trunk, organ IDs with no label table, and an S whose file names no part.
+  explicit Session(double voxelMm, bool icrp = false) {
     repose::PhantomOptions po;
     po.voxelMm = voxelMm;
+    if (icrp) {
+      po.armsResting = true;
+      po.labels = repose::PhantomLabelling::Icrp110;
+    }
     const repose::Phantom phantom(po);
     volumes = phantom.makeVolumes();
+    if (icrp) volumes.second.labels() = repose::LabelTable();
     G = dir.filePath("G.nii.gz"), S = dir.filePath("S.nii.gz"), CT = dir.filePath("CT.nii.gz");
     repose::writeTextFileAtomically(dir.filePath("skeleton.json").toStdString(),
                                     phantom.skeletonJson());
@@ -232,6 +243,110 @@ class qSlicerReposeViewsTest : public QObject {
     const QImage shot(png);
     QVERIFY(!shot.isNull());
     QVERIFY(colours(shot, shot.rect()) > 30);
+  }
+
+  // A user's own segmentation with no colour table (ICRP 110 IDs, arms resting): the labels are
+  // named by their convention; "Rig from organ map" makes S, the joints and the tissue table (a
+  // job) and they become the body parts; built, the views draw the labels in distinct colours,
+  // and the data probe under them names the label at the pointer, posed and input. An S whose
+  // file names no part gets the rig's part names.
+  void ownSegmentationShowsNamedColouredLabelsAndTheProbe() {
+    Session session(8, true);
+    QVERIFY(session.show());
+    vtkSlicerReposeLogic* logic = session.logic;
+    qSlicerReposeModuleWidget* panel = session.panel;
+    qSlicerReposeViewsWidget* views = session.views;
+    QVERIFY(panel->setInputPath(session.G));
+    QVERIFY2(panel->inputInfoText().contains("named from the icrp110"),
+             qPrintable(panel->inputInfoText()));
+    // Rig from the panel: written beside G (no output folder set), then G's body parts.
+    const QString rig = session.dir.filePath("G_rig");
+    QCOMPARE(panel->rigFolder(), rig);
+    auto* rigButton = panel->findChild<QPushButton*>("RigFromOrganMapButton");
+    QVERIFY(rigButton && rigButton->isEnabled());
+    rigButton->click();
+    QVERIFY(logic->IsJobRunning());
+    panel->waitForJobs();
+    QVERIFY2(panel->jobStatusText().startsWith("Rigged (icrp110"),
+             qPrintable(panel->jobStatusText()));
+    for (const char* f : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
+      QVERIFY2(QFileInfo::exists(rig + "/" + f), f);
+    QCOMPARE(QString::fromStdString(session.node->GetBodyPartMapPath()), rig + "/S.nii.gz");
+    QVERIFY(session.window.grab().save(artifact("guide_own_segmentation_rigged.png")));
+    QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose(), qPrintable(panel->jobStatusText()));
+    bool handNamed = false;
+    for (const auto& [label, name] : logic->GetLiveBodyParts()) handNamed |= name == "hand_left";
+    QVERIFY(handNamed);
+
+    // An interior voxel of the chest (its 27 neighbours share its label), and the coronal view
+    // through it. The pose is still the rest pose: posed and input agree there.
+    const repose::Volume& G = session.volumes.first;
+    const auto dims = G.dims();
+    int value = 0;
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    for (std::int64_t k = dims[2] * 6 / 10; k < dims[2] - 1 && value == 0; ++k)
+      for (std::int64_t i = dims[0] / 2 - 4; i <= dims[0] / 2 + 4 && value == 0; ++i) {
+        const std::int64_t j = dims[1] / 2;
+        const int v = int(G.valueAsDouble(G.index(i, j, k)));
+        bool interior = v > 0;
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di)
+              interior &= int(G.valueAsDouble(G.index(i + di, j + dj, k + dk))) == v;
+        if (interior) value = v, at = G.geometry().voxelToRas(double(i), double(j), double(k));
+      }
+    QVERIFY(value > 0);
+    views->setSlicePosition(1, at.y());
+    qSlicerReposeSliceView* coronal = views->sliceView(1);
+
+    // Distinct labels, distinct colours: every pixel of one label has one colour, and no two
+    // labels share one.
+    std::map<int, QRgb> colourOf;
+    std::map<QRgb, int> labelOf;
+    const QImage& image = coronal->sliceImage();
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x) {
+        const int label = coronal->labelAt(x, y);
+        if (label <= 0) continue;
+        const QRgb c = image.pixel(x, y);
+        QVERIFY(colourOf.emplace(label, c).first->second == c);
+        const int other = labelOf.emplace(c, label).first->second;
+        QVERIFY2(other == label,
+                 qPrintable(QString("labels %1 and %2 share a colour").arg(other).arg(label)));
+      }
+    QVERIFY2(colourOf.size() >= 10, qPrintable(QString::number(colourOf.size())));
+
+    // The pointer moved over that voxel: the probe names its label, posed and input, and the
+    // position as Slicer writes it.
+    const QPointF point = coronal->widgetPointOfRas(at.x(), at.y(), at.z());
+    QMouseEvent move(QEvent::MouseMove, point, Qt::NoButton, Qt::NoButton, Qt::NoModifier);
+    QApplication::sendEvent(coronal, &move);
+    const QString name = QString::fromStdString(logic->GetLiveLabelName(value));
+    QVERIFY2(name != QString::number(value), qPrintable(name));  // named, not numbered
+    const QString text = views->probeText();
+    qInfo("probe: %s", qPrintable(text));
+    QVERIFY2(text.startsWith("Green (coronal)"), qPrintable(text));
+    QVERIFY2(text.contains(QString("posed: %1 %2").arg(value).arg(name)), qPrintable(text));
+    QVERIFY2(text.contains(QString("input: %1 %2").arg(value).arg(name)), qPrintable(text));
+    QVERIFY2(text.contains(
+                 QString("%1 %2").arg(at.y() < 0 ? 'P' : 'A').arg(std::fabs(at.y()), 0, 'f', 1)),
+             qPrintable(text));
+    QVERIFY(session.window.grab().save(artifact("guide_own_segmentation_probe.png")));
+    // Off the slice: the line empties.
+    QEvent leave(QEvent::Leave);
+    QApplication::sendEvent(coronal, &leave);
+    QVERIFY(views->probeText().isEmpty());
+    // The phantom's own S, its part names dropped from the file: named as the rig names them.
+    vtkMRMLReposeSegmentationNode* unnamedParts =
+        logic->AddSegmentation(session.G.toStdString(), session.S.toStdString());
+    QVERIFY2(unnamedParts, logic->GetLastErrorMessage().c_str());
+    const repose::Volume parts =
+        vtkSlicerReposeVolumeConversion::FromImageData(unnamedParts->GetBodyPartMap());
+    QVERIFY(parts.labels().find(repose::kPartHandLeft));
+    QCOMPARE(QString::fromStdString(parts.labels().find(repose::kPartHandLeft)->name),
+             QString("hand_left"));
   }
 
   // No pose file: Build makes a new pose (everything fixed) and poses it live. In the 3D view,

@@ -4,6 +4,7 @@
 #include "repose/dosimetry/ColeCole.h"
 #include "repose/rig/LabelConvention.h"
 #include "repose/util/Error.h"
+#include "repose/util/NameMatch.h"
 #include "repose/volume/LabelStatistics.h"
 
 #include <cctype>
@@ -14,17 +15,6 @@
 
 namespace repose {
 namespace {
-
-std::string normalized(const std::string& name) {
-  std::string s;
-  for (const char c : name) {
-    const char l = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    s += l == '_' ? ' ' : (l == ';' ? ',' : l);
-  }
-  const auto first = s.find_first_not_of(' ');
-  const auto last = s.find_last_not_of(' ');
-  return first == std::string::npos ? "" : s.substr(first, last - first + 1);
-}
 
 std::vector<std::string> fields(const std::string& line) {
   std::vector<std::string> f;
@@ -105,28 +95,8 @@ std::map<int, std::string> readUserCsv(const std::string& path) {
 
 }  // namespace
 
-bool globMatches(const std::string& pattern, const std::string& text) {
-  // Iterative matcher with one backtrack point per '*': linear in practice for short names.
-  std::size_t p = 0, t = 0, star = std::string::npos, mark = 0;
-  while (t < text.size()) {
-    if (p < pattern.size() && (pattern[p] == '?' || pattern[p] == text[t])) {
-      ++p, ++t;
-    } else if (p < pattern.size() && pattern[p] == '*') {
-      star = p++;
-      mark = t;
-    } else if (star != std::string::npos) {
-      p = star + 1;
-      t = ++mark;
-    } else {
-      return false;
-    }
-  }
-  while (p < pattern.size() && pattern[p] == '*') ++p;
-  return p == pattern.size();
-}
-
 std::string tissueForName(const std::string& name, std::string* pattern) {
-  const std::string key = normalized(name);
+  const std::string key = normalizedLabelName(name);
   if (key.empty()) return "";
   for (const auto& [glob, tissue] : rules())
     if (globMatches(glob, key)) {

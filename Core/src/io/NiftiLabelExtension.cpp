@@ -109,7 +109,7 @@ LabelTable parseCaretLabelTable(const std::string& xml) {
     if (!r.empty() && !g.empty() && !b.empty())
       label.color = {std::atof(r.c_str()), std::atof(g.c_str()), std::atof(b.c_str())};
     else {
-      label.color = LabelTable::defaultColor(label.value);
+      label.color = LabelTable::defaultColor(label.value, label.name);
       label.colorGenerated = true;
     }
     table.set(label);

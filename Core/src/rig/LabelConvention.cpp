@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -453,6 +454,91 @@ LabelConvention labelConvention(const Volume& organs, const std::string& request
   for (auto& [v, r] : c.roles)
     if (r.name.empty()) r.name = "label_" + std::to_string(v);
   return c;
+}
+
+std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissues,
+                                        const std::string& source) {
+  if (!organs.isLabelMap()) return "";
+  const std::vector<int> values = present(organs);
+  std::vector<int> unnamed;
+  for (const int v : values)
+    if (nameOf(organs, v).empty()) unnamed.push_back(v);
+  std::map<int, std::string> names;  // value -> name from the table or the convention
+  std::string from;
+  if (!unnamed.empty() && tissues) {
+    for (const int v : unnamed)
+      if (const auto t = tissues->find(v); t != tissues->end() && !t->second.name.empty()) {
+        // The table's CSV has no quoting, so its writer turned commas into ';' (ICRP 110's
+        // "Humeri, upper half, cortical"): shown with its commas again.
+        std::string name = t->second.name;
+        std::replace(name.begin(), name.end(), ';', ',');
+        names[v] = name;
+      }
+    from = "the tissue table";
+  } else if (!unnamed.empty()) {
+    try {
+      const LabelConvention c = labelConvention(organs, "auto", source);
+      for (const int v : unnamed)
+        if (const auto r = c.roles.find(v);
+            r != c.roles.end() && r->second.name != "label_" + std::to_string(v))
+          names[v] = r->second.name;
+      from = "the " + c.name + " convention (" + c.detection + ")";
+    } catch (const Error&) {
+      // No convention fits: the labels keep their numbers.
+    }
+  }
+  LabelTable& table = organs.labels();
+  // Colours the file gave stay; the made-up ones are kept apart from every colour already taken
+  // (two shades of one class, or two hues, can come out alike): in value order, the first
+  // variant at least kMinApart from the others in some channel, as the slice views draw them.
+  constexpr double kMinApart = 6.0 / 255;
+  std::vector<std::array<double, 3>> taken;
+  std::vector<Label> made;
+  for (const int v : values) {
+    const Label* had = table.find(v);
+    Label l = had ? *had : Label{};
+    l.value = v;
+    if (l.name.empty()) {
+      const auto n = names.find(v);
+      l.name = n != names.end() ? n->second : std::to_string(v);
+    }
+    if (had && !had->colorGenerated)
+      taken.push_back(l.color);
+    else
+      made.push_back(l);
+  }
+  auto apart = [&](const std::array<double, 3>& c) {
+    double nearest = 1;
+    for (const auto& t : taken)
+      nearest = std::min(nearest, std::max({std::fabs(c[0] - t[0]), std::fabs(c[1] - t[1]),
+                                            std::fabs(c[2] - t[2])}));
+    return nearest;
+  };
+  for (Label& l : made) {
+    std::array<double, 3> best = LabelTable::defaultColor(l.value, l.name);
+    double bestApart = apart(best);
+    for (int variant = 1; variant < 64 && bestApart < kMinApart; ++variant) {
+      const std::array<double, 3> c = LabelTable::defaultColor(l.value, l.name, variant);
+      if (const double d = apart(c); d > bestApart) best = c, bestApart = d;
+    }
+    l.color = best;
+    l.colorGenerated = true;
+    taken.push_back(best);
+  }
+  for (const int v : values)
+    if (const Label* had = table.find(v); had && !had->colorGenerated) {
+      Label l = *had;
+      if (l.name.empty()) l.name = names.count(v) ? names.at(v) : std::to_string(v);
+      table.set(l);
+    }
+  for (const Label& l : made) table.set(l);
+  if (unnamed.empty()) return "";
+  const std::size_t named = names.size();
+  return source + ": " + std::to_string(unnamed.size()) + " of " + std::to_string(values.size()) +
+         " labels unnamed in the file; " +
+         (named > 0 ? std::to_string(named) + " named from " + from
+                    : std::string("no label convention or tissue table names them")) +
+         (named < unnamed.size() ? ", the rest keep their numbers" : "");
 }
 
 }  // namespace repose

@@ -9,6 +9,7 @@
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeVolumeConversion.h"
 
 #include "CommandRunner.h"
 #include "TestPaths.h"
@@ -347,4 +348,60 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportAboveTheMemoryBudgetIsRefusedWithTheN
   ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   EXPECT_TRUE(std::filesystem::exists(out + "/posed_G.nii.gz"));
+}
+
+// "Rig from organ map" on an ICRP 110 array without a label table: the job writes S, the
+// skeleton, the tissue table and rig.json and points the parameter node at S; the segmentation
+// added next has the convention's organ names and the rig's part names. A folder that cannot be
+// made fails the job with one line naming it, and a G that is not a label map is refused before
+// any job starts.
+TEST(vtkSlicerReposeLogicPipeline, RigFromOrganMapWritesTheRigAndNamesTheLabels) {
+  ScratchDir dir("organrig");
+  repose::PhantomOptions po;
+  po.voxelMm = 8;
+  po.armsResting = true;
+  po.labels = repose::PhantomLabelling::Icrp110;
+  const auto [organs, parts] = repose::Phantom(po).makeVolumes();
+  ASSERT_TRUE(organs.labels().empty());
+  const std::string G = dir.file("AF.nii.gz");
+  repose::writeVolume(organs, G);
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> node;
+  logic->SetParameterNode(node);
+
+  const std::string rig = dir.file("AF_rig");
+  ASSERT_TRUE(logic->StartRigFromOrganMap(G, rig)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  for (const char* f : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
+    EXPECT_TRUE(std::filesystem::exists(rig + "/" + f)) << f;
+  EXPECT_EQ(node->GetBodyPartMapPath(), rig + "/S.nii.gz");
+  EXPECT_EQ(logic->GetLastRigSummary().rfind("icrp110 (AF) convention, ", 0), 0u)
+      << logic->GetLastRigSummary();
+
+  vtkMRMLReposeSegmentationNode* seg = logic->AddSegmentation(G, node->GetBodyPartMapPath());
+  ASSERT_NE(seg, nullptr) << logic->GetLastErrorMessage();
+  EXPECT_FALSE(seg->GetSkeletonJSON().empty());  // skeleton.json beside S
+  const repose::Volume named = vtkSlicerReposeVolumeConversion::FromImageData(seg->GetLabelMap());
+  ASSERT_TRUE(named.labels().find(13));
+  EXPECT_EQ(named.labels().find(13)->name, "Humeri, upper half, cortical");
+  const repose::Volume S = vtkSlicerReposeVolumeConversion::FromImageData(seg->GetBodyPartMap());
+  ASSERT_TRUE(S.labels().find(repose::kPartHandLeft));
+  EXPECT_EQ(S.labels().find(repose::kPartHandLeft)->name, "hand_left");
+
+  // A folder under a file cannot be made: the job fails, naming it; nothing else changes.
+  node->SetBodyPartMapPath("");
+  const std::string bad = G + "/rig";
+  ASSERT_TRUE(logic->StartRigFromOrganMap(G, bad)) << logic->GetLastErrorMessage();
+  EXPECT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobFailed);
+  EXPECT_NE(logic->GetLastErrorMessage().find(bad), std::string::npos)
+      << logic->GetLastErrorMessage();
+  EXPECT_EQ(logic->GetLastErrorMessage().find('\n'), std::string::npos);
+  EXPECT_EQ(node->GetBodyPartMapPath(), "");
+  // An image is no organ map.
+  repose::writeVolume(repose::syntheticCT(organs), dir.file("CT.nii.gz"));
+  EXPECT_FALSE(logic->StartRigFromOrganMap(dir.file("CT.nii.gz"), dir.file("ct_rig")));
+  EXPECT_NE(logic->GetLastErrorMessage().find("not a label map"), std::string::npos)
+      << logic->GetLastErrorMessage();
+  EXPECT_FALSE(std::filesystem::exists(dir.file("ct_rig")));
 }

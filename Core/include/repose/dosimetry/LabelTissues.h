@@ -4,6 +4,7 @@
 // Labels left without a tissue are a one-line error listing them.
 #pragma once
 
+#include "repose/util/NameMatch.h"  // globMatches, used with the rules
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 
@@ -44,7 +45,5 @@ void assignTissues(std::map<int, LabelTissue>& labels, const LabelTissueOptions&
 // The rule file's tissue for a name (lower case, '_' as space, ';' as ','), or "" when no
 // pattern matches; `pattern` receives the pattern that matched.
 std::string tissueForName(const std::string& name, std::string* pattern = nullptr);
-// Whole-text glob match with '*' (any text) and '?' (one character).
-bool globMatches(const std::string& pattern, const std::string& text);
 
 }  // namespace repose

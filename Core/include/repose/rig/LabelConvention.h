@@ -5,6 +5,7 @@
 // TotalSegmentator v2 class names; or a CSV mapping the user's labels to bones.
 #pragma once
 
+#include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 
 #include <map>
@@ -61,5 +62,15 @@ struct LabelConvention {
 // told ("auto") or does not fit G.
 LabelConvention labelConvention(const Volume& organs, const std::string& requested,
                                 const std::string& source);
+
+// What a viewer shows of a user's G whose file names or colours not every label (a converted
+// ICRP 110 array, a NIfTI without a colour table): every label present in layer 0 gets a name,
+// from the file, else `tissues` (when given), else the convention "auto" detects (ICRP 110's
+// organ names for its IDs); labels no source names keep their number. Labels without a colour of
+// their own get their structure's colour by that name (LabelTable::defaultColor(value, name)),
+// marked colorGenerated. Returns one line saying where the names came from, "" when the file
+// named every label. Never throws for a G no convention fits: that only leaves the numbers.
+std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissues,
+                                        const std::string& source);
 
 }  // namespace repose

@@ -31,6 +31,10 @@ class LabelTable {
   std::size_t size() const { return labels_.size(); }
   // A distinct, stable colour for a value with no colour given (golden-angle hue walk).
   static std::array<double, 3> defaultColor(int value);
+  // The colour of a named label with no colour given: its structure's colour by name
+  // (AnatomyColors.h: bone ivory, muscle red...), shaded by value; else defaultColor(value).
+  // `variant` > 0: another colour of the same kind (anatomyColor's variant; another hue).
+  static std::array<double, 3> defaultColor(int value, const std::string& name, int variant = 0);
 
  private:
   std::vector<Label> labels_;  // sorted by (layer, value)

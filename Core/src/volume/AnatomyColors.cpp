@@ -1,0 +1,128 @@
+// Anatomy colours: the rules parsed once, matched by name; the class colour shaded in HSV.
+#include "repose/volume/AnatomyColors.h"
+
+#include "AnatomyColorRules.h"  // generated from Resources/Colors/anatomy_colors.csv
+#include "repose/util/NameMatch.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace repose {
+namespace {
+
+struct ColorRule {
+  std::string pattern;
+  std::array<double, 3> rgb;
+};
+
+const std::vector<ColorRule>& rules() {
+  static const std::vector<ColorRule> parsed = [] {
+    std::vector<ColorRule> out;
+    std::istringstream in(kAnatomyColorRulesCsv);
+    std::string line;
+    bool header = true;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      if (header) {  // pattern,red,green,blue
+        header = false;
+        continue;
+      }
+      // The pattern may hold commas (ICRP's names do): the colour is the last three fields.
+      std::array<double, 3> rgb{};
+      std::size_t end = line.size();
+      for (int k = 2; k >= 0; --k) {
+        const std::size_t comma = line.rfind(',', end - 1);
+        if (comma == std::string::npos) throw std::logic_error("anatomy_colors.csv: " + line);
+        rgb[std::size_t(k)] = std::stod(line.substr(comma + 1, end - comma - 1)) / 255.0;
+        end = comma;
+      }
+      out.push_back({line.substr(0, end), rgb});
+    }
+    return out;
+  }();
+  return parsed;
+}
+
+const ColorRule* ruleFor(const std::string& name) {
+  const std::string key = normalizedLabelName(name);
+  if (key.empty()) return nullptr;
+  for (const ColorRule& r : rules())
+    if (globMatches(r.pattern, key)) return &r;
+  return nullptr;
+}
+
+double fraction(double x) {
+  return x - std::floor(x);
+}
+
+std::array<double, 3> toHsv(const std::array<double, 3>& rgb) {
+  const double mx = std::max({rgb[0], rgb[1], rgb[2]}), mn = std::min({rgb[0], rgb[1], rgb[2]});
+  const double d = mx - mn;
+  double h = 0;
+  if (d > 0) {
+    if (mx == rgb[0])
+      h = std::fmod((rgb[1] - rgb[2]) / d + 6, 6.0);
+    else if (mx == rgb[1])
+      h = (rgb[2] - rgb[0]) / d + 2;
+    else
+      h = (rgb[0] - rgb[1]) / d + 4;
+  }
+  return {h * 60, mx > 0 ? d / mx : 0, mx};
+}
+
+}  // namespace
+
+std::optional<std::array<double, 3>> anatomyColor(const std::string& name, int value, int variant) {
+  const ColorRule* rule = ruleFor(name);
+  if (!rule) return std::nullopt;
+  // Three low-discrepancy walks over the value (golden ratio, sqrt 2, 1/pi fractions) shade
+  // brightness, hue and saturation around the class colour: labels of one class (ICRP 110's
+  // dozens of bones, four vessel regions) differ in some direction even when their values are
+  // close, and the class stays recognisable (hue within +-14 degrees).
+  const double seed = value + 1013.0 * variant;
+  const double a = fraction(seed * 0.6180339887), b = fraction(seed * 0.4142135624),
+               c = fraction(seed * 0.3183098862);
+  const std::array<double, 3> hsv = toHsv(rule->rgb);
+  const double v = std::clamp(hsv[2] * (0.74 + 0.36 * a), 0.12, 1.0);
+  const double s = std::clamp(hsv[1] * (0.7 + 0.6 * c) + 0.04 * (c - 0.5), 0.0, 1.0);
+  return hsvToRgb(hsv[0] + 28 * (b - 0.5), s, v);
+}
+
+std::array<double, 3> hsvToRgb(double h, double s, double v) {
+  h = std::fmod(std::fmod(h, 360.0) + 360.0, 360.0) / 60.0;
+  const double c = v * s, x = c * (1 - std::fabs(std::fmod(h, 2.0) - 1)), m = v - c;
+  std::array<double, 3> rgb{};
+  switch (static_cast<int>(h)) {
+    case 0:
+      rgb = {c, x, 0};
+      break;
+    case 1:
+      rgb = {x, c, 0};
+      break;
+    case 2:
+      rgb = {0, c, x};
+      break;
+    case 3:
+      rgb = {0, x, c};
+      break;
+    case 4:
+      rgb = {x, 0, c};
+      break;
+    default:
+      rgb = {c, 0, x};
+      break;
+  }
+  for (double& ch : rgb) ch = std::clamp(ch + m, 0.0, 1.0);
+  return rgb;
+}
+
+std::string anatomyColorRule(const std::string& name) {
+  const ColorRule* rule = ruleFor(name);
+  return rule ? rule->pattern : "";
+}
+
+}  // namespace repose
