@@ -22,6 +22,7 @@
 #include <QStackedWidget>
 #include <QStatusBar>
 #include <QTextBrowser>
+#include <QScrollArea>
 #include <QVBoxLayout>
 
 qReposeMainWindow::qReposeMainWindow(qReposeModuleDiscovery* discovery, QWidget* parent)
@@ -50,7 +51,14 @@ qReposeMainWindow::qReposeMainWindow(qReposeModuleDiscovery* discovery, QWidget*
   connect(helpBox, &QGroupBox::toggled, this->HelpBrowser, &QWidget::setVisible);
   layout->addWidget(helpBox);
   this->ModulePanels = new QStackedWidget;
-  layout->addWidget(this->ModulePanels, 1);
+  // Scrolled, as Slicer's module panel: a panel taller than the screen (the Output section's
+  // quality table and plot after an export) keeps its sections at their size.
+  auto* scroll = new QScrollArea;
+  scroll->setObjectName("ModulePanelScrollArea");
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setWidget(this->ModulePanels);
+  layout->addWidget(scroll, 1);
 
   auto* dock = new QDockWidget("Modules");
   dock->setObjectName("ModulePanelDock");

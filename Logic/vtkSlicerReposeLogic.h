@@ -142,6 +142,23 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   void SetTissueTablePath(const std::string& path);
   // The segmentation node the last ApplyPose job made (null before).
   vtkMRMLReposeSegmentationNode* GetLastPosedSegmentation() const;
+  // What the panel shows of the last ApplyPose job (vtkSlicerReposeLogicQuality.cxx): its
+  // report.json's quality checks (docs/QUALITY.md's targets) as rows of what was measured, the
+  // target and whether it was met; each label's volume change (name, %, largest first) for the
+  // plot; the job's warnings (separations not made, a tissue table that does not fit). Empty
+  // before an export.
+  struct QualityCheck {
+    std::string name, measured, target;
+    bool met = false;
+  };
+  std::vector<QualityCheck> GetLastPoseQuality() const;
+  struct LabelChange {
+    int value = 0;
+    std::string name;
+    double changePercent = 0;
+  };
+  std::vector<LabelChange> GetLastPoseLabelChanges() const;
+  const std::vector<std::string>& GetLastPoseWarnings() const { return this->LastPoseWarnings; }
 
   // Pose edits, undoable: the group's transform (rotation about `axis` through `pivot` by
   // `angleDeg`, then `translation`) in the pose's current keyframe, or in the pose itself when it
@@ -231,6 +248,17 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::vector<std::pair<int, std::string>> GetLiveBodyParts() const;
   // The centre of the rest body's box (where the views' slices start).
   std::array<double, 3> GetLiveRestCenter() const;
+  // What the live frame predicts of the export's volumes (repose::predictVolumeChange on its
+  // transfer mesh, computed once per frame when asked, a few ms at the seed's scale): the body's
+  // change in %, and the body part that changes most with the part that drags it (names of S;
+  // empty when nothing changes), as `repose pose` warns of tissue dragged along a contact.
+  struct LivePrediction {
+    bool valid = false;
+    double bodyChangePercent = 0;
+    std::string worstPart, draggedBy;
+    double worstPartChangePercent = 0;
+  };
+  LivePrediction GetLivePrediction();
   // The data probe's input side: the live segmentation's G (at rest, as read) at a RAS point, the
   // nearest voxel's label; -1 outside its grid or without a live pose. And a label's display name
   // (the file's, else the tissue table's or the label convention's, else its number).
@@ -307,6 +335,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::vector<double> RefinementErrors;
   std::unique_ptr<vtkSlicerReposeJob> Job;
   vtkSmartPointer<vtkMRMLReposeSegmentationNode> LastPosedSegmentation;
+  std::string LastPoseReport;  // report.json of the last ApplyPose job
+  std::vector<std::string> LastPoseWarnings;
   vtkSlicerReposePoseHistory History;  // undo and redo of pose edits
   struct LiveSession;
   std::shared_ptr<LiveSession> Live;  // shared_ptr: its type is complete only in the Live file

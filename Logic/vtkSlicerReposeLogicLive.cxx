@@ -13,6 +13,7 @@
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
+#include <repose/mesh/VolumePrediction.h>
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseRig.h>
 #include <repose/raster/Rasterizer.h>
@@ -42,6 +43,7 @@ struct vtkSlicerReposeLogic::LiveSession {
   Eigen::Vector3d Lo{0, 0, 0}, Hi{0, 0, 0};
   vtkSmartPointer<vtkPolyData> Cage, Body;
   double FrameMilliseconds = 0;
+  std::optional<vtkSlicerReposeLogic::LivePrediction> Prediction;  // of Deformed, when asked
 };
 
 namespace {
@@ -217,6 +219,7 @@ bool vtkSlicerReposeLogic::SolveLiveFrame(const repose::Pose& pose) {
     // iterations per edit (the export solves its frame from rest).
     const repose::PoseRig::Frame frame = live.Rig->liveFrame(pose, index);
     live.Deformed = frame.deformed;
+    live.Prediction.reset();
     setPoints(live.Cage, frame.cage);
     setPoints(live.Body, frame.deformed);
     const repose::TransferMesh& mesh = live.Rig->mesh();
@@ -293,6 +296,28 @@ std::array<double, 3> vtkSlicerReposeLogic::GetLiveRestCenter() const {
   const Eigen::Vector3d c =
       (mesh.vertices.colwise().minCoeff() + mesh.vertices.colwise().maxCoeff()).transpose() / 2;
   return {c.x(), c.y(), c.z()};
+}
+
+vtkSlicerReposeLogic::LivePrediction vtkSlicerReposeLogic::GetLivePrediction() {
+  if (!this->Live || this->Live->Deformed.rows() == 0) return {};
+  LiveSession& live = *this->Live;
+  if (!live.Prediction) {
+    const repose::VolumePrediction p = repose::predictVolumeChange(live.Rig->mesh(), live.Deformed);
+    LivePrediction out;
+    out.valid = true;
+    out.bodyChangePercent = p.changePercent();
+    auto name = [&](int part) -> std::string {
+      if (part == 0) return "";
+      const repose::Label* l = live.PartLabels.find(part);
+      return l && !l->name.empty() ? l->name : std::to_string(part);
+    };
+    out.worstPart = name(p.worstPart);
+    out.draggedBy = name(p.draggedBy);
+    for (const repose::PartVolumeChange& c : p.parts)
+      if (c.part == p.worstPart) out.worstPartChangePercent = c.changePercent();
+    live.Prediction = out;
+  }
+  return *live.Prediction;
 }
 
 int vtkSlicerReposeLogic::GetLiveRestLabelAt(double r, double a, double s) const {

@@ -431,6 +431,8 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
             node->SetNodeReferenceID("pose", poseRef->GetID());
             this->Scene->AddNode(node);
             this->LastPosedSegmentation = node;
+            this->LastPoseReport = f->reportJson;
+            this->LastPoseWarnings = job->warnings();
           };
         });
     return true;

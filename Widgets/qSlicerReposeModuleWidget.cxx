@@ -9,6 +9,7 @@
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
+#include "qSlicerReposeVolumeChangePlot.h"
 #include "vtkSlicerReposeLogic.h"
 
 #include <vtkCommand.h>
@@ -19,10 +20,14 @@
 #include <QDir>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QHeaderView>
+#include <QScrollBar>
+#include <QTableWidget>
 #include <QSignalBlocker>
 #include <QThread>
 #include <QTimer>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <optional>
@@ -39,6 +44,39 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   enum class Step { None, OrganRig, Rig, Refine, Live, Export } RunningStep = Step::None;
   QString JobStatus = "Idle.";
   bool Updating = false;
+  // After an export: its quality checks (check, measured, target, result) and the per-label
+  // volume changes; hidden until then.
+  QTableWidget* QualityTable = nullptr;
+  qSlicerReposeVolumeChangePlot* VolumeChangePlot = nullptr;
+
+  void showQuality(vtkSlicerReposeLogic* logic) {
+    const auto rows = logic->GetLastPoseQuality();
+    this->QualityTable->setRowCount(int(rows.size()));
+    for (int r = 0; r < int(rows.size()); ++r) {
+      const auto& row = rows[std::size_t(r)];
+      const QStringList cells = {QString::fromStdString(row.name),
+                                 QString::fromStdString(row.measured),
+                                 QString::fromStdString(row.target), row.met ? "pass" : "FAIL"};
+      for (int c = 0; c < cells.size(); ++c) {
+        auto* item = new QTableWidgetItem(cells[c]);
+        item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable);
+        if (c == 3) item->setForeground(row.met ? QColor(30, 130, 50) : QColor(200, 40, 30));
+        this->QualityTable->setItem(r, c, item);
+      }
+    }
+    this->QualityTable->resizeColumnsToContents();
+    this->QualityTable->setMinimumHeight(
+        this->QualityTable->horizontalHeader()->height() +
+        this->QualityTable->verticalHeader()->defaultSectionSize() * int(rows.size()) +
+        this->QualityTable->horizontalScrollBar()->sizeHint().height() + 4);
+    this->QualityTable->setVisible(!rows.empty());
+    std::vector<std::pair<QString, double>> changes;
+    for (const auto& c : logic->GetLastPoseLabelChanges())
+      changes.push_back({QString::fromStdString(c.name.empty() ? std::to_string(c.value) : c.name),
+                         c.changePercent});
+    this->VolumeChangePlot->setChanges(changes);
+    this->VolumeChangePlot->setVisible(!changes.empty());
+  }
 
   // A button's job as the panel shows it: not started, "Error: " and the unmet precondition
   // (`missing`, when not empty) or the logic's message; started, the timer polls `step` and the
@@ -65,6 +103,17 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   d->JobTimer.setInterval(100);
   connect(&d->JobTimer, &QTimer::timeout, this, &qSlicerReposeModuleWidget::onJobTimer);
   d->JobStatusLabel->setWordWrap(true);  // "Rigged (...)", errors: whole, not cut at the edge
+  d->LiveStatusLabel->setWordWrap(true);
+  d->QualityTable = new QTableWidget(0, 4, d->OutputGroupBox);
+  d->QualityTable->setObjectName("QualityTable");
+  d->QualityTable->setHorizontalHeaderLabels({"Check", "Measured", "Target", "Result"});
+  d->QualityTable->verticalHeader()->hide();
+  d->QualityTable->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  d->QualityTable->setVisible(false);
+  d->VolumeChangePlot = new qSlicerReposeVolumeChangePlot(d->OutputGroupBox);
+  d->VolumeChangePlot->setVisible(false);
+  d->outputLayout->addWidget(d->QualityTable, d->outputLayout->rowCount(), 0, 1, 3);
+  d->outputLayout->addWidget(d->VolumeChangePlot, d->outputLayout->rowCount(), 0, 1, 3);
   connect(d->InputPathLineEdit, &QLineEdit::editingFinished, this,
           &qSlicerReposeModuleWidget::onInputPathEditingFinished);
   connect(d->InputBrowseButton, &QToolButton::clicked, this,
@@ -365,11 +414,21 @@ void qSlicerReposeModuleWidget::onJobTimer() {
                    "): body parts from " +
                    QString::fromStdString(d->ParameterNode->GetBodyPartMapPath()) +
                    "; build the cage and mesh next.";
+  } else if (status == vtkSlicerReposeLogic::JobSucceeded && finished == Step::Export) {
+    // The report's quality on screen, and the job's warnings in the message line.
+    d->showQuality(d->Logic);
+    const auto rows = d->Logic->GetLastPoseQuality();
+    const auto failed =
+        std::count_if(rows.begin(), rows.end(), [](const auto& r) { return !r.met; });
+    d->JobStatus = "Exported to " + QString::fromStdString(d->ParameterNode->GetOutputFolder()) +
+                   (failed == 0 ? QString("; every quality target met")
+                                : QString("; %1 of %2 quality targets missed (table below)")
+                                      .arg(failed)
+                                      .arg(rows.size()));
+    for (const std::string& w : d->Logic->GetLastPoseWarnings())
+      d->JobStatus += "\nWarning: " + QString::fromStdString(w);
   } else if (status == vtkSlicerReposeLogic::JobSucceeded) {
-    d->JobStatus =
-        finished == Step::Live
-            ? "Live: drag a handle in the 3D view or the angle; the views follow."
-            : "Exported to " + QString::fromStdString(d->ParameterNode->GetOutputFolder());
+    d->JobStatus = "Live: drag a handle in the 3D view or the angle; the views follow.";
   } else if (status == vtkSlicerReposeLogic::JobCancelled) {
     d->JobStatus = "Cancelled; nothing was written.";
   } else {
@@ -627,10 +686,28 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   d->NewGroupButton->setEnabled(live && selected > 0);
   d->NewPoseButton->setEnabled(d->Logic != nullptr);
   d->AngleSlider->setEnabled(pose != nullptr && !groups.isEmpty());
-  d->LiveStatusLabel->setText(live ? QString("Live: frame solved in %1 ms")
-                                         .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
-                              : pose ? "Build the cage and mesh to pose live."
-                                     : "No pose loaded.");
+  QString liveText = pose ? "Build the cage and mesh to pose live." : "No pose loaded.";
+  if (live) {
+    // What the export will show, predicted from the live frame's transfer mesh.
+    const vtkSlicerReposeLogic::LivePrediction p = d->Logic->GetLivePrediction();
+    liveText =
+        QString("Live: frame solved in %1 ms").arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1);
+    if (p.valid) {
+      liveText += QString("; body volume %1%2 % (predicted)")
+                      .arg(p.bodyChangePercent >= 0 ? "+" : "")
+                      .arg(p.bodyChangePercent, 0, 'f', 2);
+      // A part stretched by another it is tied to: tissue dragged along a contact.
+      if (!p.worstPart.empty() && std::fabs(p.worstPartChangePercent) > 1)
+        liveText +=
+            QString("; %1 %2%3 %%4")
+                .arg(QString::fromStdString(p.worstPart))
+                .arg(p.worstPartChangePercent >= 0 ? "+" : "")
+                .arg(p.worstPartChangePercent, 0, 'f', 1)
+                .arg(p.draggedBy.empty() ? QString()
+                                         : ", dragged by " + QString::fromStdString(p.draggedBy));
+    }
+  }
+  d->LiveStatusLabel->setText(liveText);
 
   // Jobs: progress, status, what can be pressed. A job someone else started (the module opening
   // a scene) is polled here too, so it commits and the views follow.

@@ -9,6 +9,7 @@
 #include "qSlicerReposeModuleWidget.h"
 #include "qSlicerReposeSliceView.h"
 #include "qSlicerReposeViewsWidget.h"
+#include "qSlicerReposeVolumeChangePlot.h"
 #include "vtkMRMLReposeParametersNode.h"
 #include "vtkMRMLReposePoseNode.h"
 #include "vtkMRMLReposeSegmentationNode.h"
@@ -31,6 +32,10 @@
 #include <vtkTransform.h>
 
 #include <QDir>
+#include <QJsonDocument>
+#include <QJsonObject>
+#include <QLabel>
+#include <QTableWidget>
 #include <QComboBox>
 #include <QMouseEvent>
 #include <QWheelEvent>
@@ -220,9 +225,42 @@ class qSlicerReposeViewsTest : public QObject {
     panel->waitForJobs();
     QVERIFY2(panel->jobStatusText().startsWith("Cancelled"), qPrintable(panel->jobStatusText()));
     QVERIFY(!QFileInfo::exists(out + "/posed_G.nii.gz"));
+    // Before it, the live frame's prediction of the body's volume is on the panel.
+    const vtkSlicerReposeLogic::LivePrediction predicted = logic->GetLivePrediction();
+    QVERIFY(predicted.valid);
+    auto* liveStatus = panel->findChild<QLabel*>("LiveStatusLabel");
+    QVERIFY2(liveStatus->text().contains("(predicted)"), qPrintable(liveStatus->text()));
+    auto* quality = panel->findChild<QTableWidget*>("QualityTable");
+    QVERIFY(quality && !quality->isVisibleTo(panel));
     QVERIFY2(panel->exportPose(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
     QVERIFY2(panel->jobStatusText().startsWith("Exported"), qPrintable(panel->jobStatusText()));
+    // The quality table after the export: one row per check of report.json, pass or FAIL as the
+    // report says, and the per-label plot.
+    QVERIFY(quality->isVisibleTo(panel));
+    QFile reportFile(out + "/report.json");
+    QVERIFY(reportFile.open(QIODevice::ReadOnly));
+    const QJsonObject checks =
+        QJsonDocument::fromJson(reportFile.readAll()).object()["quality"].toObject();
+    const std::map<QString, QString> rowOf = {{"Body volume", "body_within_half_percent"},
+                                              {"Worst label", "labels_within_1_percent"},
+                                              {"Bones rigid", "bones_rigid"},
+                                              {"Holes", "no_new_holes"},
+                                              {"Labels lost", "no_label_lost"}};
+    QCOMPARE(quality->rowCount(), int(checks.size()) - 1);  // all_met is the sum of the rows
+    for (int r = 0; r < quality->rowCount(); ++r) {
+      const QString check = quality->item(r, 0)->text();
+      QVERIFY2(rowOf.count(check), qPrintable(check));
+      const bool met = checks[rowOf.at(check)].toObject()["met"].toBool();
+      QCOMPARE(quality->item(r, 3)->text(), QString(met ? "pass" : "FAIL"));
+    }
+    const double exportedBody =
+        checks["body_within_half_percent"].toObject()["change_percent"].toDouble();
+    qInfo("body volume: %.3f %% predicted live, %.3f %% exported; %s", predicted.bodyChangePercent,
+          exportedBody, qPrintable(quality->item(0, 1)->text()));
+    QVERIFY(std::fabs(predicted.bodyChangePercent - exportedBody) < 0.5);  // the target
+    auto* plot = panel->findChild<qSlicerReposeVolumeChangePlot*>("VolumeChangePlot");
+    QVERIFY(plot && plot->isVisibleTo(panel) && plot->barCount() > 5);
     QVERIFY(window.grab().save(artifact("guide_4_exported.png")));
     for (const char* f : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd", "report.json"})
       QVERIFY2(QFileInfo::exists(out + "/" + f), f);
