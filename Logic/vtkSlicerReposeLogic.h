@@ -193,6 +193,27 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // itself for the new groups (a job).
   std::string AddPoseGroup(vtkMRMLReposePoseNode* pose, const std::vector<int>& cageVertices,
                            int bodyPart = 0);
+  // Posing by joint. The joints of the skeleton beside a body-part map (skeleton.json, as
+  // `repose rig` and `repose phantom` write it): each with its axes, its anatomical range per
+  // axis (repose::jointRangeDeg) and the body parts distal to it. Empty when there is none.
+  struct JointInfo {
+    std::string name;
+    std::vector<std::string> axes;
+    std::vector<std::pair<double, double>> rangesDeg;  // per axis
+    std::vector<std::string> distalParts;
+  };
+  static std::vector<JointInfo> GetJointsBeside(const std::string& partsPath);
+  // The pose's group that turns `joint` about its `axis` (repose::jointGroup: "<joint>.<axis>",
+  // the distal parts, pivot and axis by name), undoable; groups selecting any of those parts (by
+  // name or label: another joint of the same limb, a part's group) give way to it, with their
+  // keyframe entries, and a fixed "rest" group keeps the others. The rig is built again for it
+  // (StartBuildRig resolves the names). Returns the group's name, or "" with a message.
+  std::string SetPoseJoint(vtkMRMLReposePoseNode* pose, const std::string& partsPath,
+                           const std::string& joint, const std::string& axis, double angleDeg);
+  // The pose as a pose file, its joint groups in the named form ("axis": "elbow_left.flexion",
+  // "pivot": "elbow_left") so it poses any rigged body; written atomically. False with a message.
+  bool WritePoseFile(vtkMRMLReposePoseNode* pose, const std::string& partsPath,
+                     const std::string& path);
   // A limb separation added to the pose, undoable: parts by name or label of S, the region as
   // "box:x0,y0,z0,x1,y1,z1" or "sphere:x,y,z,r" (RAS mm). The rig built next makes it (an inset
   // cage between the parts, the transfer mesh cut along their border). False with a message.

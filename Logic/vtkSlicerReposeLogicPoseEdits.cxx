@@ -7,8 +7,10 @@
 #include "vtkMRMLReposeScene.h"
 #include "vtkSlicerReposeLogic.h"
 #include "vtkSlicerReposeLogicGuarded.h"
+#include "vtkSlicerReposeLogicRead.h"
 
 #include <repose/pose/Pose.h>
+#include <repose/pose/Skeleton.h>
 #include <repose/util/Error.h>
 
 #include <vtkMatrix4x4.h>
@@ -250,6 +252,102 @@ std::string vtkSlicerReposeLogic::AddPoseGroup(vtkMRMLReposePoseNode* node,
     pose.groups.push_back(group);
     this->RecordPoseEdit(node, repose::poseToJson(pose));
     return group.name;
+  });
+}
+
+std::vector<vtkSlicerReposeLogic::JointInfo> vtkSlicerReposeLogic::GetJointsBeside(
+    const std::string& partsPath) {
+  std::vector<JointInfo> out;
+  const std::string path = partsPath.empty() ? "" : repose::findSkeletonBeside(partsPath);
+  if (path.empty()) return out;
+  try {
+    for (const repose::SkeletonJoint& j : repose::readSkeleton(path).joints) {
+      JointInfo info;
+      info.name = j.name;
+      for (const auto& [axis, v] : j.axes) {
+        info.axes.push_back(axis);
+        info.rangesDeg.push_back(repose::jointRangeDeg(j.name, axis));
+      }
+      out.push_back(info);
+    }
+    const repose::Skeleton skeleton = repose::readSkeleton(path);
+    for (JointInfo& info : out) info.distalParts = repose::jointDistalParts(skeleton, info.name);
+  } catch (const repose::Error&) {
+    out.clear();  // a broken skeleton offers no joint (StartBuildRig names the problem)
+  }
+  return out;
+}
+
+namespace {
+repose::Skeleton skeletonBeside(const std::string& partsPath) {
+  const std::string path = partsPath.empty() ? "" : repose::findSkeletonBeside(partsPath);
+  if (path.empty())
+    throw repose::Error("no skeleton.json beside the body-part map " +
+                        (partsPath.empty() ? std::string("(none given)") : partsPath) +
+                        ": rig from the organ map first");
+  return repose::readSkeleton(path);
+}
+}  // namespace
+
+std::string vtkSlicerReposeLogic::SetPoseJoint(vtkMRMLReposePoseNode* node,
+                                               const std::string& partsPath,
+                                               const std::string& joint, const std::string& axis,
+                                               double angleDeg) {
+  return this->Guarded<std::string>("", [&]() -> std::string {
+    if (!node) throw repose::Error("no pose");
+    const repose::Skeleton skeleton = skeletonBeside(partsPath);
+    const repose::PoseGroup group = repose::jointGroup(skeleton, joint, axis, angleDeg);
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    // Parts by label: S's names, to tell which groups select the joint's parts.
+    const repose::LabelTable partLabels = vtkSlicerReposeLogicRead::ReadVolume(partsPath).labels();
+    const std::set<std::string> taken(group.select.partNames.begin(), group.select.partNames.end());
+    auto selectsTaken = [&](const repose::PoseGroup& g) {
+      for (const std::string& n : g.select.partNames)
+        if (taken.count(n)) return true;
+      for (const int label : g.select.parts)
+        if (const repose::Label* l = partLabels.find(label); l && taken.count(l->name)) return true;
+      return false;
+    };
+    std::vector<std::string> removed;
+    for (const repose::PoseGroup& g : pose.groups)
+      if (!g.select.rest && (g.name == group.name || selectsTaken(g))) removed.push_back(g.name);
+    auto isRemoved = [&](const std::string& name) {
+      return std::find(removed.begin(), removed.end(), name) != removed.end();
+    };
+    pose.groups.erase(std::remove_if(pose.groups.begin(), pose.groups.end(),
+                                     [&](const repose::PoseGroup& g) { return isRemoved(g.name); }),
+                      pose.groups.end());
+    for (repose::PoseKeyframe& k : pose.keyframes)
+      k.transforms.erase(std::remove_if(k.transforms.begin(), k.transforms.end(),
+                                        [&](const auto& e) { return isRemoved(e.first); }),
+                         k.transforms.end());
+    // Before the rest group, as the pose suite's files order them.
+    const auto rest = std::find_if(pose.groups.begin(), pose.groups.end(),
+                                   [](const repose::PoseGroup& g) { return g.select.rest; });
+    pose.groups.insert(rest, group);
+    if (std::none_of(pose.groups.begin(), pose.groups.end(),
+                     [](const repose::PoseGroup& g) { return g.select.rest; })) {
+      repose::PoseGroup still;
+      still.name = "rest";
+      still.select.rest = true;
+      still.fixed = true;
+      pose.groups.push_back(still);
+    }
+    this->RecordPoseEdit(node, repose::poseToJson(pose));
+    return group.name;
+  });
+}
+
+bool vtkSlicerReposeLogic::WritePoseFile(vtkMRMLReposePoseNode* node, const std::string& partsPath,
+                                         const std::string& path) {
+  return this->Guarded<bool>(false, [&]() -> bool {
+    if (!node) throw repose::Error("no pose");
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    if (const std::string skeleton = partsPath.empty() ? "" : repose::findSkeletonBeside(partsPath);
+        !skeleton.empty())
+      repose::nameJointGroups(pose, repose::readSkeleton(skeleton));
+    repose::writePoseFile(pose, path);
+    return true;
   });
 }
 

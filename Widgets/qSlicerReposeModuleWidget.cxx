@@ -20,7 +20,11 @@
 #include <QDir>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QComboBox>
+#include <QHBoxLayout>
 #include <QHeaderView>
+#include <QLabel>
+#include <QPushButton>
 #include <QScrollBar>
 #include <QTableWidget>
 #include <QSignalBlocker>
@@ -48,6 +52,20 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   // volume changes; hidden until then.
   QTableWidget* QualityTable = nullptr;
   qSlicerReposeVolumeChangePlot* VolumeChangePlot = nullptr;
+  // The Joint row: joint, axis, "Pose by joint", "Save pose..."; the joints of the skeleton
+  // beside the body-part map, read again when that path changes.
+  QComboBox* JointComboBox = nullptr;
+  QComboBox* JointAxisComboBox = nullptr;
+  QPushButton* PoseJointButton = nullptr;
+  QPushButton* SavePoseButton = nullptr;
+  std::vector<vtkSlicerReposeLogic::JointInfo> Joints;
+  std::string JointsFor;  // the body-part map path they were read for
+
+  const vtkSlicerReposeLogic::JointInfo* joint(const std::string& name) const {
+    for (const auto& j : this->Joints)
+      if (j.name == name) return &j;
+    return nullptr;
+  }
 
   void showQuality(vtkSlicerReposeLogic* logic) {
     const auto rows = logic->GetLastPoseQuality();
@@ -104,6 +122,48 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   connect(&d->JobTimer, &QTimer::timeout, this, &qSlicerReposeModuleWidget::onJobTimer);
   d->JobStatusLabel->setWordWrap(true);  // "Rigged (...)", errors: whole, not cut at the edge
   d->LiveStatusLabel->setWordWrap(true);
+  // The Joint row, under the Angle row of the Pose section.
+  d->JointComboBox = new QComboBox(d->PoseGroupBox);
+  d->JointComboBox->setObjectName("JointComboBox");
+  d->JointComboBox->setToolTip("A joint of the skeleton beside the body-part map");
+  d->JointAxisComboBox = new QComboBox(d->PoseGroupBox);
+  d->JointAxisComboBox->setObjectName("JointAxisComboBox");
+  d->PoseJointButton = new QPushButton("Pose by joint", d->PoseGroupBox);
+  d->PoseJointButton->setObjectName("PoseJointButton");
+  d->PoseJointButton->setToolTip(
+      "Turn the parts distal to this joint about this axis: a handle group, the cage and mesh "
+      "built for it, then the Angle slider moves the joint within its anatomical range");
+  d->SavePoseButton = new QPushButton("Save pose...", d->PoseGroupBox);
+  d->SavePoseButton->setObjectName("SavePoseButton");
+  d->SavePoseButton->setToolTip(
+      "Write the pose as a pose file (joints by name: it poses any "
+      "rigged body)");
+  {
+    const int row = d->poseLayout->rowCount();
+    d->poseLayout->addWidget(new QLabel("Joint:", d->PoseGroupBox), row, 0);
+    auto* pick = new QHBoxLayout;
+    pick->addWidget(d->JointComboBox, 1);
+    pick->addWidget(d->JointAxisComboBox, 1);
+    d->poseLayout->addLayout(pick, row, 1, 1, d->poseLayout->columnCount() - 1);
+    auto* buttons = new QHBoxLayout;
+    buttons->addWidget(d->PoseJointButton);
+    buttons->addWidget(d->SavePoseButton);
+    d->poseLayout->addLayout(buttons, row + 1, 1, 1, d->poseLayout->columnCount() - 1);
+  }
+  connect(d->JointComboBox, &QComboBox::currentTextChanged, this, [d](const QString& name) {
+    const QSignalBlocker block(d->JointAxisComboBox);
+    d->JointAxisComboBox->clear();
+    if (const auto* j = d->joint(name.toStdString()))
+      for (const std::string& a : j->axes) d->JointAxisComboBox->addItem(QString::fromStdString(a));
+  });
+  connect(d->PoseJointButton, &QPushButton::clicked, this, [this, d] {
+    this->poseByJoint(d->JointComboBox->currentText(), d->JointAxisComboBox->currentText());
+  });
+  connect(d->SavePoseButton, &QPushButton::clicked, this, [this] {
+    const QString path =
+        QFileDialog::getSaveFileName(this, "Save the pose", QString(), "Pose files (*.pose.json)");
+    if (!path.isEmpty()) this->savePose(path);
+  });
   d->QualityTable = new QTableWidget(0, 4, d->OutputGroupBox);
   d->QualityTable->setObjectName("QualityTable");
   d->QualityTable->setHorizontalHeaderLabels({"Check", "Measured", "Target", "Result"});
@@ -346,6 +406,49 @@ bool qSlicerReposeModuleWidget::rigFromOrganMap() {
       "Rigging from the organ map into " + folder + "...");
   this->updateWidgetFromMRML();
   return started;
+}
+
+QStringList qSlicerReposeModuleWidget::joints() const {
+  Q_D(const qSlicerReposeModuleWidget);
+  QStringList names;
+  for (const auto& j : d->Joints) names << QString::fromStdString(j.name);
+  return names;
+}
+
+bool qSlicerReposeModuleWidget::poseByJoint(const QString& joint, const QString& axis) {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return false;
+  auto fail = [&](const QString& why) {
+    d->JobStatus = "Error: " + why;
+    this->updateWidgetFromMRML();
+    return false;
+  };
+  if (joint.isEmpty() || axis.isEmpty())
+    return fail("choose a joint and an axis (the skeleton beside the body-part map)");
+  if (!this->activePose() && !this->newPose())
+    return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
+  const std::string group =
+      d->Logic->SetPoseJoint(this->activePose(), d->ParameterNode->GetBodyPartMapPath(),
+                             joint.toStdString(), axis.toStdString(), 0.0);
+  if (group.empty()) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
+  d->ParameterNode->SetActiveGroup(group);
+  // A new group changes the rig (its separations, whole pieces): built again, then live.
+  return this->buildRig();
+}
+
+bool qSlicerReposeModuleWidget::savePose(const QString& path) {
+  Q_D(qSlicerReposeModuleWidget);
+  if (!d->Logic || !d->ParameterNode) return false;
+  const bool ok =
+      this->activePose() &&
+      d->Logic->WritePoseFile(this->activePose(), d->ParameterNode->GetBodyPartMapPath(),
+                              path.toStdString());
+  d->JobStatus =
+      ok ? "Pose saved to " + path
+         : "Error: " + (this->activePose() ? QString::fromStdString(d->Logic->GetLastErrorMessage())
+                                           : QString("no pose to save"));
+  this->updateWidgetFromMRML();
+  return ok;
 }
 
 bool qSlicerReposeModuleWidget::exportPose() {
@@ -627,6 +730,30 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
     d->GroupComboBox->addItems(groups);
   }
   if (node) d->GroupComboBox->setCurrentText(QString::fromStdString(node->GetActiveGroup()));
+  // The Joint row: the skeleton's joints (read again when the body-part map changes).
+  const std::string partsPath = node ? node->GetBodyPartMapPath() : "";
+  if (partsPath != d->JointsFor) {
+    d->JointsFor = partsPath;
+    d->Joints = vtkSlicerReposeLogic::GetJointsBeside(partsPath);
+    const QString was = d->JointComboBox->currentText();
+    d->JointComboBox->clear();  // its signal fills the axes of the first joint
+    for (const auto& j : d->Joints) d->JointComboBox->addItem(QString::fromStdString(j.name));
+    if (d->JointComboBox->findText(was) >= 0) d->JointComboBox->setCurrentText(was);
+  }
+  d->JointComboBox->setEnabled(!d->Joints.empty());
+  d->JointAxisComboBox->setEnabled(!d->Joints.empty());
+  d->SavePoseButton->setEnabled(pose != nullptr);
+  // The Angle slider's range: the active joint group's anatomical range, else a full turn.
+  std::pair<double, double> range{-180, 180};
+  if (node) {
+    const std::string active = node->GetActiveGroup();
+    const std::size_t dot = active.find('.');
+    if (const auto* j = dot == std::string::npos ? nullptr : d->joint(active.substr(0, dot)))
+      for (std::size_t a = 0; a < j->axes.size(); ++a)
+        if (j->axes[a] == active.substr(dot + 1)) range = j->rangesDeg[a];
+  }
+  d->AngleSlider->setRange(int(range.first), int(range.second));
+  d->AngleSpinBox->setRange(int(range.first), int(range.second));
   const int angle = int(std::lround(this->activeGroupAngle()));
   if (!d->AngleSlider->isSliderDown()) d->AngleSlider->setValue(angle);
   d->AngleSpinBox->setValue(angle);
@@ -718,6 +845,7 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
     d->JobTimer.start();
   }
   d->BuildRigButton->setEnabled(ready && !running);
+  d->PoseJointButton->setEnabled(ready && !running && !d->Joints.empty());
   d->RigFromOrganMapButton->setEnabled(
       d->ParameterNode && !d->ParameterNode->GetInputSegmentationPath().empty() && !running);
   d->RefineMeshButton->setEnabled(live && !running);

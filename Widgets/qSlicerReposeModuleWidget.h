@@ -52,6 +52,16 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   void waitForJobs();
   QString jobStatusText() const;
 
+  // Posing by joint (the Pose section's Joint row): the joint's group (its distal parts, about its
+  // named axis through it) made the active group of the active pose (a new pose when there is
+  // none), and the cage and mesh built for it; then the Angle slider is that joint's slider, in
+  // its anatomical range. False with the reason in jobStatusText().
+  bool poseByJoint(const QString& joint, const QString& axis);
+  // The joints offered (of the skeleton beside the body-part map).
+  QStringList joints() const;
+  // The active pose as a pose file, joint groups named (it poses any rigged body).
+  bool savePose(const QString& path);
+
   // The rotation controls: the active group turned to `angleDeg` about its own axis and pivot.
   bool setActiveGroupAngle(double angleDeg);
   double activeGroupAngle() const;

@@ -32,6 +32,7 @@
 #include <vtkTransform.h>
 
 #include <QDir>
+#include <QJsonArray>
 #include <QJsonDocument>
 #include <QJsonObject>
 #include <QLabel>
@@ -385,6 +386,71 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(parts.labels().find(repose::kPartHandLeft));
     QCOMPARE(QString::fromStdString(parts.labels().find(repose::kPartHandLeft)->name),
              QString("hand_left"));
+  }
+
+  // Posing by joint: the left shoulder's abduction picked in the Joint row builds its group (the
+  // arm's parts about the joint's named axis) and the rig; its slider, in the joint's anatomical
+  // range, dragged to 90 degrees gives the same posed volume, voxel for voxel, as the pose suite's
+  // arm_raise90.pose.json; the pose saved names the joint, so it poses any rigged body.
+  void posingByJointEqualsThePoseFile() {
+    Session session(8);
+    QVERIFY(session.show());
+    vtkSlicerReposeLogic* logic = session.logic;
+    vtkMRMLReposeParametersNode* node = session.node;
+    qSlicerReposeModuleWidget* panel = session.panel;
+    QVERIFY(panel->setInputPath(session.G));
+    node->SetBodyPartMapPath(session.S.toStdString());
+    QVERIFY2(panel->joints().contains("shoulder_left"), qPrintable(panel->joints().join(",")));
+    auto* joint = panel->findChild<QComboBox*>("JointComboBox");
+    auto* axis = panel->findChild<QComboBox*>("JointAxisComboBox");
+    QVERIFY(joint && axis);
+    joint->setCurrentText("shoulder_left");
+    QVERIFY(axis->findText("abduction") >= 0 && axis->findText("flexion") >= 0);
+    axis->setCurrentText("abduction");
+    panel->findChild<QPushButton*>("PoseJointButton")->click();
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() && logic->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
+    QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("shoulder_left.abduction"));
+    auto* slider = panel->findChild<QSlider*>("AngleSlider");
+    QCOMPARE(slider->minimum(), -30);
+    QCOMPARE(slider->maximum(), 180);
+    slider->setSliderDown(true);
+    for (int angle = 10; angle <= 90; angle += 10) slider->setValue(angle);
+    slider->setSliderDown(false);
+    QCOMPARE(panel->activeGroupAngle(), 90.0);
+    QVERIFY(session.window.grab().save(artifact("guide_joint_slider.png")));
+
+    const QString byJoint = session.dir.filePath("by_joint"),
+                  byFile = session.dir.filePath("by_file");
+    node->SetOutputFolder(byJoint.toStdString());
+    QVERIFY2(panel->exportPose(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(panel->jobStatusText().startsWith("Exported"), qPrintable(panel->jobStatusText()));
+    // Saved, the pose names the joint and its axis, not this body's numbers.
+    const QString saved = session.dir.filePath("joint.pose.json");
+    QVERIFY2(panel->savePose(saved), qPrintable(panel->jobStatusText()));
+    QFile file(saved);
+    QVERIFY(file.open(QIODevice::ReadOnly));
+    const QJsonObject group =
+        QJsonDocument::fromJson(file.readAll()).object()["groups"].toArray()[0].toObject();
+    QCOMPARE(group["rotation"].toObject()["axis"].toString(), QString("shoulder_left.abduction"));
+    QCOMPARE(group["rotation"].toObject()["pivot"].toString(), QString("shoulder_left"));
+    QCOMPARE(group["rotation"].toObject()["angle_deg"].toDouble(), 90.0);
+
+    // The pose suite's file, built and exported the same way: the same posed labels.
+    QVERIFY(panel->setPosePath(QString(REPOSE_SOURCE_DIR) + "/bench/poses/arm_raise90.pose.json"));
+    QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    node->SetOutputFolder(byFile.toStdString());
+    QVERIFY2(panel->exportPose(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(panel->jobStatusText().startsWith("Exported"), qPrintable(panel->jobStatusText()));
+    const repose::Volume a = repose::readVolume((byJoint + "/posed_G.nii.gz").toStdString());
+    const repose::Volume b = repose::readVolume((byFile + "/posed_G.nii.gz").toStdString());
+    QVERIFY(a.dims() == b.dims());
+    QVERIFY(a.geometry().ijkToRas.isApprox(b.geometry().ijkToRas, 1e-9));
+    QVERIFY2(a.bytes() == b.bytes(), "the joint slider's frame differs from the pose file's");
   }
 
   // No pose file: Build makes a new pose (everything fixed) and poses it live. In the 3D view,

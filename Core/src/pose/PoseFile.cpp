@@ -412,4 +412,85 @@ void writePoseFile(const Pose& pose, const std::string& path) {
   writeTextFileAtomically(path, poseToJson(pose));
 }
 
+std::vector<std::string> jointDistalParts(const Skeleton& skeleton, const std::string& joint) {
+  const SkeletonJoint* j = skeleton.find(joint);
+  if (!j || j->parts[1].empty()) return {};
+  std::vector<std::string> parts{j->parts[1]};
+  // Joints below: those whose chain of parents reaches `joint` (the skeleton is a tree).
+  for (const SkeletonJoint& other : skeleton.joints) {
+    if (other.name == joint || other.parts[1].empty()) continue;
+    for (const SkeletonJoint* up = skeleton.find(other.parent); up; up = skeleton.find(up->parent))
+      if (up->name == joint) {
+        if (std::find(parts.begin(), parts.end(), other.parts[1]) == parts.end())
+          parts.push_back(other.parts[1]);
+        break;
+      }
+  }
+  return parts;
+}
+
+PoseGroup jointGroup(const Skeleton& skeleton, const std::string& joint, const std::string& axis,
+                     double angleDeg) {
+  const std::string where = "joint group " + joint + "." + axis;
+  skeleton.axis(joint + "." + axis, where);  // throws for an unknown joint or axis
+  PoseGroup g;
+  g.name = joint + "." + axis;
+  g.select.partNames = jointDistalParts(skeleton, joint);
+  if (g.select.partNames.empty())
+    throw Error(skeleton.source + ": joint " + joint +
+                " names no distal body part (\"parts\" in skeleton.json): cannot pose by it");
+  g.transform.pivotJoint = joint;
+  g.transform.axisName = joint + "." + axis;
+  g.transform.angleDeg = angleDeg;
+  return g;
+}
+
+std::pair<double, double> jointRangeDeg(const std::string& joint, const std::string& axis) {
+  // Active ranges of motion of a healthy adult (clinical goniometry), rounded out; the sign is
+  // the skeleton's (docs/POSES.md: positive flexion flexes, positive abduction moves away from
+  // the midline).
+  struct Range {
+    const char* joint;
+    const char* axis;
+    double lo, hi;
+  };
+  static constexpr Range kRanges[] = {
+      {"shoulder", "flexion", -60, 180}, {"shoulder", "abduction", -30, 180},
+      {"shoulder", "rotation", -90, 90}, {"elbow", "flexion", 0, 150},
+      {"elbow", "rotation", -90, 90},    {"wrist", "flexion", -70, 80},
+      {"wrist", "rotation", -90, 90},    {"hip", "flexion", -30, 120},
+      {"hip", "abduction", -30, 45},     {"hip", "rotation", -45, 45},
+      {"knee", "flexion", 0, 150},       {"knee", "rotation", -30, 30},
+      {"ankle", "flexion", -50, 20},     {"ankle", "rotation", -30, 30},
+      {"neck", "flexion", -60, 50},      {"neck", "lateral", -45, 45},
+      {"neck", "rotation", -80, 80}};
+  const std::string kind = joint.substr(0, joint.find('_'));
+  for (const Range& r : kRanges)
+    if (kind == r.joint && axis == r.axis) return {r.lo, r.hi};
+  return {-180, 180};
+}
+
+void nameJointGroups(Pose& pose, const Skeleton& skeleton) {
+  auto named = [&](const std::string& group) -> std::string {
+    const std::size_t dot = group.find('.');
+    if (dot == std::string::npos) return "";
+    const SkeletonJoint* j = skeleton.find(group.substr(0, dot));
+    if (!j) return "";
+    const std::string axis = group.substr(dot + 1);
+    for (const auto& [name, v] : j->axes)
+      if (name == axis) return j->name;
+    return "";
+  };
+  auto name = [&](PoseTransform& t, const std::string& group) {
+    const std::string joint = named(group);
+    if (joint.empty()) return;
+    t.pivotJoint = joint;
+    t.axisName = group;
+  };
+  for (PoseGroup& g : pose.groups)
+    if (!g.fixed) name(g.transform, g.name);
+  for (PoseKeyframe& k : pose.keyframes)
+    for (auto& [group, t] : k.transforms) name(t, group);
+}
+
 }  // namespace repose

@@ -168,3 +168,48 @@ TEST(PoseFile, GroupsResolveToCageVerticesAndBodyParts) {
                   .norm(),
               1e-9);
 }
+
+// Posing by joint on the phantom's skeleton: a joint's group selects the parts distal to it,
+// turns about its named axis through it, and resolves to the skeleton's numbers; named again, the
+// pose file is the suite's named form; an axis the joint does not have is refused by name.
+TEST(PoseFile, JointGroupsSelectTheDistalPartsAndNameTheirJointWhenWritten) {
+  repose::PhantomOptions po;
+  po.voxelMm = 8;
+  const repose::Skeleton skeleton =
+      repose::parseSkeleton(repose::Phantom(po).skeletonJson(), "skeleton.json");
+  using Parts = std::vector<std::string>;
+  EXPECT_EQ(repose::jointDistalParts(skeleton, "shoulder_left"),
+            (Parts{"upper_arm_left", "forearm_left", "hand_left"}));
+  EXPECT_EQ(repose::jointDistalParts(skeleton, "elbow_left"), (Parts{"forearm_left", "hand_left"}));
+  EXPECT_EQ(repose::jointDistalParts(skeleton, "knee_right"), (Parts{"shank_right", "foot_right"}));
+  EXPECT_EQ(repose::jointDistalParts(skeleton, "ankle_left"), (Parts{"foot_left"}));
+  EXPECT_TRUE(repose::jointDistalParts(skeleton, "tail").empty());
+
+  repose::Pose pose;
+  pose.name = "by joint";
+  pose.groups.push_back(repose::jointGroup(skeleton, "elbow_left", "flexion", 90));
+  repose::PoseGroup rest;
+  rest.name = "rest";
+  rest.select.rest = true;
+  rest.fixed = true;
+  pose.groups.push_back(rest);
+  EXPECT_EQ(pose.groups[0].name, "elbow_left.flexion");
+  EXPECT_TRUE(repose::poseNamesJoints(pose));
+  repose::Pose resolved = pose;
+  repose::resolvePoseJoints(resolved, skeleton);
+  const repose::SkeletonJoint* elbow = skeleton.find("elbow_left");
+  ASSERT_NE(elbow, nullptr);
+  EXPECT_TRUE(resolved.groups[0].transform.pivot.isApprox(elbow->centre));
+  EXPECT_TRUE(
+      resolved.groups[0].transform.axis.isApprox(skeleton.axis("elbow_left.flexion", "test")));
+  EXPECT_FALSE(repose::poseNamesJoints(resolved));
+  // Named again: the same text as the pose built by name.
+  repose::nameJointGroups(resolved, skeleton);
+  EXPECT_EQ(repose::poseToJson(resolved), repose::poseToJson(pose));
+
+  EXPECT_THROW(repose::jointGroup(skeleton, "elbow_left", "abduction", 10), repose::Error);
+  EXPECT_THROW(repose::jointGroup(skeleton, "tail", "flexion", 10), repose::Error);
+  EXPECT_EQ(repose::jointRangeDeg("elbow_left", "flexion"), std::make_pair(0.0, 150.0));
+  EXPECT_EQ(repose::jointRangeDeg("shoulder_right", "abduction"), std::make_pair(-30.0, 180.0));
+  EXPECT_EQ(repose::jointRangeDeg("tail", "wag"), std::make_pair(-180.0, 180.0));
+}

@@ -126,8 +126,11 @@ TEST(RandomPoseProperties, EveryFrameIsFiniteLabelledOnceAndFullyReported) {
       EXPECT_EQ(row["voxels_after"].get<std::int64_t>(), organVoxels[value]) << "label " << value;
       reportedVoxels += row["voxels_after"].get<std::int64_t>();
     }
-    for (const int value : organValues)
-      if (value != 0) EXPECT_TRUE(reported.count(value)) << "label " << value << " unreported";
+    for (const int value : organValues) {
+      if (value != 0) {
+        EXPECT_TRUE(reported.count(value)) << "label " << value << " unreported";
+      }
+    }
     EXPECT_EQ(reportedVoxels, body);
     const double bodyChange = report["body"]["volume_change_percent"].get<double>();
     ASSERT_TRUE(std::isfinite(bodyChange));

@@ -78,6 +78,24 @@ bool poseNamesJoints(const Pose& pose);
 // joint or axis the skeleton lacks.
 void resolvePoseJoints(Pose& pose, const Skeleton& skeleton);
 
+// Posing by joint. The group that turns `joint` of the skeleton about its named axis: named
+// "<joint>.<axis>" (e.g. "elbow_left.flexion"), selecting the body parts distal to the joint (its
+// own distal part and those of every joint below it: the forearm and the hand for the elbow), its
+// pivot and axis the joint's by name (resolvePoseJoints gives the numbers). Throws repose::Error
+// naming the joint or axis the skeleton lacks, or a joint whose distal part is not known.
+PoseGroup jointGroup(const Skeleton& skeleton, const std::string& joint, const std::string& axis,
+                     double angleDeg);
+// The body parts distal to a joint (names of S, proximal first); empty when not known.
+std::vector<std::string> jointDistalParts(const Skeleton& skeleton, const std::string& joint);
+// The anatomical range of motion of a joint about one of its axes, degrees (a healthy adult's,
+// as clinical goniometry tables give them, rounded out), for the workbench's joint sliders:
+// e.g. elbow flexion 0..150, shoulder abduction -30..180; -180..180 for an unknown pair.
+std::pair<double, double> jointRangeDeg(const std::string& joint, const std::string& axis);
+// The inverse of resolving for joint groups: every group named "<joint>.<axis>" of the skeleton
+// gets its pivot and axis back as names (in its base transform and keyframes), so the pose file
+// written poses any rigged body.
+void nameJointGroups(Pose& pose, const Skeleton& skeleton);
+
 // Whether two poses have the same handle groups (names, fixed, selections) in the same order:
 // a rig prepared for one solves frames of the other.
 bool sameHandleGroups(const Pose& a, const Pose& b);
