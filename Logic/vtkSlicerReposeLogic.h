@@ -206,8 +206,9 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // The pose's group that turns `joint` about its `axis` (repose::jointGroup: "<joint>.<axis>",
   // the distal parts, pivot and axis by name), undoable; groups selecting any of those parts (by
   // name or label: another joint of the same limb, a part's group) give way to it, with their
-  // keyframe entries, and a fixed "rest" group keeps the others. The rig is built again for it
-  // (StartBuildRig resolves the names). Returns the group's name, or "" with a message.
+  // keyframe entries, and a fixed "rest" group keeps the others. Live posing of this pose stops:
+  // the rig must be built again for it (StartBuildRig resolves the names and cuts the joint's
+  // contacts). Returns the group's name, or "" with a message.
   std::string SetPoseJoint(vtkMRMLReposePoseNode* pose, const std::string& partsPath,
                            const std::string& joint, const std::string& axis, double angleDeg);
   // The pose as a pose file, its joint groups in the named form ("axis": "elbow_left.flexion",

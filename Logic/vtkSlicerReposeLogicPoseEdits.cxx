@@ -333,6 +333,10 @@ std::string vtkSlicerReposeLogic::SetPoseJoint(vtkMRMLReposePoseNode* node,
       still.fixed = true;
       pose.groups.push_back(still);
     }
+    // The joint's group changes the rig itself (its contacts are cut in the cage and the mesh),
+    // which re-preparing the live pose on the old cage would not do: posing stops until it is
+    // built again (StartBuildRig).
+    if (this->GetLivePose() == node) this->StopLivePose();
     this->RecordPoseEdit(node, repose::poseToJson(pose));
     return group.name;
   });

@@ -10,7 +10,10 @@ REPOSE_TEST_PHANTOM_MM=4 xvfb-run -a -s "-screen 0 1600x1200x24" \
   "$BUILD_DIR/bin/qSlicerReposeViewsTest" posingWithTheCageInTheThreeDView
 REPOSE_TEST_PHANTOM_MM=4 xvfb-run -a -s "-screen 0 1600x1200x24" \
   "$BUILD_DIR/bin/qSlicerReposeViewsTest" posingThroughThePanelUpdatesTheViews
-for f in guide_1_rig_built guide_2_part_selected guide_3_hand_moved guide_4_exported; do
+REPOSE_TEST_PHANTOM_MM=4 xvfb-run -a -s "-screen 0 1600x1200x24" \
+  "$BUILD_DIR/bin/qSlicerReposeViewsTest" ownSegmentationShowsNamedColouredLabelsAndTheProbe
+for f in guide_1_rig_built guide_2_part_selected guide_3_hand_moved guide_4_exported \
+  guide_own_1_open guide_own_2_rigged guide_own_3_probe guide_own_4_joint guide_own_5_exported; do
   cp "$BUILD_DIR/Testing/Artifacts/$f.png" "$DOCS/$f.png"
 done
 if [ -f "$BUILD_DIR/demo/workbench_elbow90.png" ]; then

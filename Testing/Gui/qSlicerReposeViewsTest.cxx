@@ -284,13 +284,15 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(colours(shot, shot.rect()) > 30);
   }
 
-  // A user's own segmentation with no colour table (ICRP 110 IDs, arms resting): the labels are
-  // named by their convention; "Rig from organ map" makes S, the joints and the tissue table (a
-  // job) and they become the body parts; built, the views draw the labels in distinct colours,
-  // and the data probe under them names the label at the pointer, posed and input. An S whose
-  // file names no part gets the rig's part names.
+  // A user's own segmentation with no colour table (ICRP 110 IDs, arms resting), step by step as
+  // docs/USER_GUIDE.md walks through it (a picture per step): open it, and the labels are named
+  // by their convention; "Rig from organ map" makes S, the joints and the tissue table (a job)
+  // and they become the body parts; built, the views draw the labels in distinct colours, and
+  // the data probe under them names the label at the pointer, posed and input; the left shoulder
+  // posed by joint, the predicted body volume on the panel; exported, the quality table. An S
+  // whose file names no part gets the rig's part names.
   void ownSegmentationShowsNamedColouredLabelsAndTheProbe() {
-    Session session(8, true);
+    Session session(phantomVoxelMm(), true);
     QVERIFY(session.show());
     vtkSlicerReposeLogic* logic = session.logic;
     qSlicerReposeModuleWidget* panel = session.panel;
@@ -298,6 +300,7 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(panel->setInputPath(session.G));
     QVERIFY2(panel->inputInfoText().contains("named from the icrp110"),
              qPrintable(panel->inputInfoText()));
+    QVERIFY(session.window.grab().save(artifact("guide_own_1_open.png")));
     // Rig from the panel: written beside G (no output folder set), then G's body parts.
     const QString rig = session.dir.filePath("G_rig");
     QCOMPARE(panel->rigFolder(), rig);
@@ -311,7 +314,7 @@ class qSlicerReposeViewsTest : public QObject {
     for (const char* f : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
       QVERIFY2(QFileInfo::exists(rig + "/" + f), f);
     QCOMPARE(QString::fromStdString(session.node->GetBodyPartMapPath()), rig + "/S.nii.gz");
-    QVERIFY(session.window.grab().save(artifact("guide_own_segmentation_rigged.png")));
+    QVERIFY(session.window.grab().save(artifact("guide_own_2_rigged.png")));
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
     QVERIFY2(logic->GetLivePose(), qPrintable(panel->jobStatusText()));
@@ -372,11 +375,48 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY2(text.contains(
                  QString("%1 %2").arg(at.y() < 0 ? 'P' : 'A').arg(std::fabs(at.y()), 0, 'f', 1)),
              qPrintable(text));
-    QVERIFY(session.window.grab().save(artifact("guide_own_segmentation_probe.png")));
+    QVERIFY(session.window.grab().save(artifact("guide_own_3_probe.png")));
     // Off the slice: the line empties.
     QEvent leave(QEvent::Leave);
     QApplication::sendEvent(coronal, &leave);
     QVERIFY(views->probeText().isEmpty());
+
+    // The left arm raised sideways by its shoulder's slider: the arm is cut from the trunk it
+    // rests on, and the panel predicts the body's volume as it goes.
+    QVERIFY(panel->joints().contains("shoulder_left"));
+    panel->findChild<QComboBox*>("JointComboBox")->setCurrentText("shoulder_left");
+    panel->findChild<QComboBox*>("JointAxisComboBox")->setCurrentText("abduction");
+    // Built again for the joint's group (not re-prepared on the rest pose's cage, which has no
+    // cut between the arm and the trunk it rests on).
+    QVERIFY2(panel->poseByJoint("shoulder_left", "abduction"), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    auto* slider = panel->findChild<QSlider*>("AngleSlider");
+    slider->setSliderDown(true);
+    for (int angle = 15; angle <= 90; angle += 15) slider->setValue(angle);
+    slider->setSliderDown(false);
+    QCOMPARE(panel->activeGroupAngle(), 90.0);
+    views->setSlicePosition(1, at.y());
+    QVERIFY(panel->findChild<QLabel*>("LiveStatusLabel")->text().contains("(predicted)"));
+    QVERIFY(session.window.grab().save(artifact("guide_own_4_joint.png")));
+    // Exported: the quality table and the plot.
+    session.node->SetOutputFolder(session.dir.filePath("out").toStdString());
+    QVERIFY2(panel->exportPose(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(panel->jobStatusText().startsWith("Exported"), qPrintable(panel->jobStatusText()));
+    auto* quality = panel->findChild<QTableWidget*>("QualityTable");
+    QVERIFY(quality->isVisibleTo(panel) && quality->rowCount() >= 4);
+    qInfo("exported: %s", qPrintable(panel->jobStatusText()));
+    // The arm cut free: the body keeps its volume (as `repose pose` poses these files), and the
+    // live prediction said so.
+    QCOMPARE(quality->item(0, 0)->text(), QString("Body volume"));
+    QVERIFY2(quality->item(0, 3)->text() == "pass", qPrintable(quality->item(0, 1)->text()));
+    const double exportedBody = quality->item(0, 1)->text().split(' ').front().toDouble();
+    QVERIFY2(std::fabs(logic->GetLivePrediction().bodyChangePercent - exportedBody) < 0.5,
+             qPrintable(QString("%1 predicted, %2 exported")
+                            .arg(logic->GetLivePrediction().bodyChangePercent)
+                            .arg(exportedBody)));
+    QVERIFY(session.window.grab().save(artifact("guide_own_5_exported.png")));
     // The phantom's own S, its part names dropped from the file: named as the rig names them.
     vtkMRMLReposeSegmentationNode* unnamedParts =
         logic->AddSegmentation(session.G.toStdString(), session.S.toStdString());
