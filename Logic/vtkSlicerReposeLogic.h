@@ -281,6 +281,10 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
     double worstPartChangePercent = 0;
   };
   LivePrediction GetLivePrediction();
+  // A drag is in progress (between BeginPoseInteraction and EndPoseInteraction): the panel then
+  // leaves the prediction (about 20 ms at the seed's 41K vertices, ReposeLiveBench's
+  // "prediction") to the drag's end.
+  bool IsPoseInteractionActive() const { return this->History.IsInteracting(); }
   // The data probe's input side: the live segmentation's G (at rest, as read) at a RAS point, the
   // nearest voxel's label; -1 outside its grid or without a live pose. And a label's display name
   // (the file's, else the tissue table's or the label convention's, else its number).

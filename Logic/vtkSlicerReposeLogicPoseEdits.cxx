@@ -72,6 +72,7 @@ void vtkSlicerReposeLogic::BeginPoseInteraction() {
 
 void vtkSlicerReposeLogic::EndPoseInteraction() {
   this->History.EndInteraction();
+  this->Modified();  // the panel shows what it leaves out during a drag (the prediction)
 }
 
 bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,

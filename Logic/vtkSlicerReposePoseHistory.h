@@ -20,6 +20,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposePoseHistory {
   bool Record(const std::string& nodeID, const std::string& before, const std::string& after);
   void BeginInteraction();
   void EndInteraction();
+  bool IsInteracting() const { return this->Interacting; }
   // The step to undo (its `before` is to be applied), moved to the redo side; none when empty.
   std::optional<Step> Undo();
   // The step to redo (its `after` is to be applied), moved back; none when empty.

@@ -815,8 +815,11 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   d->AngleSlider->setEnabled(pose != nullptr && !groups.isEmpty());
   QString liveText = pose ? "Build the cage and mesh to pose live." : "No pose loaded.";
   if (live) {
-    // What the export will show, predicted from the live frame's transfer mesh.
-    const vtkSlicerReposeLogic::LivePrediction p = d->Logic->GetLivePrediction();
+    // What the export will show, predicted from the live frame's transfer mesh: after a drag,
+    // not during it (it costs about as much as the frame and the three slices together).
+    const bool dragging = d->AngleSlider->isSliderDown() || d->Logic->IsPoseInteractionActive();
+    const vtkSlicerReposeLogic::LivePrediction p =
+        dragging ? vtkSlicerReposeLogic::LivePrediction{} : d->Logic->GetLivePrediction();
     liveText =
         QString("Live: frame solved in %1 ms").arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1);
     if (p.valid) {

@@ -3,7 +3,9 @@
 // edit, then the frame it triggers: the posed cage, Green coordinates, the rigidity solves),
 // then the three 512-pixel slices the views show (axial, coronal, sagittal through the posed
 // body's centre). Prints the median and 99th percentile of each stage and of the whole event as
-// JSON. Single-shot: run by bench/run_bench.py (`make bench`).
+// JSON; also the cost of the body's volume change the frame predicts ("prediction", which the
+// panel shows when a drag ends, so it is not in "event"). Single-shot: run by bench/run_bench.py
+// (`make bench`).
 //
 //   ReposeLiveBench SCENE_DIR [--events 200] [--pixels 512] [--group NAME] [--degrees 90]
 //                   [--pose FILE]
@@ -143,6 +145,12 @@ int main(int argc, char** argv) {
     stages["edit_outside_frame"].push_back(edit - frame);
     stages["slices"].push_back(slices);
     stages["event"].push_back(ms(t0, Clock::now()));
+    // Not part of a drag's event: the panel's predicted body volume change, which the workbench
+    // computes when a drag ends (vtkSlicerReposeLogic::IsPoseInteractionActive); timed here on
+    // every frame for its cost.
+    const auto p0 = Clock::now();
+    if (!logic->GetLivePrediction().valid) fail("prediction: " + logic->GetLastErrorMessage());
+    stages["prediction"].push_back(ms(p0, Clock::now()));
   }
   logic->EndPoseInteraction();
 
