@@ -111,6 +111,10 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // parameter node's body-part map is folder/S.nii.gz and the tissue table folder/tissues.csv;
   // GetLastRigSummary says what was found.
   bool StartRigFromOrganMap(const std::string& labelsPath, const std::string& folder);
+  // Where the panel rigs to: `outputFolder`/rig when an output folder is set, else
+  // <G's folder>/<G's name without extension>_rig beside the segmentation ("" without a G).
+  static std::string DefaultRigFolder(const std::string& labelsPath,
+                                      const std::string& outputFolder);
   const std::string& GetLastRigSummary() const { return this->LastRigSummary; }
   // Cage and transfer mesh of the segmentation's S (separations from the pose, settings from the
   // parameter node when one is set), referenced by the pose node.

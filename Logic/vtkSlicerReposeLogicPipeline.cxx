@@ -252,6 +252,13 @@ std::shared_ptr<const repose::PoseJob> vtkSlicerReposeLogic::PoseJobFor(
   return std::make_shared<const repose::PoseJob>(pose, G, S, std::move(request));
 }
 
+std::string vtkSlicerReposeLogic::DefaultRigFolder(const std::string& labelsPath,
+                                                   const std::string& outputFolder) {
+  if (!outputFolder.empty()) return (fs::path(outputFolder) / "rig").string();
+  if (labelsPath.empty()) return "";
+  return (fs::path(labelsPath).parent_path() / (stemOf(labelsPath) + "_rig")).string();
+}
+
 bool vtkSlicerReposeLogic::StartRigFromOrganMap(const std::string& labelsPath,
                                                 const std::string& folder) {
   return this->Guarded<bool>(false, [&]() -> bool {

@@ -17,7 +17,6 @@
 #include <vtkSmartPointer.h>
 
 #include <QApplication>
-#include <QDir>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QComboBox>
@@ -33,7 +32,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <optional>
 
 namespace {}  // namespace
@@ -381,17 +379,8 @@ bool qSlicerReposeModuleWidget::buildRig() {
 QString qSlicerReposeModuleWidget::rigFolder() const {
   Q_D(const qSlicerReposeModuleWidget);
   if (!d->ParameterNode) return {};
-  const QString out = QString::fromStdString(d->ParameterNode->GetOutputFolder());
-  if (!out.isEmpty()) return QDir(out).filePath("rig");
-  const QFileInfo g(QString::fromStdString(d->ParameterNode->GetInputSegmentationPath()));
-  if (g.fileName().isEmpty()) return {};
-  QString stem = g.fileName();
-  for (const char* ext : {".nii.gz", ".seg.nrrd", ".nii", ".nrrd", ".nhdr", ".mha", ".mhd"})
-    if (stem.endsWith(ext)) {
-      stem.chop(int(std::strlen(ext)));
-      break;
-    }
-  return g.dir().filePath(stem + "_rig");
+  return QString::fromStdString(vtkSlicerReposeLogic::DefaultRigFolder(
+      d->ParameterNode->GetInputSegmentationPath(), d->ParameterNode->GetOutputFolder()));
 }
 
 bool qSlicerReposeModuleWidget::rigFromOrganMap() {

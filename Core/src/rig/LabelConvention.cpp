@@ -502,10 +502,12 @@ std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissu
       const auto n = names.find(v);
       l.name = n != names.end() ? n->second : std::to_string(v);
     }
-    if (had && !had->colorGenerated)
+    if (had && !had->colorGenerated) {
       taken.push_back(l.color);
-    else
+      table.set(l);  // `had` is not used after this: set() may move the entries
+    } else {
       made.push_back(l);
+    }
   }
   auto apart = [&](const std::array<double, 3>& c) {
     double nearest = 1;
@@ -525,12 +527,6 @@ std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissu
     l.colorGenerated = true;
     taken.push_back(best);
   }
-  for (const int v : values)
-    if (const Label* had = table.find(v); had && !had->colorGenerated) {
-      Label l = *had;
-      if (l.name.empty()) l.name = names.count(v) ? names.at(v) : std::to_string(v);
-      table.set(l);
-    }
   for (const Label& l : made) table.set(l);
   if (unnamed.empty()) return "";
   const std::size_t named = names.size();
