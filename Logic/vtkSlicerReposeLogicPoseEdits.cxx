@@ -262,17 +262,17 @@ std::vector<vtkSlicerReposeLogic::JointInfo> vtkSlicerReposeLogic::GetJointsBesi
   const std::string path = partsPath.empty() ? "" : repose::findSkeletonBeside(partsPath);
   if (path.empty()) return out;
   try {
-    for (const repose::SkeletonJoint& j : repose::readSkeleton(path).joints) {
+    const repose::Skeleton skeleton = repose::readSkeleton(path);
+    for (const repose::SkeletonJoint& j : skeleton.joints) {
       JointInfo info;
       info.name = j.name;
       for (const auto& [axis, v] : j.axes) {
         info.axes.push_back(axis);
         info.rangesDeg.push_back(repose::jointRangeDeg(j.name, axis));
       }
+      info.distalParts = repose::jointDistalParts(skeleton, j.name);
       out.push_back(info);
     }
-    const repose::Skeleton skeleton = repose::readSkeleton(path);
-    for (JointInfo& info : out) info.distalParts = repose::jointDistalParts(skeleton, info.name);
   } catch (const repose::Error&) {
     out.clear();  // a broken skeleton offers no joint (StartBuildRig names the problem)
   }
