@@ -166,7 +166,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
 
   // Pose edits, undoable: the group's transform (rotation about `axis` through `pivot` by
   // `angleDeg`, then `translation`) in the pose's current keyframe, or in the pose itself when it
-  // has none. False with a message for an unknown group or a fixed one.
+  // has none; a group's further turns (a joint group's other axes) are kept. False with a message
+  // for an unknown group or a fixed one.
   bool SetPoseGroupTransform(vtkMRMLReposePoseNode* pose, const std::string& group,
                              const std::array<double, 3>& axis, double angleDeg,
                              const std::array<double, 3>& pivot,
@@ -180,13 +181,30 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   };
   std::optional<GroupTransform> GetPoseGroupTransform(vtkMRMLReposePoseNode* pose,
                                                       const std::string& group) const;
-  // The same transform as a 4x4 matrix (rest RAS mm -> posed RAS mm), and setting it from one
-  // (the 3D view's transform widget): the group keeps its pivot and its axis direction. False
-  // with a message when the matrix is not a rigid motion.
+  // The group's motion as a 4x4 matrix (rest RAS mm -> posed RAS mm; for a group that follows
+  // another, carried along its chain), and setting it from one (the 3D view's transform widget):
+  // the group keeps its pivot and its axis direction, and a follower's own transform is what is
+  // left after the groups it follows. False with a message when the matrix is not a rigid
+  // motion, or for a group turning about several axes (a joint's: its sliders move it).
   bool GetPoseGroupMatrix(vtkMRMLReposePoseNode* pose, const std::string& group,
                           vtkMatrix4x4* matrix) const;
   bool SetPoseGroupMatrix(vtkMRMLReposePoseNode* pose, const std::string& group,
                           vtkMatrix4x4* matrix);
+  // A group's turns in the current keyframe: its rotation, then each further turn (a joint
+  // group: one per axis of its joint, repose::jointTurnAxes' order), each with its axis (a
+  // joint's axis by name until the rig resolves it, e.g. "elbow_left.flexion", else the vector)
+  // and angle. Empty for an unknown or fixed group. Setting a turn's angle is an undoable edit
+  // (a drag between Begin/EndPoseInteraction is one step) that re-solves a live pose. False with
+  // a message (unknown group, no such turn).
+  struct GroupTurn {
+    std::string axisName;
+    std::array<double, 3> axis{1, 0, 0};
+    double angleDeg = 0;
+  };
+  std::vector<GroupTurn> GetPoseGroupTurns(vtkMRMLReposePoseNode* pose,
+                                           const std::string& group) const;
+  bool SetPoseGroupTurnAngle(vtkMRMLReposePoseNode* pose, const std::string& group, int turn,
+                             double angleDeg);
   // A new pose node with the one fixed group "rest" (every cage vertex): a pose built up from
   // selections in the 3D view.
   vtkMRMLReposePoseNode* NewPose(const std::string& name);
@@ -202,19 +220,21 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // axis (repose::jointRangeDeg) and the body parts distal to it. Empty when there is none.
   struct JointInfo {
     std::string name;
-    std::vector<std::string> axes;
+    std::vector<std::string> axes;  // in the order of its group's turns (repose::jointTurnAxes)
+    std::vector<std::array<double, 3>> axisVectors;    // per axis, unit, RAS
     std::vector<std::pair<double, double>> rangesDeg;  // per axis
     std::vector<std::string> distalParts;
   };
   static std::vector<JointInfo> GetJointsBeside(const std::string& partsPath);
-  // The pose's group that turns `joint` about its `axis` (repose::jointGroup: "<joint>.<axis>",
-  // the distal parts, pivot and axis by name), undoable; groups selecting any of those parts (by
-  // name or label: another joint of the same limb, a part's group) give way to it, with their
-  // keyframe entries, and a fixed "rest" group keeps the others. Live posing of this pose stops:
-  // the rig must be built again for it (StartBuildRig resolves the names and cuts the joint's
-  // contacts). Returns the group's name, or "" with a message.
+  // The pose's group that turns `joint` about every one of its axes (repose::setJointGroup:
+  // named after the joint, a turn per axis by name, its angles kept if the joint had a group),
+  // undoable. Joint groups of the same limb form a chain: the shoulder's keeps the upper arm and
+  // carries the elbow's, which follows it; other groups selecting the joint's parts (by name or
+  // label) give way, with their keyframe entries; a fixed "rest" group keeps the others. Live
+  // posing of this pose stops: the rig must be built again for it (StartBuildRig resolves the
+  // names and cuts the joint's contacts). Returns the group's name, or "" with a message.
   std::string SetPoseJoint(vtkMRMLReposePoseNode* pose, const std::string& partsPath,
-                           const std::string& joint, const std::string& axis, double angleDeg);
+                           const std::string& joint);
   // The pose as a pose file, its joint groups in the named form ("axis": "elbow_left.flexion",
   // "pivot": "elbow_left") so it poses any rigged body; written atomically. False with a message.
   bool WritePoseFile(vtkMRMLReposePoseNode* pose, const std::string& partsPath,
@@ -294,12 +314,27 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // (the file's, else the tissue table's or the label convention's, else its number).
   int GetLiveRestLabelAt(double r, double a, double s) const;
   std::string GetLiveLabelName(int value) const;
+  // A body part's name (S's label table; else its number).
+  std::string GetLivePartName(int value) const;
+  // The skeleton's joints where the live frame puts them: each centre anchored once in the rest
+  // transfer mesh (repose::anchorPoints) and moved with it, its axes turned by the deformation
+  // of the tissue there. Empty without a live pose or a skeleton (the segmentation's).
+  struct LiveJoint {
+    std::string name;
+    std::array<double, 3> centre{};                                   // RAS mm, posed
+    std::vector<std::pair<std::string, std::array<double, 3>>> axes;  // unit, posed
+  };
+  std::vector<LiveJoint> GetLiveJoints() const;
   // The live frame's labels of G on the slice plane through `positionMm` (orientation 0 axial,
   // 1 coronal, 2 sagittal), square pixels, `pixels` across the box's larger in-plane side and as
   // many as the box needs across the other: a one-voxel-thick label image on RAS axes (what the
   // slice views show while a handle is dragged). Null without a live pose. Its time:
   // GetLiveSliceMilliseconds.
   vtkSmartPointer<vtkImageData> ComputeLiveSlice(int orientation, double positionMm, int pixels);
+  // The body-part map S (or G's body mask) on the same plane and grid, posed the same way: what
+  // the slice views outline when asked (the parameter node's ShowBodyParts).
+  vtkSmartPointer<vtkImageData> ComputeLivePartsSlice(int orientation, double positionMm,
+                                                      int pixels);
   // The segmentation's image (CT, MR) on the same plane and grid as ComputeLiveSlice, posed the
   // same way (trilinear at the rest position; the image's minimum where no tissue is). Null when
   // the segmentation has no image or there is no live pose.

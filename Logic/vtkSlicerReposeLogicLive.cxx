@@ -13,9 +13,11 @@
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
+#include <repose/mesh/PointAnchors.h>
 #include <repose/mesh/VolumePrediction.h>
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseRig.h>
+#include <repose/pose/Skeleton.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/util/Error.h>
 
@@ -34,6 +36,7 @@ struct vtkSlicerReposeLogic::LiveSession {
   vtkSmartPointer<vtkMRMLReposePoseNode> Pose;
   unsigned long PoseObserverTag = 0;
   std::shared_ptr<const repose::Volume> Labels;  // G
+  std::shared_ptr<const repose::Volume> Parts;   // S (or G's body mask), for the overlay
   std::shared_ptr<const repose::Volume> Image;   // the segmentation's image, if any
   double ImageBackground = 0, ImageWindow = 0, ImageLevel = 0;
   std::shared_ptr<const repose::PoseRig> Rig;
@@ -44,6 +47,10 @@ struct vtkSlicerReposeLogic::LiveSession {
   vtkSmartPointer<vtkPolyData> Cage, Body;
   double FrameMilliseconds = 0;
   std::optional<vtkSlicerReposeLogic::LivePrediction> Prediction;  // of Deformed, when asked
+  // The skeleton's joints, anchored once in the rest mesh: their centres follow every frame.
+  std::vector<repose::SkeletonJoint> Joints;
+  Eigen::MatrixX3d JointCentres;  // rest, one row per joint
+  std::vector<repose::PointAnchor> JointAnchors;
 };
 
 namespace {
@@ -128,6 +135,8 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
         vtkSlicerReposeLogicInputs::PartsOf(nodes.Segmentation));
     const std::shared_ptr<const repose::PoseJob> job =
         this->PoseJobFor(nodes.Segmentation, pose, *G, *S);
+    const std::optional<repose::Skeleton> skeleton =
+        vtkSlicerReposeLogicInputs::SkeletonOf(nodes.Segmentation);
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(
         "live pose",
@@ -136,6 +145,7 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           repose::reportProgress(progress, 0, "embedding");
           auto session = std::make_shared<LiveSession>();
           session->Labels = G;
+          session->Parts = S;
           if (image) {
             session->Image = image;
             imageWindow(*image, session->ImageBackground, session->ImageWindow,
@@ -146,6 +156,14 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           session->OuterFaces = repose::outerFaces(session->Rig->mesh());
           session->Cage = vtkSlicerReposeMeshConversion::ToPolyData(session->Rig->cage());
           session->Body = bodySurface(session->Rig->mesh(), session->OuterFaces);
+          if (skeleton) {
+            session->Joints = skeleton->joints;
+            session->JointCentres.resize(Eigen::Index(session->Joints.size()), 3);
+            for (std::size_t j = 0; j < session->Joints.size(); ++j)
+              session->JointCentres.row(Eigen::Index(j)) = session->Joints[j].centre.transpose();
+            session->JointAnchors =
+                repose::anchorPoints(session->Rig->mesh(), session->JointCentres);
+          }
           repose::reportProgress(progress, 1, "embedding");
           return [this, session, poseRef] {
             this->StopLivePose();
@@ -332,6 +350,39 @@ int vtkSlicerReposeLogic::GetLiveRestLabelAt(double r, double a, double s) const
   return int(G.valueAsDouble(G.index(at[0], at[1], at[2])));
 }
 
+std::string vtkSlicerReposeLogic::GetLivePartName(int value) const {
+  if (this->Live)
+    if (const repose::Label* l = this->Live->PartLabels.find(value); l && !l->name.empty())
+      return l->name;
+  return std::to_string(value);
+}
+
+std::vector<vtkSlicerReposeLogic::LiveJoint> vtkSlicerReposeLogic::GetLiveJoints() const {
+  std::vector<LiveJoint> out;
+  if (!this->Live || this->Live->Joints.empty() || this->Live->Deformed.rows() == 0) return out;
+  const LiveSession& live = *this->Live;
+  const repose::TransferMesh& mesh = live.Rig->mesh();
+  const Eigen::MatrixX3d centres =
+      repose::movePoints(mesh, live.Deformed, live.JointAnchors, live.JointCentres);
+  for (std::size_t j = 0; j < live.Joints.size(); ++j) {
+    LiveJoint joint;
+    joint.name = live.Joints[j].name;
+    const Eigen::Index row = Eigen::Index(j);
+    joint.centre = {centres(row, 0), centres(row, 1), centres(row, 2)};
+    // An axis turns with the tissue around the joint's centre (its tet's gradient).
+    const int tet = live.JointAnchors[j].tet;
+    const Eigen::Matrix3d F = tet >= 0 ? repose::tetDeformationGradient(mesh, live.Deformed, tet)
+                                       : Eigen::Matrix3d::Identity();
+    for (const auto& [axisName, axis] : live.Joints[j].axes) {
+      Eigen::Vector3d a = F * axis;
+      a = a.norm() > 1e-12 ? a.normalized() : axis;
+      joint.axes.push_back({axisName, {a.x(), a.y(), a.z()}});
+    }
+    out.push_back(std::move(joint));
+  }
+  return out;
+}
+
 std::string vtkSlicerReposeLogic::GetLiveLabelName(int value) const {
   if (this->Live && this->Live->Labels)
     if (const repose::Label* l = this->Live->Labels->labels().find(value); l && !l->name.empty())
@@ -379,6 +430,20 @@ vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orienta
   this->LiveSliceMilliseconds =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return Conversion::ToImageData(slice);
+}
+
+vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLivePartsSlice(int orientation,
+                                                                          double positionMm,
+                                                                          int pixels) {
+  if (!this->Live || !this->Live->Parts || this->Live->Deformed.rows() == 0 || orientation < 0 ||
+      orientation > 2 || pixels < 2)
+    return nullptr;
+  const LiveSession& live = *this->Live;
+  repose::RasterOptions options;
+  options.outerFaces = &live.OuterFaces;
+  return Conversion::ToImageData(repose::rasterizeLabels(
+      *live.Parts, live.Rig->mesh(), live.Deformed,
+      liveSliceGrid(live.Lo, live.Hi, orientation, positionMm, pixels), options));
 }
 
 vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveImageSlice(int orientation,

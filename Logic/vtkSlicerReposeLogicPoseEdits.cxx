@@ -15,7 +15,10 @@
 
 #include <vtkMatrix4x4.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace {
@@ -27,6 +30,14 @@ repose::PoseGroup& findGroup(repose::Pose& pose, const std::string& group,
   if (it == pose.groups.end())
     throw repose::Error("pose " + poseName + ": no group \"" + group + "\"");
   return *it;
+}
+
+// A group an edit can move: an unknown or fixed one throws, naming it.
+repose::PoseGroup& movableGroup(repose::Pose& pose, const std::string& group,
+                                const std::string& poseName) {
+  repose::PoseGroup& g = findGroup(pose, group, poseName);
+  if (g.fixed) throw repose::Error("pose " + poseName + ": group \"" + group + "\" is fixed");
+  return g;
 }
 
 // The keyframe an edit applies to: the node's current one, or none (the base pose).
@@ -83,10 +94,9 @@ bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
   return this->Guarded<bool>(false, [&]() -> bool {
     if (!node) throw repose::Error("no pose");
     repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
-    repose::PoseGroup& g = findGroup(pose, group, node->GetName());
-    if (g.fixed)
-      throw repose::Error("pose " + node->GetName() + ": group \"" + group + "\" is fixed");
+    repose::PoseGroup& g = movableGroup(pose, group, node->GetName());
     repose::PoseTransform t;
+    t.then = currentTransform(pose, node, g).then;  // a joint group's other axes stay turned
     t.axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
     if (!(t.axis.norm() > 0) || !t.axis.allFinite())
       throw repose::Error("the rotation axis is zero");
@@ -121,19 +131,74 @@ std::optional<vtkSlicerReposeLogic::GroupTransform> vtkSlicerReposeLogic::GetPos
   }
 }
 
+namespace {
+// The motion of the groups a group follows, in the edited frame (identity for none): what its
+// own transform is carried by.
+Eigen::Isometry3d carriedBy(repose::Pose& pose, vtkMRMLReposePoseNode* node,
+                            const repose::PoseGroup& group) {
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  std::size_t steps = 0;
+  for (std::string up = group.follows; !up.empty() && steps++ <= pose.groups.size();) {
+    const repose::PoseGroup& g = findGroup(pose, up, node->GetName());
+    m = (g.fixed ? Eigen::Isometry3d::Identity() : currentTransform(pose, node, g).isometry()) * m;
+    up = g.follows;
+  }
+  return m;
+}
+}  // namespace
+
 bool vtkSlicerReposeLogic::GetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
                                               vtkMatrix4x4* matrix) const {
-  const std::optional<GroupTransform> g = this->GetPoseGroupTransform(node, group);
-  if (!matrix || !g) return false;
-  repose::PoseTransform t;
-  t.axis = Eigen::Vector3d(g->axis[0], g->axis[1], g->axis[2]);
-  t.angleDeg = g->angleDeg;
-  t.pivot = Eigen::Vector3d(g->pivot[0], g->pivot[1], g->pivot[2]);
-  t.translation = Eigen::Vector3d(g->translation[0], g->translation[1], g->translation[2]);
-  const Eigen::Matrix4d m = t.isometry().matrix();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) matrix->SetElement(r, c, m(r, c));
-  return true;
+  if (!matrix || !node) return false;
+  try {
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    const repose::PoseGroup& g = findGroup(pose, group, node->GetName());
+    if (g.fixed) return false;
+    const Eigen::Matrix4d m =
+        (carriedBy(pose, node, g) * currentTransform(pose, node, g).isometry()).matrix();
+    for (int r = 0; r < 4; ++r)
+      for (int c = 0; c < 4; ++c) matrix->SetElement(r, c, m(r, c));
+    return true;
+  } catch (const std::exception&) {
+    return false;  // a query, as GetPoseGroupTransform
+  }
+}
+
+std::vector<vtkSlicerReposeLogic::GroupTurn> vtkSlicerReposeLogic::GetPoseGroupTurns(
+    vtkMRMLReposePoseNode* node, const std::string& group) const {
+  if (!node) return {};
+  try {
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    const repose::PoseGroup& g = findGroup(pose, group, node->GetName());
+    if (g.fixed) return {};
+    const repose::PoseTransform t = currentTransform(pose, node, g);
+    auto turn = [](const std::string& name, const Eigen::Vector3d& axis, double angle) {
+      return GroupTurn{name, {axis.x(), axis.y(), axis.z()}, angle};
+    };
+    std::vector<GroupTurn> turns{turn(t.axisName, t.axis, t.angleDeg)};
+    for (const repose::PoseTurn& u : t.then) turns.push_back(turn(u.axisName, u.axis, u.angleDeg));
+    return turns;
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
+bool vtkSlicerReposeLogic::SetPoseGroupTurnAngle(vtkMRMLReposePoseNode* node,
+                                                 const std::string& group, int turn,
+                                                 double angleDeg) {
+  return this->Guarded<bool>(false, [&]() -> bool {
+    if (!node) throw repose::Error("no pose");
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    repose::PoseGroup& g = movableGroup(pose, group, node->GetName());
+    repose::PoseTransform t = currentTransform(pose, node, g);
+    if (turn < 0 || std::size_t(turn) > t.then.size())
+      throw repose::Error("group \"" + group + "\" has no turn " + std::to_string(turn));
+    if (!std::isfinite(angleDeg)) throw repose::Error("the angle is not finite");
+    (turn == 0 ? t.angleDeg : t.then[std::size_t(turn - 1)].angleDeg) = angleDeg;
+    setCurrentTransform(pose, node, g, t);
+    this->RecordPoseEdit(node, repose::poseToJson(pose));
+    return true;
+  });
 }
 
 bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
@@ -142,6 +207,11 @@ bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
   const std::optional<GroupTransform> old = this->GetPoseGroupTransform(node, group);
   if (!matrix || !old) {
     this->LastErrorMessage = "pose group \"" + group + "\" cannot be moved (unknown or fixed)";
+    return false;
+  }
+  if (this->GetPoseGroupTurns(node, group).size() > 1) {
+    this->LastErrorMessage =
+        "pose group \"" + group + "\" turns about several axes of its joint: its sliders move it";
     return false;
   }
   Eigen::Matrix3d R;
@@ -154,6 +224,18 @@ bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
       !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || R.determinant() < 0) {
     this->LastErrorMessage = "pose group \"" + group + "\": the motion is not a rigid one";
     return false;
+  }
+  // A follower's own part of the motion: what is left after the groups it follows.
+  {
+    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+    const Eigen::Isometry3d carrier =
+        carriedBy(pose, node, findGroup(pose, group, node->GetName()));
+    Eigen::Isometry3d world = Eigen::Isometry3d::Identity();
+    world.linear() = R;
+    world.translation() = shift;
+    const Eigen::Isometry3d own = carrier.inverse() * world;
+    R = own.linear();
+    shift = own.translation();
   }
   // x' = R (x - p) + p + T with the group's own pivot p: T = shift + R p - p. The axis keeps the
   // direction it had, so the panel's angle control still turns the same way after a drag.
@@ -266,8 +348,10 @@ std::vector<vtkSlicerReposeLogic::JointInfo> vtkSlicerReposeLogic::GetJointsBesi
     for (const repose::SkeletonJoint& j : skeleton.joints) {
       JointInfo info;
       info.name = j.name;
-      for (const auto& [axis, v] : j.axes) {
+      for (const std::string& axis : repose::jointTurnAxes(j)) {  // a joint group's turns' order
+        const Eigen::Vector3d v = *j.axis(axis);
         info.axes.push_back(axis);
+        info.axisVectors.push_back({v.x(), v.y(), v.z()});
         info.rangesDeg.push_back(repose::jointRangeDeg(j.name, axis));
       }
       info.distalParts = repose::jointDistalParts(skeleton, j.name);
@@ -292,54 +376,20 @@ repose::Skeleton skeletonBeside(const std::string& partsPath) {
 
 std::string vtkSlicerReposeLogic::SetPoseJoint(vtkMRMLReposePoseNode* node,
                                                const std::string& partsPath,
-                                               const std::string& joint, const std::string& axis,
-                                               double angleDeg) {
+                                               const std::string& joint) {
   return this->Guarded<std::string>("", [&]() -> std::string {
     if (!node) throw repose::Error("no pose");
     const repose::Skeleton skeleton = skeletonBeside(partsPath);
-    const repose::PoseGroup group = repose::jointGroup(skeleton, joint, axis, angleDeg);
     repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
     // Parts by label: S's names, to tell which groups select the joint's parts.
     const repose::LabelTable partLabels = vtkSlicerReposeLogicRead::ReadVolume(partsPath).labels();
-    const std::set<std::string> taken(group.select.partNames.begin(), group.select.partNames.end());
-    auto selectsTaken = [&](const repose::PoseGroup& g) {
-      for (const std::string& n : g.select.partNames)
-        if (taken.count(n)) return true;
-      for (const int label : g.select.parts)
-        if (const repose::Label* l = partLabels.find(label); l && taken.count(l->name)) return true;
-      return false;
-    };
-    std::vector<std::string> removed;
-    for (const repose::PoseGroup& g : pose.groups)
-      if (!g.select.rest && (g.name == group.name || selectsTaken(g))) removed.push_back(g.name);
-    auto isRemoved = [&](const std::string& name) {
-      return std::find(removed.begin(), removed.end(), name) != removed.end();
-    };
-    pose.groups.erase(std::remove_if(pose.groups.begin(), pose.groups.end(),
-                                     [&](const repose::PoseGroup& g) { return isRemoved(g.name); }),
-                      pose.groups.end());
-    for (repose::PoseKeyframe& k : pose.keyframes)
-      k.transforms.erase(std::remove_if(k.transforms.begin(), k.transforms.end(),
-                                        [&](const auto& e) { return isRemoved(e.first); }),
-                         k.transforms.end());
-    // Before the rest group, as the pose suite's files order them.
-    const auto rest = std::find_if(pose.groups.begin(), pose.groups.end(),
-                                   [](const repose::PoseGroup& g) { return g.select.rest; });
-    pose.groups.insert(rest, group);
-    if (std::none_of(pose.groups.begin(), pose.groups.end(),
-                     [](const repose::PoseGroup& g) { return g.select.rest; })) {
-      repose::PoseGroup still;
-      still.name = "rest";
-      still.select.rest = true;
-      still.fixed = true;
-      pose.groups.push_back(still);
-    }
+    const std::string group = repose::setJointGroup(pose, skeleton, joint, partLabels);
     // The joint's group changes the rig itself (its contacts are cut in the cage and the mesh),
     // which re-preparing the live pose on the old cage would not do: posing stops until it is
     // built again (StartBuildRig).
     if (this->GetLivePose() == node) this->StopLivePose();
     this->RecordPoseEdit(node, repose::poseToJson(pose));
-    return group.name;
+    return group;
   });
 }
 

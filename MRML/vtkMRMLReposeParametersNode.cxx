@@ -32,6 +32,8 @@ void vtkMRMLReposeParametersNode::ForEachField(F&& f) {
   f("SelectedCageVertices", &Self::SelectedCageVertices, &Self::SetSelectedCageVertices);
   f("SelectedBodyPart", &Self::SelectedBodyPart, &Self::SetSelectedBodyPart);
   f("LabelOpacity", &Self::LabelOpacity, &Self::SetLabelOpacity);
+  f("ShowBodyParts", &Self::ShowBodyParts, &Self::SetShowBodyParts);
+  f("ShowJoints", &Self::ShowJoints, &Self::SetShowJoints);
 }
 
 namespace {
@@ -93,6 +95,18 @@ void vtkMRMLReposeParametersNode::SetLabelOpacity(double opacity) {
   if (clampAssign(this->LabelOpacity, opacity, 0.0, 1.0)) this->Modified();
 }
 
+void vtkMRMLReposeParametersNode::SetShowBodyParts(bool show) {
+  if (this->ShowBodyParts == show) return;
+  this->ShowBodyParts = show;
+  this->Modified();
+}
+
+void vtkMRMLReposeParametersNode::SetShowJoints(bool show) {
+  if (this->ShowJoints == show) return;
+  this->ShowJoints = show;
+  this->Modified();
+}
+
 int vtkMRMLReposeParametersNode::StartModify() {
   return this->DisableModified++;
 }
@@ -146,6 +160,8 @@ bool vtkMRMLReposeParametersNode::ReadJSON(const std::string& text, std::string*
         typeOk = v.is_array() && std::all_of(v.begin(), v.end(), [](const nlohmann::json& e) {
                    return e.is_number_integer();
                  });
+      else if constexpr (std::is_same_v<T, bool>)
+        typeOk = v.is_boolean();
       else if constexpr (std::is_integral_v<T>)
         typeOk = v.is_number_integer();
       else
@@ -159,7 +175,9 @@ bool vtkMRMLReposeParametersNode::ReadJSON(const std::string& text, std::string*
     using T = std::decay_t<decltype(this->*member)>;
     const auto it = json.find(name);
     if (it == json.end()) return;
-    if constexpr (std::is_integral_v<T>)
+    if constexpr (std::is_same_v<T, bool>)
+      (this->*setter)(it->template get<bool>());
+    else if constexpr (std::is_integral_v<T>)
       (this->*setter)(saturatedInt(*it));
     else if constexpr (std::is_same_v<T, std::vector<int>>) {
       std::vector<int> v;

@@ -81,6 +81,13 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   // Opacity of the labels over the image in the slice views, clamped to [0, 1].
   void SetLabelOpacity(double opacity);
   double GetLabelOpacity() const { return this->LabelOpacity; }
+  // What the views draw besides the labels: the body-part map S as outlines in the slice views
+  // (each part in its own colour), and the skeleton's joints in the 3D view (spheres with their
+  // names and axes, where the live frame puts them).
+  void SetShowBodyParts(bool show);
+  bool GetShowBodyParts() const { return this->ShowBodyParts; }
+  void SetShowJoints(bool show);
+  bool GetShowJoints() const { return this->ShowJoints; }
 
  protected:
   vtkMRMLReposeParametersNode() = default;
@@ -106,6 +113,8 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   std::vector<int> SelectedCageVertices;
   int SelectedBodyPart = 0;
   double LabelOpacity = 0.8;
+  bool ShowBodyParts = false;
+  bool ShowJoints = true;
 
  private:
   vtkMRMLReposeParametersNode(const vtkMRMLReposeParametersNode&) = delete;

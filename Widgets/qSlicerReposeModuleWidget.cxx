@@ -17,8 +17,12 @@
 #include <vtkSmartPointer.h>
 
 #include <QApplication>
+#include <QCheckBox>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QGridLayout>
+#include <QSlider>
+#include <QSpinBox>
 #include <QComboBox>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -50,11 +54,16 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   // volume changes; hidden until then.
   QTableWidget* QualityTable = nullptr;
   qSlicerReposeVolumeChangePlot* VolumeChangePlot = nullptr;
-  // The Joint row: joint, axis, "Pose by joint", "Save pose..."; the joints of the skeleton
-  // beside the body-part map, read again when that path changes.
+  // The Joint row: joint, "Pose by joint", "Save pose..."; the joints of the skeleton beside
+  // the body-part map, read again when that path changes. Under it, the active joint group's
+  // sliders, a row per axis (label, slider, spin box), built for the joint they show.
   QComboBox* JointComboBox = nullptr;
-  QComboBox* JointAxisComboBox = nullptr;
   QPushButton* PoseJointButton = nullptr;
+  QWidget* JointSliders = nullptr;
+  std::string JointSlidersFor;
+  std::vector<QString> JointSliderAxes;
+  std::vector<QSlider*> JointAxisSliders;
+  std::vector<QSpinBox*> JointAxisSpinBoxes;
   QPushButton* SavePoseButton = nullptr;
   std::vector<vtkSlicerReposeLogic::JointInfo> Joints;
   std::string JointsFor;  // the body-part map path they were read for
@@ -124,13 +133,17 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   d->JointComboBox = new QComboBox(d->PoseGroupBox);
   d->JointComboBox->setObjectName("JointComboBox");
   d->JointComboBox->setToolTip("A joint of the skeleton beside the body-part map");
-  d->JointAxisComboBox = new QComboBox(d->PoseGroupBox);
-  d->JointAxisComboBox->setObjectName("JointAxisComboBox");
   d->PoseJointButton = new QPushButton("Pose by joint", d->PoseGroupBox);
   d->PoseJointButton->setObjectName("PoseJointButton");
   d->PoseJointButton->setToolTip(
-      "Turn the parts distal to this joint about this axis: a handle group, the cage and mesh "
-      "built for it, then the Angle slider moves the joint within its anatomical range");
+      "Turn the parts distal to this joint about its axes: a handle group (chained to the "
+      "limb's other joints), the cage and mesh built for it, then a slider per axis moves the "
+      "joint within its anatomical range");
+  d->JointSliders = new QWidget(d->PoseGroupBox);
+  d->JointSliders->setObjectName("JointSliders");
+  auto* sliderGrid = new QGridLayout(d->JointSliders);
+  sliderGrid->setContentsMargins(0, 0, 0, 0);
+  d->JointSliders->setVisible(false);
   d->SavePoseButton = new QPushButton("Save pose...", d->PoseGroupBox);
   d->SavePoseButton->setObjectName("SavePoseButton");
   d->SavePoseButton->setToolTip(
@@ -141,22 +154,13 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
     d->poseLayout->addWidget(new QLabel("Joint:", d->PoseGroupBox), row, 0);
     auto* pick = new QHBoxLayout;
     pick->addWidget(d->JointComboBox, 1);
-    pick->addWidget(d->JointAxisComboBox, 1);
+    pick->addWidget(d->PoseJointButton);
+    pick->addWidget(d->SavePoseButton);
     d->poseLayout->addLayout(pick, row, 1, 1, d->poseLayout->columnCount() - 1);
-    auto* buttons = new QHBoxLayout;
-    buttons->addWidget(d->PoseJointButton);
-    buttons->addWidget(d->SavePoseButton);
-    d->poseLayout->addLayout(buttons, row + 1, 1, 1, d->poseLayout->columnCount() - 1);
+    d->poseLayout->addWidget(d->JointSliders, row + 1, 0, 1, d->poseLayout->columnCount());
   }
-  connect(d->JointComboBox, &QComboBox::currentTextChanged, this, [d](const QString& name) {
-    const QSignalBlocker block(d->JointAxisComboBox);
-    d->JointAxisComboBox->clear();
-    if (const auto* j = d->joint(name.toStdString()))
-      for (const std::string& a : j->axes) d->JointAxisComboBox->addItem(QString::fromStdString(a));
-  });
-  connect(d->PoseJointButton, &QPushButton::clicked, this, [this, d] {
-    this->poseByJoint(d->JointComboBox->currentText(), d->JointAxisComboBox->currentText());
-  });
+  connect(d->PoseJointButton, &QPushButton::clicked, this,
+          [this, d] { this->poseByJoint(d->JointComboBox->currentText()); });
   connect(d->SavePoseButton, &QPushButton::clicked, this, [this] {
     const QString path =
         QFileDialog::getSaveFileName(this, "Save the pose", QString(), "Pose files (*.pose.json)");
@@ -221,6 +225,12 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   });
   connect(d->OpacitySlider, &QSlider::valueChanged, this, [d](int v) {
     if (d->ParameterNode && !d->Updating) d->ParameterNode->SetLabelOpacity(v / 100.0);
+  });
+  connect(d->ShowBodyPartsCheckBox, &QCheckBox::toggled, this, [d](bool on) {
+    if (d->ParameterNode && !d->Updating) d->ParameterNode->SetShowBodyParts(on);
+  });
+  connect(d->ShowJointsCheckBox, &QCheckBox::toggled, this, [d](bool on) {
+    if (d->ParameterNode && !d->Updating) d->ParameterNode->SetShowJoints(on);
   });
   connect(d->GroupComboBox, &QComboBox::currentTextChanged, this, [d](const QString& group) {
     if (d->ParameterNode && !d->Updating && !group.isEmpty())
@@ -404,7 +414,7 @@ QStringList qSlicerReposeModuleWidget::joints() const {
   return names;
 }
 
-bool qSlicerReposeModuleWidget::poseByJoint(const QString& joint, const QString& axis) {
+bool qSlicerReposeModuleWidget::poseByJoint(const QString& joint) {
   Q_D(qSlicerReposeModuleWidget);
   if (!d->Logic || !d->ParameterNode) return false;
   auto fail = [&](const QString& why) {
@@ -412,17 +422,133 @@ bool qSlicerReposeModuleWidget::poseByJoint(const QString& joint, const QString&
     this->updateWidgetFromMRML();
     return false;
   };
-  if (joint.isEmpty() || axis.isEmpty())
-    return fail("choose a joint and an axis (the skeleton beside the body-part map)");
+  if (joint.isEmpty()) return fail("choose a joint (the skeleton beside the body-part map)");
   if (!this->activePose() && !this->newPose())
     return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
-  const std::string group =
-      d->Logic->SetPoseJoint(this->activePose(), d->ParameterNode->GetBodyPartMapPath(),
-                             joint.toStdString(), axis.toStdString(), 0.0);
+  const std::string group = d->Logic->SetPoseJoint(
+      this->activePose(), d->ParameterNode->GetBodyPartMapPath(), joint.toStdString());
   if (group.empty()) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
   d->ParameterNode->SetActiveGroup(group);
   // A new group changes the rig (its separations, whole pieces): built again, then live.
   return this->buildRig();
+}
+
+bool qSlicerReposeModuleWidget::setJointAngle(const QString& axis, double angleDeg) {
+  Q_D(qSlicerReposeModuleWidget);
+  const auto at = std::find(d->JointSliderAxes.begin(), d->JointSliderAxes.end(), axis);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  if (!d->Logic || !pose || !d->JointSliders->isVisibleTo(d->PoseGroupBox) ||
+      at == d->JointSliderAxes.end())
+    return false;
+  return d->Logic->SetPoseGroupTurnAngle(pose, d->ParameterNode->GetActiveGroup(),
+                                         int(at - d->JointSliderAxes.begin()), angleDeg);
+}
+
+double qSlicerReposeModuleWidget::jointAngle(const QString& axis) const {
+  Q_D(const qSlicerReposeModuleWidget);
+  const auto at = std::find(d->JointSliderAxes.begin(), d->JointSliderAxes.end(), axis);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  if (!d->Logic || !pose || at == d->JointSliderAxes.end()) return 0;
+  const auto turns = d->Logic->GetPoseGroupTurns(pose, d->ParameterNode->GetActiveGroup());
+  const std::size_t k = std::size_t(at - d->JointSliderAxes.begin());
+  return k < turns.size() ? turns[k].angleDeg : 0;
+}
+
+QStringList qSlicerReposeModuleWidget::jointAxesShown() const {
+  Q_D(const qSlicerReposeModuleWidget);
+  QStringList axes;
+  if (d->JointSliders->isVisibleTo(d->PoseGroupBox))
+    for (const QString& a : d->JointSliderAxes) axes << a;
+  return axes;
+}
+
+void qSlicerReposeModuleWidget::updateJointSliders(const std::string& group) {
+  Q_D(qSlicerReposeModuleWidget);
+  // A joint's group (named after the joint) whose every turn is about one of the joint's axes
+  // gets a slider per turn; a group of one axis ("elbow_left.flexion", from a pose file) or one
+  // turned otherwise keeps the Angle row.
+  const vtkSlicerReposeLogic::JointInfo* joint = d->joint(group);
+  vtkMRMLReposePoseNode* pose = this->activePose();
+  const auto turns = joint && pose ? d->Logic->GetPoseGroupTurns(pose, group)
+                                   : std::vector<vtkSlicerReposeLogic::GroupTurn>{};
+  // Each turn's axis by name: the one it names, or the joint's axis it equals (once resolved).
+  std::vector<QString> axes;
+  for (const auto& turn : turns) {
+    QString name;
+    if (!turn.axisName.empty()) {
+      if (turn.axisName.rfind(group + ".", 0) == 0)
+        name = QString::fromStdString(turn.axisName.substr(group.size() + 1));
+    } else {
+      for (std::size_t k = 0; k < joint->axes.size(); ++k) {
+        const auto& v = joint->axisVectors[k];
+        if (v[0] * turn.axis[0] + v[1] * turn.axis[1] + v[2] * turn.axis[2] > 1 - 1e-9)
+          name = QString::fromStdString(joint->axes[k]);
+      }
+    }
+    if (name.isEmpty() || std::find(axes.begin(), axes.end(), name) != axes.end()) {
+      axes.clear();
+      break;
+    }
+    axes.push_back(name);
+  }
+  const bool show = !axes.empty();
+  d->JointSliders->setVisible(show);
+  d->AngleSlider->setEnabled(!show);
+  d->AngleSpinBox->setEnabled(!show);
+  if (!show) return;
+  if (d->JointSlidersFor != group || d->JointSliderAxes != axes) {
+    d->JointSlidersFor = group;
+    auto* grid = static_cast<QGridLayout*>(d->JointSliders->layout());
+    while (QLayoutItem* item = grid->takeAt(0)) {
+      delete item->widget();
+      delete item;
+    }
+    d->JointSliderAxes.clear();
+    d->JointAxisSliders.clear();
+    d->JointAxisSpinBoxes.clear();
+    for (std::size_t k = 0; k < axes.size(); ++k) {
+      const QString axis = axes[k];
+      const std::size_t a =
+          std::size_t(std::find(joint->axes.begin(), joint->axes.end(), axis.toStdString()) -
+                      joint->axes.begin());
+      const auto [lo, hi] = joint->rangesDeg[a];
+      auto* label = new QLabel(axis + ":", d->JointSliders);
+      auto* slider = new QSlider(Qt::Horizontal, d->JointSliders);
+      slider->setObjectName("JointSlider_" + axis);
+      slider->setRange(int(lo), int(hi));
+      slider->setToolTip(QString("%1 of %2, %3 to %4 degrees")
+                             .arg(axis, QString::fromStdString(group))
+                             .arg(lo)
+                             .arg(hi));
+      auto* spin = new QSpinBox(d->JointSliders);
+      spin->setObjectName("JointSpinBox_" + axis);
+      spin->setRange(int(lo), int(hi));
+      spin->setSuffix(" \u00b0");
+      // Flexion on top, the limb's own rotation last (the turns' order reversed).
+      const int row = int(axes.size() - 1 - k);
+      grid->addWidget(label, row, 0);
+      grid->addWidget(slider, row, 1);
+      grid->addWidget(spin, row, 2);
+      d->JointSliderAxes.push_back(axis);
+      d->JointAxisSliders.push_back(slider);
+      d->JointAxisSpinBoxes.push_back(spin);
+      // A drag is one undo step, each move re-solves live, as the Angle slider.
+      connect(slider, &QSlider::sliderPressed, this,
+              &qSlicerReposeModuleWidget::onAngleSliderPressed);
+      connect(slider, &QSlider::sliderReleased, this,
+              &qSlicerReposeModuleWidget::onAngleSliderReleased);
+      auto set = [this, d, axis](int value) {
+        if (!d->Updating) this->setJointAngle(axis, value);
+      };
+      connect(slider, &QSlider::valueChanged, this, set);
+      connect(spin, qOverload<int>(&QSpinBox::valueChanged), this, set);
+    }
+  }
+  for (std::size_t k = 0; k < d->JointAxisSliders.size() && k < turns.size(); ++k) {
+    const int value = int(std::lround(turns[k].angleDeg));
+    if (!d->JointAxisSliders[k]->isSliderDown()) d->JointAxisSliders[k]->setValue(value);
+    d->JointAxisSpinBoxes[k]->setValue(value);
+  }
 }
 
 bool qSlicerReposeModuleWidget::savePose(const QString& path) {
@@ -691,6 +817,8 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
     d->TransferMeshSizeSpinBox->setValue(node->GetTransferMeshSizeMm());
     d->MemoryBudgetSpinBox->setValue(node->GetOutputMemoryBudgetMB());
     d->OpacitySlider->setValue(int(std::lround(100 * node->GetLabelOpacity())));
+    d->ShowBodyPartsCheckBox->setChecked(node->GetShowBodyParts());
+    d->ShowJointsCheckBox->setChecked(node->GetShowJoints());
   }
   QString info;
   if (!node)
@@ -730,8 +858,8 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
     if (d->JointComboBox->findText(was) >= 0) d->JointComboBox->setCurrentText(was);
   }
   d->JointComboBox->setEnabled(!d->Joints.empty());
-  d->JointAxisComboBox->setEnabled(!d->Joints.empty());
   d->SavePoseButton->setEnabled(pose != nullptr);
+  this->updateJointSliders(node ? node->GetActiveGroup() : "");
   // The Angle slider's range: the active joint group's anatomical range, else a full turn.
   std::pair<double, double> range{-180, 180};
   if (node) {
@@ -801,7 +929,11 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   d->ClearSelectionButton->setEnabled(selected > 0);
   d->NewGroupButton->setEnabled(live && selected > 0);
   d->NewPoseButton->setEnabled(d->Logic != nullptr);
-  d->AngleSlider->setEnabled(pose != nullptr && !groups.isEmpty());
+  // A joint group turns by its sliders (updateJointSliders), other groups by the Angle row.
+  const bool angleRow =
+      pose != nullptr && !groups.isEmpty() && !d->JointSliders->isVisibleTo(d->PoseGroupBox);
+  d->AngleSlider->setEnabled(angleRow);
+  d->AngleSpinBox->setEnabled(angleRow);
   QString liveText = pose ? "Build the cage and mesh to pose live." : "No pose loaded.";
   if (live) {
     // What the export will show, predicted from the live frame's transfer mesh: after a drag,

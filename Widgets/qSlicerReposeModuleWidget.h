@@ -10,6 +10,8 @@
 #include <QScopedPointer>
 #include <QWidget>
 
+#include <string>
+
 class qSlicerReposeModuleWidgetPrivate;
 class vtkMRMLReposeParametersNode;
 class vtkMRMLReposePoseNode;
@@ -52,11 +54,18 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   void waitForJobs();
   QString jobStatusText() const;
 
-  // Posing by joint (the Pose section's Joint row): the joint's group (its distal parts, about its
-  // named axis through it) made the active group of the active pose (a new pose when there is
-  // none), and the cage and mesh built for it; then the Angle slider is that joint's slider, in
-  // its anatomical range. False with the reason in jobStatusText().
-  bool poseByJoint(const QString& joint, const QString& axis);
+  // Posing by joint (the Pose section's Joint row): the joint's group (its distal parts, a turn
+  // about each of its axes through it; chained to the groups of the limb's other joints) made
+  // the active group of the active pose (a new pose when there is none), and the cage and mesh
+  // built for it; then a slider per axis (flexion, abduction, rotation...) in the joint's
+  // anatomical ranges turns it live. False with the reason in jobStatusText().
+  bool poseByJoint(const QString& joint);
+  // The active joint group's sliders: the angle about one of its axes (by name), set as a drag
+  // of its slider would (one undo step); false when the active group is no joint's or has no
+  // such axis. The axes shown ("" list when none).
+  bool setJointAngle(const QString& axis, double angleDeg);
+  double jointAngle(const QString& axis) const;
+  QStringList jointAxesShown() const;
   // The joints offered (of the skeleton beside the body-part map).
   QStringList joints() const;
   // The active pose as a pose file, joint groups named (it poses any rigged body).
@@ -96,6 +105,7 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   void onAngleSliderPressed();
   void onAngleSliderReleased();
   void onAngleChanged(int angle);
+  void updateJointSliders(const std::string& group);  // the active group's, or hidden
 
   QScopedPointer<qSlicerReposeModuleWidgetPrivate> d_ptr;
   Q_DECLARE_PRIVATE(qSlicerReposeModuleWidget)

@@ -106,10 +106,18 @@ void qSlicerReposeSliceView::wheelEvent(QWheelEvent* event) {
   event->accept();
 }
 
+void qSlicerReposeSliceView::setPartsOverlay(vtkImageData* parts,
+                                             const QHash<int, QColor>& colors) {
+  this->Parts = parts;
+  this->PartColors = colors;
+}
+
 void qSlicerReposeSliceView::setSlice(vtkImageData* labels, vtkLookupTable* lut,
                                       vtkImageData* image) {
   this->Image = QImage();
   this->Labels.clear();
+  this->PartPixels.clear();
+  this->OutlinePixels.clear();
   this->Shown = labels;
   this->Width = this->Height = 0;
   vtkDataArray* values = labels ? labels->GetPointData()->GetScalars() : nullptr;
@@ -158,7 +166,65 @@ void qSlicerReposeSliceView::setSlice(vtkImageData* labels, vtkLookupTable* lut,
                                 int(std::lround(255 * std::clamp(rgb[1], 0.0, 1.0))),
                                 int(std::lround(255 * std::clamp(rgb[2], 0.0, 1.0)))));
     }
+  this->drawPartsOutline();
   this->update();
+}
+
+void qSlicerReposeSliceView::drawPartsOutline() {
+  vtkDataArray* parts = this->Parts ? this->Parts->GetPointData()->GetScalars() : nullptr;
+  const int w = this->Width, h = this->Height;
+  if (!parts || parts->GetNumberOfTuples() != vtkIdType(w) * h) return;
+  this->PartPixels.assign(std::size_t(w) * std::size_t(h), 0);
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i)
+      this->PartPixels[std::size_t(w - 1 - i) + std::size_t(w) * std::size_t(h - 1 - j)] =
+          int(parts->GetTuple1(vtkIdType(i) + vtkIdType(w) * j));
+  // A part's pixel is on its outline where a 4-neighbour is another part or nothing (the slice's
+  // edge counts as nothing), so touching parts are each outlined along their border.
+  this->OutlinePixels.assign(this->PartPixels.size(), 0);
+  auto part = [&](int x, int y) {
+    return x < 0 || y < 0 || x >= w || y >= h
+               ? 0
+               : this->PartPixels[std::size_t(x) + std::size_t(w) * std::size_t(y)];
+  };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const int p = part(x, y);
+      if (p == 0) continue;
+      if (part(x - 1, y) == p && part(x + 1, y) == p && part(x, y - 1) == p && part(x, y + 1) == p)
+        continue;
+      this->OutlinePixels[std::size_t(x) + std::size_t(w) * std::size_t(y)] = 1;
+      this->Image.setPixel(x, y, this->PartColors.value(p, QColor(Qt::white)).rgb());
+    }
+}
+
+int qSlicerReposeSliceView::partAt(int x, int y) const {
+  if (this->PartPixels.empty() || x < 0 || y < 0 || x >= this->Width || y >= this->Height)
+    return -1;
+  return this->PartPixels[std::size_t(x) + std::size_t(this->Width) * std::size_t(y)];
+}
+
+bool qSlicerReposeSliceView::isPartOutline(int x, int y) const {
+  return this->partAt(x, y) > 0 &&
+         this->OutlinePixels[std::size_t(x) + std::size_t(this->Width) * std::size_t(y)];
+}
+
+int qSlicerReposeSliceView::partAtRas(double r, double a, double s) const {
+  int x, y;
+  if (!this->pixelOfRas(r, a, s, x, y)) return -1;
+  return this->partAt(x, y);
+}
+
+bool qSlicerReposeSliceView::pixelOfRas(double r, double a, double s, int& x, int& y) const {
+  if (!this->Shown || this->Image.isNull()) return false;
+  const double ras[3] = {r, a, s};
+  double ijk[3];
+  this->Shown->TransformPhysicalPointToContinuousIndex(ras, ijk);
+  const int i = int(std::lround(ijk[0])), j = int(std::lround(ijk[1]));
+  if (i < 0 || j < 0 || i >= this->Width || j >= this->Height || std::fabs(ijk[2]) > 0.5)
+    return false;
+  x = this->Width - 1 - i, y = this->Height - 1 - j;
+  return true;
 }
 
 int qSlicerReposeSliceView::labelAt(int x, int y) const {
@@ -167,13 +233,9 @@ int qSlicerReposeSliceView::labelAt(int x, int y) const {
 }
 
 int qSlicerReposeSliceView::labelAtRas(double r, double a, double s) const {
-  if (!this->Shown || this->Image.isNull()) return -1;
-  const double ras[3] = {r, a, s};
-  double ijk[3];
-  this->Shown->TransformPhysicalPointToContinuousIndex(ras, ijk);
-  const int i = int(std::lround(ijk[0])), j = int(std::lround(ijk[1]));
-  if (i < 0 || j < 0 || i >= this->Width || j >= this->Height || std::fabs(ijk[2]) > 0.5) return -1;
-  return this->labelAt(this->Width - 1 - i, this->Height - 1 - j);
+  int x, y;
+  if (!this->pixelOfRas(r, a, s, x, y)) return -1;
+  return this->labelAt(x, y);
 }
 
 int qSlicerReposeSliceView::labelsShown() const {

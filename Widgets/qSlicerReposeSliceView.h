@@ -7,6 +7,7 @@
 #include "qSlicerReposeModuleWidgetsExport.h"
 
 #include <QColor>
+#include <QHash>
 #include <QImage>
 #include <QWidget>
 
@@ -29,6 +30,10 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
   // The labels on the plane (one voxel thick, RAS-aligned, as the Logic's live slices) and an
   // optional image on the same grid; the lookup table maps label values to colours.
   void setSlice(vtkImageData* labels, vtkLookupTable* lut, vtkImageData* image = nullptr);
+  // The body-part map on the same grid, drawn over the labels as outlines (each part's border
+  // pixels in its colour, opaque), as Slicer outlines a segmentation; null: none. Takes effect
+  // at the next setSlice.
+  void setPartsOverlay(vtkImageData* parts, const QHash<int, QColor>& colors);
   void setPositionMm(double position);
   double positionMm() const { return this->PositionMm; }
   void setLabelOpacity(double opacity);
@@ -43,6 +48,11 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
   int labelAt(int x, int y) const;
   // Distinct non-zero labels on the slice.
   int labelsShown() const;
+  // The overlay's body part at a pixel of sliceImage() (0 none, -1 outside or no overlay), and
+  // whether that pixel is drawn as the part's outline.
+  int partAt(int x, int y) const;
+  bool isPartOutline(int x, int y) const;
+  int partAtRas(double r, double a, double s) const;
   // The label shown at a RAS point of the plane (nearest pixel; -1 off the slice).
   int labelAtRas(double r, double a, double s) const;
   // The RAS point under a widget position (false off the drawn slice), and the widget position
@@ -70,6 +80,9 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
 
  private:
   QRectF imageRect() const;  // where the slice is drawn in the widget (aspect kept)
+  // The pixel of sliceImage() a RAS point of the plane falls in (false off the slice).
+  bool pixelOfRas(double r, double a, double s, int& x, int& y) const;
+  void drawPartsOutline();  // the overlay over Image, after the labels
   static constexpr int BarHeight = 18;
 
   int Orientation;
@@ -78,6 +91,10 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeSliceView : public QWidg
   double Window = 0, Level = 0;
   QImage Image;                         // RGB of the slice, rows top = superior (or anterior)
   std::vector<int> Labels;              // label per pixel of Image
+  vtkSmartPointer<vtkImageData> Parts;  // the overlay's body parts (null: none)
+  QHash<int, QColor> PartColors;
+  std::vector<int> PartPixels;          // part per pixel of Image (empty: no overlay)
+  std::vector<char> OutlinePixels;      // drawn as a part's outline
   vtkSmartPointer<vtkImageData> Shown;  // the slice drawn (its geometry maps RAS to pixels)
   int Width = 0, Height = 0;
   double AspectMm = 1;  // pixel height / width in mm

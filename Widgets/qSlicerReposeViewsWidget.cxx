@@ -11,6 +11,16 @@
 
 #include <QVTKOpenGLNativeWidget.h>
 #include <vtkActor.h>
+#include <vtkActor2D.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkGlyph3D.h>
+#include <vtkLabeledDataMapper.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkSphereSource.h>
+#include <vtkStringArray.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkCamera.h>
 #include <vtkCommand.h>
 #include <vtkGenericOpenGLRenderWindow.h>
@@ -45,6 +55,14 @@ class qSlicerReposeViewsWidgetPrivate {
   vtkSmartPointer<vtkRenderer> Renderer;
   vtkSmartPointer<vtkActor> BodyActor, CageActor, CageVertexActor;
   vtkSmartPointer<vtkPolyDataMapper> BodyMapper, CageMapper, CageVertexMapper;
+  // The skeleton's joints: spheres at the posed centres (glyphs of JointPoints), their axes as
+  // coloured lines (JointAxes), their names as labels at the centres.
+  vtkSmartPointer<vtkPolyData> JointPoints, JointAxes;
+  vtkSmartPointer<vtkSphereSource> JointSphere;
+  vtkSmartPointer<vtkActor> JointActor, JointAxisActor;
+  vtkSmartPointer<vtkActor2D> JointLabelActor;
+  QHash<int, QColor> PartColors;  // the body-part overlay's colours, per live pose
+  vtkMRMLReposePoseNode* PartColorsFor = nullptr;
   qSlicerReposeSliceView* Slices[3] = {nullptr, nullptr, nullptr};
   double Positions[3] = {std::numeric_limits<double>::quiet_NaN(),
                          std::numeric_limits<double>::quiet_NaN(),
@@ -96,6 +114,47 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
   d->CageVertexActor->GetProperty()->SetPointSize(5);
   d->CageVertexActor->GetProperty()->SetColor(1.0, 0.9, 0.2);
   d->CageVertexActor->GetProperty()->LightingOff();
+  {
+    // Joints as Slicer draws markups: spheres with their names beside, always in front of the
+    // semi-transparent body; axes in the colours of the anatomical planes' conventions.
+    d->JointPoints = vtkSmartPointer<vtkPolyData>::New();
+    d->JointSphere = vtkSmartPointer<vtkSphereSource>::New();
+    d->JointSphere->SetThetaResolution(16);
+    d->JointSphere->SetPhiResolution(12);
+    vtkNew<vtkGlyph3D> glyphs;
+    glyphs->SetInputData(d->JointPoints);
+    glyphs->SetSourceConnection(d->JointSphere->GetOutputPort());
+    glyphs->ScalingOff();
+    vtkNew<vtkPolyDataMapper> sphereMapper;
+    sphereMapper->SetInputConnection(glyphs->GetOutputPort());
+    d->JointActor = vtkSmartPointer<vtkActor>::New();
+    d->JointActor->SetMapper(sphereMapper);
+    d->JointActor->GetProperty()->SetColor(0.4, 1.0, 1.0);  // Slicer's unselected markup colour
+    d->JointActor->VisibilityOff();
+    d->Renderer->AddActor(d->JointActor);
+    d->JointAxes = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPolyDataMapper> axisMapper;
+    axisMapper->SetInputData(d->JointAxes);
+    axisMapper->SetScalarModeToUseCellData();
+    d->JointAxisActor = vtkSmartPointer<vtkActor>::New();
+    d->JointAxisActor->SetMapper(axisMapper);
+    d->JointAxisActor->GetProperty()->SetLineWidth(3);
+    d->JointAxisActor->GetProperty()->LightingOff();
+    d->JointAxisActor->VisibilityOff();
+    d->Renderer->AddActor(d->JointAxisActor);
+    vtkNew<vtkLabeledDataMapper> labelMapper;
+    labelMapper->SetInputData(d->JointPoints);
+    labelMapper->SetLabelModeToLabelFieldData();
+    labelMapper->SetFieldDataName("name");
+    labelMapper->GetLabelTextProperty()->SetFontSize(12);
+    labelMapper->GetLabelTextProperty()->SetColor(1, 1, 1);
+    labelMapper->GetLabelTextProperty()->ShadowOn();
+    labelMapper->GetLabelTextProperty()->BoldOn();
+    d->JointLabelActor = vtkSmartPointer<vtkActor2D>::New();
+    d->JointLabelActor->SetMapper(labelMapper);
+    d->JointLabelActor->VisibilityOff();
+    d->Renderer->AddActor2D(d->JointLabelActor);
+  }
   d->Timing = vtkSmartPointer<vtkTextActor>::New();
   d->Timing->GetTextProperty()->SetFontSize(13);
   d->Timing->GetTextProperty()->SetColor(0.1, 0.1, 0.2);  // on the light lower part
@@ -213,6 +272,9 @@ void qSlicerReposeViewsWidget::refresh() {
   d->BodyActor->SetVisibility(pose != nullptr);
   d->CageActor->SetVisibility(pose != nullptr);
   d->CageVertexActor->SetVisibility(pose != nullptr);
+  vtkMRMLReposeParametersNode* parameters = d->Logic ? d->Logic->GetParameterNode() : nullptr;
+  const bool showParts = pose && parameters && parameters->GetShowBodyParts();
+  this->updateJoints(pose && parameters && parameters->GetShowJoints());
   d->SliceMilliseconds = 0;
   if (!pose) {
     d->Timing->VisibilityOff();
@@ -236,6 +298,14 @@ void qSlicerReposeViewsWidget::refresh() {
     if (seg && seg->GetLabelMap())
       d->Lookup = vtkSlicerReposeLogic::GetLabelLookupTable(seg->GetLabelMap());
   }
+  // Body-part colours: well-spread hues in S's label order, once per live pose.
+  if (d->PartColorsFor != pose) {
+    d->PartColorsFor = pose;
+    d->PartColors.clear();
+    int i = 0;
+    for (const auto& [label, name] : d->Logic->GetLiveBodyParts())
+      d->PartColors.insert(label, QColor::fromHsvF(std::fmod(0.13 + 0.618034 * i++, 1.0), 0.85, 1));
+  }
   const std::array<double, 3> centre = d->Logic->GetLiveRestCenter();
   std::array<double, 3> sliceMs{};
   for (int o = 0; o < 3; ++o) {
@@ -252,6 +322,9 @@ void qSlicerReposeViewsWidget::refresh() {
     d->Slices[o]->setPositionMm(d->Positions[o]);
     if (vtkMRMLReposeParametersNode* p = d->Logic->GetParameterNode())
       d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());
+    d->Slices[o]->setPartsOverlay(
+        showParts ? d->Logic->ComputeLivePartsSlice(o, d->Positions[o], d->Pixels) : nullptr,
+        d->PartColors);
     d->Slices[o]->setSlice(slice, d->Lookup, image);
   }
   // What a drag costs, by the stages ReposeLiveBench reports (docs/PERFORMANCE.md): the frame's
@@ -282,6 +355,89 @@ void qSlicerReposeViewsWidget::refresh() {
   if (d->CageInteraction) d->CageInteraction->update();
   d->RenderWindow->Render();
   d->View3D->update();
+}
+
+void qSlicerReposeViewsWidget::updateJoints(bool show) {
+  Q_D(qSlicerReposeViewsWidget);
+  const std::vector<vtkSlicerReposeLogic::LiveJoint> joints =
+      show && d->Logic ? d->Logic->GetLiveJoints() : std::vector<vtkSlicerReposeLogic::LiveJoint>{};
+  const bool visible = !joints.empty();
+  d->JointActor->SetVisibility(visible);
+  d->JointAxisActor->SetVisibility(visible);
+  d->JointLabelActor->SetVisibility(visible);
+  vtkNew<vtkPoints> centres;
+  vtkNew<vtkStringArray> names;
+  names->SetName("name");
+  vtkNew<vtkPoints> axisPoints;
+  vtkNew<vtkCellArray> axisLines;
+  vtkNew<vtkUnsignedCharArray> axisColors;
+  axisColors->SetNumberOfComponents(3);
+  axisColors->SetName("axis");
+  // Sized to the body: a sphere about 1.5 % of its largest side, an axis four times as long.
+  const std::array<double, 6> box = d->Logic ? d->Logic->GetLiveBounds() : std::array<double, 6>{};
+  const double larger = std::max({box[1] - box[0], box[3] - box[2], box[5] - box[4]});
+  const double radius = std::max(2.0, 0.015 * larger), length = 4 * radius;
+  d->JointSphere->SetRadius(radius);
+  for (const auto& joint : joints) {
+    centres->InsertNextPoint(joint.centre.data());
+    names->InsertNextValue(joint.name);
+    for (const auto& [axisName, axis] : joint.axes) {
+      // flexion red, abduction green, rotation blue, the neck's lateral bend yellow
+      const unsigned char rgb[4][3] = {
+          {230, 50, 50}, {60, 200, 60}, {70, 110, 255}, {240, 220, 60}};
+      const int k = axisName == "flexion"     ? 0
+                    : axisName == "abduction" ? 1
+                    : axisName == "rotation"  ? 2
+                                              : 3;
+      const vtkIdType a = axisPoints->InsertNextPoint(joint.centre[0] - length * axis[0] / 2,
+                                                      joint.centre[1] - length * axis[1] / 2,
+                                                      joint.centre[2] - length * axis[2] / 2);
+      const vtkIdType b = axisPoints->InsertNextPoint(joint.centre[0] + length * axis[0] / 2,
+                                                      joint.centre[1] + length * axis[1] / 2,
+                                                      joint.centre[2] + length * axis[2] / 2);
+      const vtkIdType ids[2] = {a, b};
+      axisLines->InsertNextCell(2, ids);
+      axisColors->InsertNextTypedTuple(rgb[k]);
+    }
+  }
+  d->JointPoints->Initialize();
+  d->JointPoints->SetPoints(centres);
+  d->JointPoints->GetPointData()->AddArray(names);
+  d->JointPoints->Modified();
+  d->JointAxes->Initialize();
+  d->JointAxes->SetPoints(axisPoints);
+  d->JointAxes->SetLines(axisLines);
+  d->JointAxes->GetCellData()->SetScalars(axisColors);
+  d->JointAxes->Modified();
+}
+
+QStringList qSlicerReposeViewsWidget::jointsShown() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  QStringList out;
+  if (!d->JointActor->GetVisibility()) return out;
+  auto* names =
+      vtkStringArray::SafeDownCast(d->JointPoints->GetPointData()->GetAbstractArray("name"));
+  for (vtkIdType i = 0; names && i < names->GetNumberOfValues(); ++i)
+    out << QString::fromStdString(names->GetValue(i));
+  return out;
+}
+
+bool qSlicerReposeViewsWidget::jointShownAt(const QString& name, double ras[3]) const {
+  Q_D(const qSlicerReposeViewsWidget);
+  const int i = this->jointsShown().indexOf(name);
+  if (i < 0) return false;
+  d->JointPoints->GetPoint(i, ras);
+  return true;
+}
+
+int qSlicerReposeViewsWidget::jointAxesShown() const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->JointAxisActor->GetVisibility() ? int(d->JointAxes->GetNumberOfLines()) : 0;
+}
+
+QColor qSlicerReposeViewsWidget::partColor(int part) const {
+  Q_D(const qSlicerReposeViewsWidget);
+  return d->PartColors.value(part);
 }
 
 QString qSlicerReposeViewsWidget::probeText() const {
@@ -315,10 +471,16 @@ QString qSlicerReposeViewsWidget::probe(int orientation, double r, double a, dou
         QString::fromStdString(d->Logic->GetLiveLabelName(value)));
   };
   const qSlicerReposeSliceView* view = d->Slices[orientation];
-  const QString text =
+  QString text =
       QString("%1 (%2)  %3   posed: %4   input: %5")
           .arg(view->viewName(), view->orientationName().toLower(), rasText(r, a, s),
                label(view->labelAtRas(r, a, s)), label(d->Logic->GetLiveRestLabelAt(r, a, s)));
+  // With the body-part outlines shown, the part drawn there too.
+  if (const int part = view->partAtRas(r, a, s); part >= 0)
+    text += part == 0 ? QString("   part: none")
+                      : QString("   part: %1 %2")
+                            .arg(part)
+                            .arg(QString::fromStdString(d->Logic->GetLivePartName(part)));
   d->Probe->setText(text);
   return text;
 }

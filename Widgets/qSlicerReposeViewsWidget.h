@@ -9,7 +9,9 @@
 
 #include "qSlicerReposeModuleWidgetsExport.h"
 
+#include <QColor>
 #include <QScopedPointer>
+#include <QStringList>
 #include <QWidget>
 
 class qSlicerReposeCageInteraction;
@@ -47,10 +49,20 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeViewsWidget : public QWi
   QString probeText() const;
   QString probe(int orientation, double r, double a, double s);
 
+  // The skeleton's joints drawn in the 3D view (the parameter node's ShowJoints, a live pose and a
+  // skeleton): their names, where a joint's sphere is drawn (RAS mm; false when not shown), and
+  // how many axis lines are drawn.
+  QStringList jointsShown() const;
+  bool jointShownAt(const QString& name, double ras[3]) const;
+  int jointAxesShown() const;
+  // The colour a body part is outlined in (ShowBodyParts), invalid for an unknown part.
+  QColor partColor(int part) const;
+
   // The four views as one picture (the 3D view read back from its framebuffer).
   QImage renderViews();
 
  private:
+  void updateJoints(bool show);  // from the Logic's live joints, or hidden
   QScopedPointer<qSlicerReposeViewsWidgetPrivate> d_ptr;
   Q_DECLARE_PRIVATE(qSlicerReposeViewsWidget)
   Q_DISABLE_COPY(qSlicerReposeViewsWidget)

@@ -12,8 +12,11 @@ REPOSE_TEST_PHANTOM_MM=4 xvfb-run -a -s "-screen 0 1600x1200x24" \
   "$BUILD_DIR/bin/qSlicerReposeViewsTest" posingThroughThePanelUpdatesTheViews
 REPOSE_TEST_PHANTOM_MM=4 xvfb-run -a -s "-screen 0 1600x1200x24" \
   "$BUILD_DIR/bin/qSlicerReposeViewsTest" ownSegmentationShowsNamedColouredLabelsAndTheProbe
+REPOSE_TEST_PHANTOM_MM=4 xvfb-run -a -s "-screen 0 1600x1200x24" \
+  "$BUILD_DIR/bin/qSlicerReposeViewsTest" bodyPartsOutlinedAndJointsDrawnWhereTheFrameMovesThem
 for f in guide_1_rig_built guide_2_part_selected guide_3_hand_moved guide_4_exported \
-  guide_own_1_open guide_own_2_rigged guide_own_3_probe guide_own_4_joint guide_own_5_exported; do
+  guide_own_1_open guide_own_2_rigged guide_own_3_probe guide_own_4_joint guide_own_5_exported \
+  parts_and_joints; do
   cp "$BUILD_DIR/Testing/Artifacts/$f.png" "$DOCS/$f.png"
 done
 if [ -f "$BUILD_DIR/demo/workbench_elbow90.png" ]; then

@@ -82,6 +82,19 @@ PoseTransform transformFrom(const py::dict& t, const PoseTransform& base) {
   if (t.contains("translation")) out.translation = t["translation"].cast<Eigen::Vector3d>();
   if (!(out.axis.norm() > 0) || !out.axis.allFinite()) throw Error("the rotation axis is zero");
   out.axis.normalize();
+  if (t.contains("then")) {  // further turns about the pivot, in order (docs/POSES.md)
+    out.then.clear();
+    for (const py::handle& item : t["then"].cast<py::list>()) {
+      const py::dict turn = item.cast<py::dict>();
+      PoseTurn u;
+      if (!turn.contains("axis")) throw Error("a turn of \"then\" needs an axis");
+      u.axis = turn["axis"].cast<Eigen::Vector3d>();
+      if (!(u.axis.norm() > 0) || !u.axis.allFinite()) throw Error("a turn's axis is zero");
+      u.axis.normalize();
+      if (turn.contains("angle_deg")) u.angleDeg = turn["angle_deg"].cast<double>();
+      out.then.push_back(u);
+    }
+  }
   return out;
 }
 
@@ -91,6 +104,14 @@ py::dict transformTo(const PoseTransform& t) {
   d["angle_deg"] = t.angleDeg;
   d["pivot"] = Eigen::Vector3d(t.pivot);
   d["translation"] = Eigen::Vector3d(t.translation);
+  py::list then;
+  for (const PoseTurn& u : t.then) {
+    py::dict turn;
+    turn["axis"] = Eigen::Vector3d(u.axis);
+    turn["angle_deg"] = u.angleDeg;
+    then.append(turn);
+  }
+  d["then"] = then;
   return d;
 }
 
@@ -171,8 +192,8 @@ set_transform; write with write.)doc")
             return transformTo(g.transform);
           },
           py::arg("group"), py::arg("keyframe") = py::none(),
-          "The group's transform {axis, angle_deg, pivot, translation} (in a keyframe, or the "
-          "base pose).")
+          "The group's transform {axis, angle_deg, pivot, translation, then} (in a keyframe, or "
+          "the base pose); then: further turns [{axis, angle_deg}] about the pivot, in order.")
       .def(
           "set_transform",
           [](Pose& p, const std::string& group, const py::object& keyframe, const py::kwargs& kw) {
@@ -191,7 +212,8 @@ set_transform; write with write.)doc")
             k->transforms.emplace_back(group, transformFrom(kw, g.transform));
           },
           py::arg("group"), py::arg("keyframe") = py::none(),
-          "Sets any of axis=, angle_deg=, pivot=, translation= of the group's transform (in a "
+          "Sets any of axis=, angle_deg=, pivot=, translation=, then= of the group's transform (in "
+          "a "
           "keyframe by index or name, or the base pose).")
       .def_property_readonly("names_joints", &poseNamesJoints,
                              "Whether a group turns about a joint named in the skeleton.")

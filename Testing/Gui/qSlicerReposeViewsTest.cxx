@@ -20,6 +20,9 @@
 #include <repose/io/AtomicOutput.h>
 #include <repose/io/VolumeIO.h>
 #include <repose/phantom/Phantom.h>
+#include <repose/pose/Skeleton.h>
+
+#include <Eigen/Geometry>
 
 #include <vtkBoxRepresentation.h>
 #include <vtkBoxWidget2.h>
@@ -37,6 +40,7 @@
 #include <QJsonObject>
 #include <QLabel>
 #include <QTableWidget>
+#include <QCheckBox>
 #include <QComboBox>
 #include <QMouseEvent>
 #include <QWheelEvent>
@@ -128,6 +132,12 @@ struct Session {
   bool show() {
     window.show();
     return QTest::qWaitForWindowExposed(&window);
+  }
+  // G opened and S (with its skeleton beside it) as the body-part map, as posing by joint needs.
+  bool openWithParts() {
+    if (!panel->setInputPath(G)) return false;
+    node->SetBodyPartMapPath(S.toStdString());
+    return true;
   }
 };
 
@@ -385,19 +395,22 @@ class qSlicerReposeViewsTest : public QObject {
     // rests on, and the panel predicts the body's volume as it goes.
     QVERIFY(panel->joints().contains("shoulder_left"));
     panel->findChild<QComboBox*>("JointComboBox")->setCurrentText("shoulder_left");
-    panel->findChild<QComboBox*>("JointAxisComboBox")->setCurrentText("abduction");
     // Built again for the joint's group (not re-prepared on the rest pose's cage, which has no
     // cut between the arm and the trunk it rests on).
-    QVERIFY2(panel->poseByJoint("shoulder_left", "abduction"), qPrintable(panel->jobStatusText()));
+    QVERIFY2(panel->poseByJoint("shoulder_left"), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
     QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
-    auto* slider = panel->findChild<QSlider*>("AngleSlider");
+    auto* slider = panel->findChild<QSlider*>("JointSlider_abduction");
+    QVERIFY(slider && slider->isVisible());
     slider->setSliderDown(true);
     for (int angle = 15; angle <= 90; angle += 15) slider->setValue(angle);
     slider->setSliderDown(false);
-    QCOMPARE(panel->activeGroupAngle(), 90.0);
+    QCOMPARE(panel->jointAngle("abduction"), 90.0);
     views->setSlicePosition(1, at.y());
     QVERIFY(panel->findChild<QLabel*>("LiveStatusLabel")->text().contains("(predicted)"));
+    // The rig in the views: S outlined over the labels, the joints in 3D (on by default).
+    panel->findChild<QCheckBox*>("ShowBodyPartsCheckBox")->setChecked(true);
+    QVERIFY(views->jointsShown().contains("shoulder_left"));
     QVERIFY(session.window.grab().save(artifact("guide_own_4_joint.png")));
     // Exported: the quality table and the plot.
     session.node->SetOutputFolder(session.dir.filePath("out").toStdString());
@@ -428,37 +441,244 @@ class qSlicerReposeViewsTest : public QObject {
              QString("hand_left"));
   }
 
-  // Posing by joint: the left shoulder's abduction picked in the Joint row builds its group (the
-  // arm's parts about the joint's named axis) and the rig; its slider, in the joint's anatomical
-  // range, dragged to 90 degrees gives the same posed volume, voxel for voxel, as the pose suite's
-  // arm_raise90.pose.json; the pose saved names the joint, so it poses any rigged body.
+  // The rig in the views: with the left elbow flexed 90 degrees by its slider, the 3D view draws
+  // every joint of the skeleton as a labelled sphere with its axes, where the frame puts it (the
+  // elbow and shoulder stay, the wrist turns about the elbow's flexion axis); "Body parts"
+  // outlines S in the slice views in its parts' colours, the forearm where it was moved to, and
+  // the probe names the part; the switches hide both again.
+  void bodyPartsOutlinedAndJointsDrawnWhereTheFrameMovesThem() {
+    Session session(phantomVoxelMm());
+    QVERIFY(session.show());
+    vtkSlicerReposeLogic* logic = session.logic;
+    qSlicerReposeModuleWidget* panel = session.panel;
+    qSlicerReposeViewsWidget* views = session.views;
+    QVERIFY(session.openWithParts());
+    QVERIFY2(panel->poseByJoint("elbow_left"), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    const repose::Skeleton skeleton =
+        repose::readSkeleton(session.dir.filePath("skeleton.json").toStdString());
+    QStringList names;
+    int axes = 0;
+    for (const repose::SkeletonJoint& j : skeleton.joints) {
+      names << QString::fromStdString(j.name);
+      axes += int(j.axes.size());
+    }
+    QCOMPARE(views->jointsShown(), names);
+    QCOMPARE(views->jointAxesShown(), axes);
+    auto shownAt = [&](const char* joint) {
+      double ras[3] = {0, 0, 0};
+      if (!views->jointShownAt(joint, ras)) qWarning("joint %s not shown", joint);
+      return Eigen::Vector3d(ras[0], ras[1], ras[2]);
+    };
+    // At rest the spheres sit on the skeleton's centres.
+    for (const repose::SkeletonJoint& j : skeleton.joints)
+      QVERIFY2((shownAt(j.name.c_str()) - j.centre).norm() < 1.0, j.name.c_str());
+
+    auto* slider = panel->findChild<QSlider*>("JointSlider_flexion");
+    QVERIFY(slider);
+    slider->setSliderDown(true);
+    for (int angle = 15; angle <= 90; angle += 15) slider->setValue(angle);
+    slider->setSliderDown(false);
+    QCOMPARE(panel->jointAngle("flexion"), 90.0);
+    const repose::SkeletonJoint& elbow = *skeleton.find("elbow_left");
+    const repose::SkeletonJoint& wrist = *skeleton.find("wrist_left");
+    const Eigen::Vector3d flexion = *elbow.axis("flexion");
+    const Eigen::Vector3d expectedWrist =
+        elbow.centre + Eigen::AngleAxisd(M_PI / 2, flexion) * (wrist.centre - elbow.centre);
+    const double forearm = (wrist.centre - elbow.centre).norm();
+    qInfo(
+        "elbow moved %.2f mm, shoulder %.2f mm, wrist %.2f mm from the turned rest wrist "
+        "(forearm %.0f mm)",
+        (shownAt("elbow_left") - elbow.centre).norm(),
+        (shownAt("shoulder_left") - skeleton.find("shoulder_left")->centre).norm(),
+        (shownAt("wrist_left") - expectedWrist).norm(), forearm);
+    QVERIFY((shownAt("elbow_left") - elbow.centre).norm() < 2.0);
+    QVERIFY((shownAt("shoulder_left") - skeleton.find("shoulder_left")->centre).norm() < 2.0);
+    QVERIFY((shownAt("wrist_left") - expectedWrist).norm() < 0.05 * forearm);
+    QVERIFY((shownAt("wrist_right") - skeleton.find("wrist_right")->centre).norm() < 2.0);
+    // The wrist's own axes turned with the forearm: its flexion axis stays the elbow's (the
+    // rotation's axis), its rotation axis along the forearm points where the forearm does now.
+    for (const auto& joint : logic->GetLiveJoints())
+      if (joint.name == "wrist_left")
+        for (const auto& [name, a] : joint.axes)
+          if (name == "rotation") {
+            const Eigen::Vector3d turned =
+                Eigen::AngleAxisd(M_PI / 2, flexion) * *wrist.axis("rotation");
+            QVERIFY2(Eigen::Vector3d(a[0], a[1], a[2]).dot(turned) > 0.95, "wrist rotation axis");
+          }
+
+    // Body parts outlined: off by default, then on from the panel.
+    qSlicerReposeSliceView* sagittal = views->sliceView(2);
+    QCOMPARE(sagittal->partAt(0, 0), -1);
+    auto* showParts = panel->findChild<QCheckBox*>("ShowBodyPartsCheckBox");
+    QVERIFY(showParts && !showParts->isChecked());
+    showParts->setChecked(true);
+    QVERIFY(session.node->GetShowBodyParts());
+    // The sagittal plane through the middle of the turned forearm.
+    const Eigen::Vector3d middle = (shownAt("elbow_left") + shownAt("wrist_left")) / 2;
+    views->setSlicePosition(2, middle.x());
+    int forearmPart = 0;
+    for (const auto& [label, name] : logic->GetLiveBodyParts())
+      if (name == "forearm_left") forearmPart = label;
+    QVERIFY(forearmPart > 0);
+    QCOMPARE(sagittal->partAtRas(middle.x(), middle.y(), middle.z()), forearmPart);
+    // Where the forearm hung at rest there is no forearm now.
+    const Eigen::Vector3d restMiddle = (elbow.centre + wrist.centre) / 2;
+    QVERIFY(sagittal->partAtRas(restMiddle.x(), restMiddle.y(), restMiddle.z()) != forearmPart);
+    // Outlines drawn in their part's colour, several parts, distinct colours.
+    std::set<int> outlined;
+    std::set<QRgb> outlineColours;
+    const QImage& image = sagittal->sliceImage();
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x)
+        if (sagittal->isPartOutline(x, y)) {
+          const int part = sagittal->partAt(x, y);
+          QCOMPARE(image.pixel(x, y), views->partColor(part).rgb());
+          outlined.insert(part);
+          outlineColours.insert(image.pixel(x, y));
+        }
+    QVERIFY2(outlined.size() >= 2 && outlined.count(forearmPart),
+             qPrintable(QString::number(outlined.size())));
+    QCOMPARE(outlineColours.size(), outlined.size());
+    // The probe names the part under the pointer.
+    const QPointF point = sagittal->widgetPointOfRas(middle.x(), middle.y(), middle.z());
+    QMouseEvent move(QEvent::MouseMove, point, Qt::NoButton, Qt::NoButton, Qt::NoModifier);
+    QApplication::sendEvent(sagittal, &move);
+    QVERIFY2(views->probeText().contains(QString("part: %1 forearm_left").arg(forearmPart)),
+             qPrintable(views->probeText()));
+    QVERIFY(session.window.grab().save(artifact("parts_and_joints.png")));
+    QVERIFY(colours(views->renderViews(), views->rect()) > 10);
+
+    // Both switched off from the panel.
+    showParts->setChecked(false);
+    QCOMPARE(sagittal->partAt(0, 0), -1);
+    auto* showJoints = panel->findChild<QCheckBox*>("ShowJointsCheckBox");
+    QVERIFY(showJoints && showJoints->isChecked());
+    showJoints->setChecked(false);
+    QVERIFY(views->jointsShown().isEmpty());
+    QCOMPARE(views->jointAxesShown(), 0);
+  }
+
+  // Joints of one limb posed together: the shoulder flexed 30 and abducted 90 degrees by its two
+  // sliders, then the elbow added (its group follows the shoulder's, which keeps the upper arm
+  // and its angles) and flexed 90: the wrist goes where the elbow's turn and then the shoulder's
+  // take it. Saved and loaded back, the pose gives the same frame.
+  void jointSlidersChainAlongTheLimb() {
+    Session session(8);
+    QVERIFY(session.show());
+    vtkSlicerReposeLogic* logic = session.logic;
+    qSlicerReposeModuleWidget* panel = session.panel;
+    qSlicerReposeViewsWidget* views = session.views;
+    QVERIFY(session.openWithParts());
+    QVERIFY2(panel->poseByJoint("shoulder_left"), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY(panel->setJointAngle("flexion", 30));
+    QVERIFY(panel->setJointAngle("abduction", 90));
+    QVERIFY2(panel->poseByJoint("elbow_left"), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QCOMPARE(QString::fromStdString(session.node->GetActiveGroup()), QString("elbow_left"));
+    QVERIFY2(panel->jointAxesShown().contains("flexion"),
+             qPrintable(panel->jointAxesShown().join(",")));
+    auto* slider = panel->findChild<QSlider*>("JointSlider_flexion");
+    QVERIFY(slider && slider->maximum() == 150);
+    slider->setSliderDown(true);
+    for (int angle = 15; angle <= 90; angle += 15) slider->setValue(angle);
+    slider->setSliderDown(false);
+    // The shoulder's sliders kept their angles.
+    session.node->SetActiveGroup("shoulder_left");
+    QCOMPARE(panel->jointAngle("flexion"), 30.0);
+    QCOMPARE(panel->jointAngle("abduction"), 90.0);
+
+    const repose::Skeleton skeleton =
+        repose::readSkeleton(session.dir.filePath("skeleton.json").toStdString());
+    const repose::SkeletonJoint& shoulder = *skeleton.find("shoulder_left");
+    const repose::SkeletonJoint& elbow = *skeleton.find("elbow_left");
+    const repose::SkeletonJoint& wrist = *skeleton.find("wrist_left");
+    auto about = [](const Eigen::Vector3d& pivot, const Eigen::Vector3d& axis, double deg) {
+      return Eigen::Translation3d(pivot) * Eigen::AngleAxisd(deg * M_PI / 180, axis) *
+             Eigen::Translation3d(-pivot);
+    };
+    // The shoulder's turns in the joint coordinate system's order (abduction, then flexion about
+    // the trunk's axis), the elbow's before them.
+    const Eigen::Isometry3d arm = about(shoulder.centre, *shoulder.axis("flexion"), 30) *
+                                  about(shoulder.centre, *shoulder.axis("abduction"), 90);
+    const Eigen::Isometry3d forearm = arm * about(elbow.centre, *elbow.axis("flexion"), 90);
+    auto shownAt = [&](const char* joint) {
+      double ras[3] = {0, 0, 0};
+      if (!views->jointShownAt(joint, ras)) qWarning("joint %s not shown", joint);
+      return Eigen::Vector3d(ras[0], ras[1], ras[2]);
+    };
+    const double forearmMm = (wrist.centre - elbow.centre).norm();
+    qInfo("elbow %.2f mm, wrist %.2f mm from the chain's; body %+.2f %% predicted",
+          (shownAt("elbow_left") - arm * elbow.centre).norm(),
+          (shownAt("wrist_left") - forearm * wrist.centre).norm(),
+          logic->GetLivePrediction().bodyChangePercent);
+    QVERIFY((shownAt("elbow_left") - arm * elbow.centre).norm() < 0.05 * forearmMm);
+    QVERIFY((shownAt("wrist_left") - forearm * wrist.centre).norm() < 0.05 * forearmMm);
+    QVERIFY((shownAt("shoulder_left") - shoulder.centre).norm() < 2.0);
+
+    // Saved by name and loaded back: the elbow follows the shoulder, the frame is the same.
+    const QString saved = session.dir.filePath("arm.pose.json");
+    QVERIFY2(panel->savePose(saved), qPrintable(panel->jobStatusText()));
+    QFile file(saved);
+    QVERIFY(file.open(QIODevice::ReadOnly));
+    const QJsonArray groups = QJsonDocument::fromJson(file.readAll()).object()["groups"].toArray();
+    bool follows = false;
+    for (const auto& g : groups)
+      follows |= g.toObject()["name"] == "elbow_left" && g.toObject()["follows"] == "shoulder_left";
+    QVERIFY(follows);
+    const Eigen::Vector3d wristBefore = shownAt("wrist_left");
+    QVERIFY(panel->setPosePath(saved));
+    QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
+    panel->waitForJobs();
+    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2((shownAt("wrist_left") - wristBefore).norm() < 1e-6,
+             qPrintable(QString::number((shownAt("wrist_left") - wristBefore).norm())));
+  }
+
+  // Posing by joint: the left shoulder picked in the Joint row builds its group (the arm's parts,
+  // a turn about each of the joint's named axes) and the rig; its abduction slider, in the
+  // joint's anatomical range, dragged to 90 degrees gives the same posed volume, voxel for voxel,
+  // as the pose suite's arm_raise90.pose.json; the pose saved names the joint and its axes, so it
+  // poses any rigged body.
   void posingByJointEqualsThePoseFile() {
     Session session(8);
     QVERIFY(session.show());
     vtkSlicerReposeLogic* logic = session.logic;
     vtkMRMLReposeParametersNode* node = session.node;
     qSlicerReposeModuleWidget* panel = session.panel;
-    QVERIFY(panel->setInputPath(session.G));
-    node->SetBodyPartMapPath(session.S.toStdString());
+    QVERIFY(session.openWithParts());
     QVERIFY2(panel->joints().contains("shoulder_left"), qPrintable(panel->joints().join(",")));
     auto* joint = panel->findChild<QComboBox*>("JointComboBox");
-    auto* axis = panel->findChild<QComboBox*>("JointAxisComboBox");
-    QVERIFY(joint && axis);
+    QVERIFY(joint);
     joint->setCurrentText("shoulder_left");
-    QVERIFY(axis->findText("abduction") >= 0 && axis->findText("flexion") >= 0);
-    axis->setCurrentText("abduction");
     panel->findChild<QPushButton*>("PoseJointButton")->click();
     panel->waitForJobs();
     QVERIFY2(logic->GetLivePose() && logic->GetLivePose() == panel->activePose(),
              qPrintable(panel->jobStatusText()));
-    QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("shoulder_left.abduction"));
-    auto* slider = panel->findChild<QSlider*>("AngleSlider");
+    QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("shoulder_left"));
+    // A slider per axis of the joint, each in its anatomical range; the Angle row gives way.
+    QVERIFY2(panel->jointAxesShown().contains("flexion") &&
+                 panel->jointAxesShown().contains("abduction"),
+             qPrintable(panel->jointAxesShown().join(",")));
+    QVERIFY(!panel->findChild<QSlider*>("AngleSlider")->isEnabled());
+    auto* slider = panel->findChild<QSlider*>("JointSlider_abduction");
+    QVERIFY(slider);
     QCOMPARE(slider->minimum(), -30);
     QCOMPARE(slider->maximum(), 180);
+    QCOMPARE(panel->findChild<QSlider*>("JointSlider_flexion")->maximum(), 180);
     slider->setSliderDown(true);
     for (int angle = 10; angle <= 90; angle += 10) slider->setValue(angle);
     slider->setSliderDown(false);
-    QCOMPARE(panel->activeGroupAngle(), 90.0);
+    QCOMPARE(panel->jointAngle("abduction"), 90.0);
+    QCOMPARE(panel->jointAngle("flexion"), 0.0);
+    // The drag is one undo step.
+    QVERIFY(logic->Undo());
+    QCOMPARE(panel->jointAngle("abduction"), 0.0);
+    QVERIFY(logic->Redo());
+    QCOMPARE(panel->jointAngle("abduction"), 90.0);
     QVERIFY(session.window.grab().save(artifact("guide_joint_slider.png")));
 
     const QString byJoint = session.dir.filePath("by_joint"),
@@ -474,9 +694,16 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(file.open(QIODevice::ReadOnly));
     const QJsonObject group =
         QJsonDocument::fromJson(file.readAll()).object()["groups"].toArray()[0].toObject();
-    QCOMPARE(group["rotation"].toObject()["axis"].toString(), QString("shoulder_left.abduction"));
-    QCOMPARE(group["rotation"].toObject()["pivot"].toString(), QString("shoulder_left"));
-    QCOMPARE(group["rotation"].toObject()["angle_deg"].toDouble(), 90.0);
+    const QJsonObject rotation = group["rotation"].toObject();
+    QCOMPARE(rotation["pivot"].toString(), QString("shoulder_left"));
+    QCOMPARE(rotation["axis"].toString(), QString("shoulder_left.rotation"));  // the first turn
+    std::map<QString, double> turns{
+        {rotation["axis"].toString(), rotation["angle_deg"].toDouble()}};
+    for (const auto& turn : rotation["then"].toArray())
+      turns[turn.toObject()["axis"].toString()] = turn.toObject()["angle_deg"].toDouble();
+    QCOMPARE(turns["shoulder_left.abduction"], 90.0);
+    QCOMPARE(turns["shoulder_left.flexion"], 0.0);
+    QCOMPARE(turns["shoulder_left.rotation"], 0.0);
 
     // The pose suite's file, built and exported the same way: the same posed labels.
     QVERIFY(panel->setPosePath(QString(REPOSE_SOURCE_DIR) + "/bench/poses/arm_raise90.pose.json"));

@@ -19,6 +19,22 @@ def test_the_suite_is_valid():
         jsonschema.validate(json.loads(path.read_text()), SCHEMA)
 
 
+def test_a_chain_of_joints_with_several_axes_is_valid():
+    # As the workbench saves a limb posed by its joints: the elbow's group follows the
+    # shoulder's, each turning about all of its joint's axes by name.
+    pose = {"format": "repose-pose", "version": 1, "name": "arm", "groups": [
+        {"name": "shoulder_left", "select": {"parts": ["upper_arm_left"]},
+         "rotation": {"axis": "shoulder_left.flexion", "angle_deg": 20, "pivot": "shoulder_left",
+                      "then": [{"axis": "shoulder_left.abduction", "angle_deg": 90},
+                               {"axis": "shoulder_left.rotation", "angle_deg": 0}]}},
+        {"name": "elbow_left", "select": {"parts": ["forearm_left", "hand_left"]},
+         "follows": "shoulder_left",
+         "rotation": {"axis": "elbow_left.flexion", "angle_deg": 90, "pivot": "elbow_left",
+                      "then": [{"axis": "elbow_left.rotation"}]}},
+        {"name": "rest", "select": {"rest": True}, "fixed": True}]}
+    jsonschema.validate(pose, SCHEMA)
+
+
 def _broken():
     base = json.loads((REPO / "bench" / "poses" / "elbow90.pose.json").read_text())
     edits = {
@@ -27,6 +43,9 @@ def _broken():
         "groups[1].colour": lambda p: p["groups"][1].update(colour="red"),
         "version": lambda p: p.update(version=2),
         "groups[0].rotation.pivot": lambda p: p["groups"][0]["rotation"].update(pivot=[1, 2]),
+        "groups[0].rotation.then[0].axis":
+            lambda p: p["groups"][0]["rotation"].update(then=[{"angle_deg": 10}]),
+        "groups[0].follows": lambda p: p["groups"][0].update(follows=7),
     }
     for field, edit in edits.items():
         pose = copy.deepcopy(base)

@@ -293,6 +293,12 @@ def test_pose_edits_move_the_frame(phantom):
     assert rp.Pose.from_json(pose.to_json()).transform("left forearm and hand")["angle_deg"] == 0
     with pytest.raises(rp.Error, match="fixed"):
         pose.set_transform("body", angle_deg=5)
+    # Further turns about the pivot survive a round trip and compose after the first.
+    pose.set_transform("left forearm and hand", then=[{"axis": [0, 0, 2], "angle_deg": 30}])
+    turned = rp.Pose.from_json(pose.to_json()).transform("left forearm and hand")
+    assert len(turned["then"]) == 1 and turned["then"][0]["angle_deg"] == 30
+    np.testing.assert_allclose(turned["then"][0]["axis"], [0, 0, 1])
+    pose.set_transform("left forearm and hand", then=[])
     rig = rp.build_rig(phantom["organs"], phantom["parts"], pose, skeleton=phantom["skeleton"])
     cage, deformed = rig.deform(0)
     # At 0 degrees the mesh stays where it was (the solve is the identity up to round-off).

@@ -127,7 +127,7 @@ struct Reader : JsonFields {
     if (j.contains("rotation")) {
       const std::string f = field.empty() ? "rotation" : field + ".rotation";
       const json& r = object(j["rotation"], f);
-      onlyKeys(r, f, {"axis", "angle_deg", "pivot"});
+      onlyKeys(r, f, {"axis", "angle_deg", "pivot", "then"});
       // Axis and pivot are numbers, or names of the skeleton's joint and axis.
       if (r.contains("axis")) {
         if (r["axis"].is_string()) {
@@ -148,6 +148,28 @@ struct Reader : JsonFields {
           t.pivotJoint.clear();
         }
       }
+      // More turns about the pivot: the list replaces the base's (keyframes give all of them).
+      if (r.contains("then")) {
+        const json& list = r["then"];
+        if (!list.is_array()) fail(f + ".then", "expected an array of turns");
+        t.then.clear();
+        for (std::size_t i = 0; i < list.size(); ++i) {
+          const std::string tf = f + ".then[" + std::to_string(i) + "]";
+          const json& turn = object(list[i], tf);
+          onlyKeys(turn, tf, {"axis", "angle_deg"});
+          if (!turn.contains("axis")) fail(tf + ".axis", "required");
+          PoseTurn u;
+          if (turn["axis"].is_string()) {
+            u.axisName = jointName(turn["axis"], tf + ".axis", true);
+          } else {
+            const Eigen::Vector3d axis = vector3(turn["axis"], tf + ".axis");
+            if (axis.norm() < 1e-9) fail(tf + ".axis", "zero vector");
+            u.axis = axis.normalized();
+          }
+          if (turn.contains("angle_deg")) u.angleDeg = number(turn["angle_deg"], tf + ".angle_deg");
+          t.then.push_back(u);
+        }
+      }
     }
     if (j.contains("translation"))
       t.translation =
@@ -161,11 +183,16 @@ json vec(const Eigen::Vector3d& v) {
 }
 
 json transformJson(const PoseTransform& t) {
-  return {{"rotation",
-           {{"axis", t.axisName.empty() ? vec(t.axis) : json(t.axisName)},
-            {"angle_deg", t.angleDeg},
-            {"pivot", t.pivotJoint.empty() ? vec(t.pivot) : json(t.pivotJoint)}}},
-          {"translation", vec(t.translation)}};
+  json rotation = {{"axis", t.axisName.empty() ? vec(t.axis) : json(t.axisName)},
+                   {"angle_deg", t.angleDeg},
+                   {"pivot", t.pivotJoint.empty() ? vec(t.pivot) : json(t.pivotJoint)}};
+  if (!t.then.empty()) {
+    rotation["then"] = json::array();
+    for (const PoseTurn& u : t.then)
+      rotation["then"].push_back({{"axis", u.axisName.empty() ? vec(u.axis) : json(u.axisName)},
+                                  {"angle_deg", u.angleDeg}});
+  }
+  return {{"rotation", rotation}, {"translation", vec(t.translation)}};
 }
 
 // Every transform of a pose with where it is, for resolving and for messages.
@@ -198,9 +225,22 @@ std::string regionToJson(const Region& r) {
   return regionJson(r).dump();
 }
 
+bool PoseTransform::namesJoints() const {
+  return !pivotJoint.empty() || !axisName.empty() ||
+         std::any_of(then.begin(), then.end(),
+                     [](const PoseTurn& u) { return !u.axisName.empty(); });
+}
+
 Eigen::Isometry3d PoseTransform::isometry() const {
-  return Eigen::Translation3d(translation + pivot) *
-         Eigen::AngleAxisd(angleDeg * M_PI / 180, axis.normalized()) * Eigen::Translation3d(-pivot);
+  // x' = R (x - pivot) + pivot + translation, R the turns in order (the first rightmost).
+  Eigen::Matrix3d R =
+      Eigen::AngleAxisd(angleDeg * M_PI / 180, axis.normalized()).toRotationMatrix();
+  for (const PoseTurn& u : then)
+    R = Eigen::AngleAxisd(u.angleDeg * M_PI / 180, u.axis.normalized()).toRotationMatrix() * R;
+  Eigen::Isometry3d m = Eigen::Isometry3d::Identity();
+  m.linear() = R;
+  m.translation() = translation + pivot - R * pivot;
+  return m;
 }
 
 bool poseNamesJoints(const Pose& pose) {
@@ -215,6 +255,10 @@ void resolvePoseJoints(Pose& pose, const Skeleton& skeleton) {
   forEachTransform(pose, [&](PoseTransform& t, const std::string& where) {
     if (!t.pivotJoint.empty()) t.pivot = skeleton.centre(t.pivotJoint, who + ", " + where);
     if (!t.axisName.empty()) t.axis = skeleton.axis(t.axisName, who + ", " + where);
+    for (PoseTurn& u : t.then) {
+      if (!u.axisName.empty()) u.axis = skeleton.axis(u.axisName, who + ", " + where);
+      u.axisName.clear();
+    }
     t.pivotJoint.clear();
     t.axisName.clear();
   });
@@ -227,6 +271,32 @@ std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> Pose::frames
                   (t.pivotJoint.empty() ? t.axisName : t.pivotJoint) +
                   "\": it needs the body's skeleton (skeleton.json beside S, or --skeleton)");
   });
+  // Who each group follows, by index (-1: nobody), checked once for every frame.
+  std::vector<int> parent(groups.size(), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (groups[g].follows.empty()) continue;
+    for (std::size_t p = 0; p < groups.size(); ++p)
+      if (groups[p].name == groups[g].follows) parent[g] = int(p);
+    if (parent[g] < 0)
+      throw Error("pose " + name + ", group \"" + groups[g].name + "\": follows no group named \"" +
+                  groups[g].follows + "\"");
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    std::size_t steps = 0;
+    for (int p = parent[g]; p >= 0; p = parent[std::size_t(p)])
+      if (++steps > groups.size() || p == int(g))
+        throw Error("pose " + name + ", group \"" + groups[g].name +
+                    "\": follows a chain of groups that comes back to it");
+  }
+  // Each group's own motion, then carried along its chain (the parent's motion after its own).
+  auto chained = [&](const std::vector<Eigen::Isometry3d>& own) {
+    std::vector<Eigen::Isometry3d> m(own.size());
+    for (std::size_t g = 0; g < own.size(); ++g) {
+      m[g] = own[g];
+      for (int p = parent[g]; p >= 0; p = parent[std::size_t(p)]) m[g] = own[std::size_t(p)] * m[g];
+    }
+    return m;
+  };
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> out;
   auto base = [&] {
     std::vector<Eigen::Isometry3d> m;
@@ -235,7 +305,7 @@ std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> Pose::frames
     return m;
   };
   if (keyframes.empty()) {
-    out.emplace_back(name, base());
+    out.emplace_back(name, chained(base()));
     return out;
   }
   for (const PoseKeyframe& k : keyframes) {
@@ -243,7 +313,7 @@ std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> Pose::frames
     for (const auto& [group, t] : k.transforms)
       for (std::size_t g = 0; g < groups.size(); ++g)
         if (groups[g].name == group) m[g] = t.isometry();
-    out.emplace_back(k.name, m);
+    out.emplace_back(k.name, chained(m));
   }
   return out;
 }
@@ -306,7 +376,7 @@ Pose parsePose(const std::string& text, const std::string& source) {
   for (std::size_t i = 0; i < j["groups"].size(); ++i) {
     const std::string f = "groups[" + std::to_string(i) + "]";
     const json& g = r.object(j["groups"][i], f);
-    r.onlyKeys(g, f, {"name", "select", "fixed", "rotation", "translation"});
+    r.onlyKeys(g, f, {"name", "select", "fixed", "follows", "rotation", "translation"});
     PoseGroup group;
     if (!g.contains("name")) r.fail(f + ".name", "required");
     group.name = r.string(g["name"], f + ".name");
@@ -322,9 +392,27 @@ Pose parsePose(const std::string& text, const std::string& source) {
     if (group.fixed && (g.contains("rotation") || g.contains("translation")))
       r.fail(f, "a fixed group has no rotation or translation");
     group.transform = r.transform(g, f, {});
+    if (g.contains("follows")) {
+      group.follows = r.string(g["follows"], f + ".follows");
+      if (group.fixed) r.fail(f + ".follows", "a fixed group stays in place: it follows nothing");
+      if (group.follows == group.name) r.fail(f + ".follows", "a group cannot follow itself");
+    }
     pose.groups.push_back(group);
   }
   if (rests > 1) r.fail("groups", "only one group can select the rest");
+  // Chains: every group followed exists, and no chain comes back to where it started.
+  for (std::size_t i = 0; i < pose.groups.size(); ++i) {
+    const std::string f = "groups[" + std::to_string(i) + "].follows";
+    std::string at = pose.groups[i].follows;
+    for (std::size_t steps = 0; !at.empty(); ++steps) {
+      const auto next = std::find_if(pose.groups.begin(), pose.groups.end(),
+                                     [&](const PoseGroup& g) { return g.name == at; });
+      if (next == pose.groups.end()) r.fail(f, "no group is named \"" + at + "\"");
+      if (next->name == pose.groups[i].name || steps > pose.groups.size())
+        r.fail(f, "the chain of groups it follows comes back to it");
+      at = next->follows;
+    }
+  }
   if (j.contains("keyframes")) {
     const json& k = j["keyframes"];
     if (!k.is_array()) r.fail("keyframes", "expected an array");
@@ -390,6 +478,7 @@ std::string poseToJson(const Pose& pose) {
       select["parts"] = parts;
     }
     json group = {{"name", g.name}, {"select", select}};
+    if (!g.follows.empty()) group["follows"] = g.follows;
     if (g.fixed) {
       group["fixed"] = true;
     } else {
@@ -445,6 +534,126 @@ PoseGroup jointGroup(const Skeleton& skeleton, const std::string& joint, const s
   return g;
 }
 
+namespace {
+// Whether `joint` lies below `ancestor` in the skeleton's tree.
+bool jointBelow(const Skeleton& skeleton, const std::string& joint, const std::string& ancestor) {
+  const SkeletonJoint* j = skeleton.find(joint);
+  std::size_t steps = 0;
+  for (const SkeletonJoint* up = j ? skeleton.find(j->parent) : nullptr;
+       up && steps <= skeleton.joints.size(); up = skeleton.find(up->parent), ++steps)
+    if (up->name == ancestor) return true;
+  return false;
+}
+}  // namespace
+
+std::vector<std::string> jointTurnAxes(const SkeletonJoint& joint) {
+  auto rank = [](const std::string& axis) {
+    return axis == "rotation" ? 0 : axis == "flexion" ? 2 : 1;  // abduction, lateral, others: 1
+  };
+  std::vector<std::string> axes;
+  for (const auto& [name, v] : joint.axes) axes.push_back(name);
+  std::stable_sort(axes.begin(), axes.end(),
+                   [&](const std::string& a, const std::string& b) { return rank(a) < rank(b); });
+  return axes;
+}
+
+std::string setJointGroup(Pose& pose, const Skeleton& skeleton, const std::string& joint,
+                          const LabelTable& partLabels) {
+  skeleton.centre(joint, "joint group " + joint);  // throws naming the joints there are
+  const SkeletonJoint& j = *skeleton.find(joint);
+  if (j.axes.empty()) throw Error(skeleton.source + ": joint " + joint + " has no axes");
+  if (jointDistalParts(skeleton, joint).empty())
+    throw Error(skeleton.source + ": joint " + joint +
+                " names no distal body part (\"parts\" in skeleton.json): cannot pose by it");
+  // The new group: a turn per axis, by name (the rig resolves them); angles kept from a group
+  // of this joint already there (its turns in the same order, or its one named axis).
+  const std::vector<std::string> axes = jointTurnAxes(j);
+  PoseGroup group;
+  group.name = joint;
+  group.transform.pivotJoint = joint;
+  std::vector<double> angles(axes.size(), 0.0);
+  for (const PoseGroup& g : pose.groups) {
+    if (g.fixed || jointOfGroup(skeleton, g.name) != joint) continue;
+    if (g.name == joint) {
+      angles[0] = g.transform.angleDeg;
+      for (std::size_t k = 0; k < g.transform.then.size() && k + 1 < angles.size(); ++k)
+        angles[k + 1] = g.transform.then[k].angleDeg;
+    } else {
+      for (std::size_t k = 0; k < axes.size(); ++k)
+        if (joint + "." + axes[k] == g.name) angles[k] = g.transform.angleDeg;
+    }
+  }
+  group.transform.axisName = joint + "." + axes[0];
+  group.transform.angleDeg = angles[0];
+  for (std::size_t k = 1; k < axes.size(); ++k)
+    group.transform.then.push_back({Eigen::Vector3d::UnitX(), angles[k], joint + "." + axes[k]});
+
+  // Groups that give way: this joint's own, and any group not of a joint that selects a part
+  // the joint moves (by name, or by label through S's table).
+  const std::vector<std::string> moved = jointDistalParts(skeleton, joint);
+  auto selectsMoved = [&](const PoseGroup& g) {
+    for (const std::string& n : g.select.partNames)
+      if (std::find(moved.begin(), moved.end(), n) != moved.end()) return true;
+    for (const int label : g.select.parts)
+      if (const Label* l = partLabels.find(label);
+          l && std::find(moved.begin(), moved.end(), l->name) != moved.end())
+        return true;
+    return false;
+  };
+  std::set<std::string> removed;
+  for (const PoseGroup& g : pose.groups) {
+    if (g.select.rest) continue;
+    const std::string of = jointOfGroup(skeleton, g.name);
+    if (of == joint || (of.empty() && selectsMoved(g))) removed.insert(g.name);
+  }
+  pose.groups.erase(std::remove_if(pose.groups.begin(), pose.groups.end(),
+                                   [&](const PoseGroup& g) { return removed.count(g.name) > 0; }),
+                    pose.groups.end());
+  for (PoseKeyframe& k : pose.keyframes)
+    k.transforms.erase(std::remove_if(k.transforms.begin(), k.transforms.end(),
+                                      [&](const auto& e) { return removed.count(e.first) > 0; }),
+                       k.transforms.end());
+  for (PoseGroup& g : pose.groups)
+    if (removed.count(g.follows)) g.follows.clear();
+  // Before the rest group, as the pose suite's files order them; a fixed rest if there is none.
+  const auto rest = std::find_if(pose.groups.begin(), pose.groups.end(),
+                                 [](const PoseGroup& g) { return g.select.rest; });
+  pose.groups.insert(rest, group);
+  if (std::none_of(pose.groups.begin(), pose.groups.end(),
+                   [](const PoseGroup& g) { return g.select.rest; })) {
+    PoseGroup still;
+    still.name = "rest";
+    still.select.rest = true;
+    still.fixed = true;
+    pose.groups.push_back(still);
+  }
+  // The chain, for every joint group: its joint's distal parts less those of the joint groups
+  // below it, carried by the nearest joint group above it.
+  std::vector<std::pair<PoseGroup*, std::string>> joints;
+  for (PoseGroup& g : pose.groups)
+    if (!g.fixed && !g.select.rest)
+      if (const std::string of = jointOfGroup(skeleton, g.name); !of.empty())
+        joints.emplace_back(&g, of);
+  for (auto& [g, of] : joints) {
+    std::vector<std::string> parts = jointDistalParts(skeleton, of);
+    std::string above;
+    for (const auto& [other, otherJoint] : joints) {
+      if (jointBelow(skeleton, otherJoint, of)) {
+        for (const std::string& p : jointDistalParts(skeleton, otherJoint))
+          parts.erase(std::remove(parts.begin(), parts.end(), p), parts.end());
+      } else if (jointBelow(skeleton, of, otherJoint) &&
+                 (above.empty() ||
+                  jointBelow(skeleton, otherJoint, jointOfGroup(skeleton, above)))) {
+        above = other->name;  // the nearest: below every other joint group above
+      }
+    }
+    g->select = PoseSelection{};
+    g->select.partNames = parts;
+    g->follows = above;
+  }
+  return group.name;
+}
+
 std::pair<double, double> jointRangeDeg(const std::string& joint, const std::string& axis) {
   // Active ranges of motion of a healthy adult (clinical goniometry), rounded out; the sign is
   // the skeleton's (docs/POSES.md: positive flexion flexes, positive abduction moves away from
@@ -470,22 +679,30 @@ std::pair<double, double> jointRangeDeg(const std::string& joint, const std::str
   return {-180, 180};
 }
 
+std::string jointOfGroup(const Skeleton& skeleton, const std::string& group) {
+  const std::size_t dot = group.find('.');
+  const SkeletonJoint* j = skeleton.find(group.substr(0, dot));
+  if (!j) return "";
+  if (dot == std::string::npos) return j->name;
+  return j->axis(group.substr(dot + 1)) ? j->name : "";
+}
+
 void nameJointGroups(Pose& pose, const Skeleton& skeleton) {
-  auto named = [&](const std::string& group) -> std::string {
-    const std::size_t dot = group.find('.');
-    if (dot == std::string::npos) return "";
-    const SkeletonJoint* j = skeleton.find(group.substr(0, dot));
-    if (!j) return "";
-    const std::string axis = group.substr(dot + 1);
-    for (const auto& [name, v] : j->axes)
-      if (name == axis) return j->name;
+  // A turn's axis by the name of the joint's axis it equals (it was resolved from that name).
+  auto axisName = [](const SkeletonJoint& j, const Eigen::Vector3d& axis) -> std::string {
+    for (const auto& [name, v] : j.axes)
+      if (v.normalized().dot(axis.normalized()) > 1 - 1e-9) return j.name + "." + name;
     return "";
   };
   auto name = [&](PoseTransform& t, const std::string& group) {
-    const std::string joint = named(group);
+    const std::string joint = jointOfGroup(skeleton, group);
     if (joint.empty()) return;
+    const SkeletonJoint& j = *skeleton.find(joint);
     t.pivotJoint = joint;
-    t.axisName = group;
+    // "<joint>.<axis>": the axis its name gives; "<joint>": each turn's by its direction.
+    if (t.axisName.empty()) t.axisName = group != joint ? group : axisName(j, t.axis);
+    for (PoseTurn& u : t.then)
+      if (u.axisName.empty()) u.axisName = axisName(j, u.axis);
   };
   for (PoseGroup& g : pose.groups)
     if (!g.fixed) name(g.transform, g.name);

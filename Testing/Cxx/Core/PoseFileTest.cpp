@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <filesystem>
 
 using namespace repose;
@@ -212,4 +214,197 @@ TEST(PoseFile, JointGroupsSelectTheDistalPartsAndNameTheirJointWhenWritten) {
   EXPECT_EQ(repose::jointRangeDeg("elbow_left", "flexion"), std::make_pair(0.0, 150.0));
   EXPECT_EQ(repose::jointRangeDeg("shoulder_right", "abduction"), std::make_pair(-30.0, 180.0));
   EXPECT_EQ(repose::jointRangeDeg("tail", "wag"), std::make_pair(-180.0, 180.0));
+}
+
+// Several turns about one pivot ("then"): applied in order about the rest axes; written and read
+// back the same; keyframes replace the list.
+TEST(PoseFile, TurnsComposeInOrderAboutThePivotAndSurviveARoundTrip) {
+  const std::string text = R"({"format":"repose-pose","version":1,"name":"t","groups":[
+    {"name":"arm","select":{"parts":[4]},
+     "rotation":{"axis":[0,0,1],"angle_deg":90,"pivot":[1,2,3],
+                 "then":[{"axis":[1,0,0],"angle_deg":90},{"axis":[0,1,0]}]}},
+    {"name":"body","select":{"rest":true},"fixed":true}]})";
+  const Pose pose = parsePose(text, "t");
+  ASSERT_EQ(pose.groups[0].transform.then.size(), 2u);
+  EXPECT_EQ(pose.groups[0].transform.then[1].angleDeg, 0);  // an angle left out is 0
+  const auto frames = pose.frames();
+  // (2,2,3): about z through the pivot to (1,3,3), then about x through it to (1,2,4).
+  EXPECT_LT((frames[0].second[0] * Eigen::Vector3d(2, 2, 3) - Eigen::Vector3d(1, 2, 4)).norm(),
+            1e-12);
+  // A keyframe's list replaces the base's: empty, the first turn only.
+  std::string keyed = text;
+  keyed.insert(keyed.size() - 1,
+               R"(,"keyframes":[{"name":"k","groups":{"arm":{"rotation":{"then":[]}}}}])");
+  const auto keyedFrames = parsePose(keyed, "k").frames();
+  ASSERT_EQ(keyedFrames.size(), 1u);
+  EXPECT_LT((keyedFrames[0].second[0] * Eigen::Vector3d(2, 2, 3) - Eigen::Vector3d(1, 3, 3)).norm(),
+            1e-12);
+  const Pose again = parsePose(poseToJson(pose), "again");
+  EXPECT_EQ(poseToJson(again), poseToJson(pose));
+  EXPECT_TRUE(again.frames()[0].second[0].isApprox(frames[0].second[0]));
+  // Bad turns are refused by field.
+  auto error = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    t.replace(t.find(from), from.size(), to);
+    return errorOf(t);
+  };
+  EXPECT_EQ(error(R"({"axis":[0,1,0]})", R"({"angle_deg":3})")
+                .rfind("p.json: groups[0].rotation.then[1].axis: required", 0),
+            0u);
+  EXPECT_EQ(error(R"({"axis":[0,1,0]})", R"({"axis":[0,0,0]})")
+                .rfind("p.json: groups[0].rotation.then[1].axis: zero", 0),
+            0u);
+  EXPECT_EQ(error(R"([{"axis":[1,0,0],"angle_deg":90},{"axis":[0,1,0]}])", R"({"a":1})")
+                .rfind("p.json: groups[0].rotation.then: expected an array", 0),
+            0u);
+}
+
+// A chain: a group that follows another moves by its own transform, then by the other's motion
+// (the forearm turned at the elbow goes where the shoulder takes the upper arm); unknown groups,
+// cycles and fixed followers are refused.
+TEST(PoseFile, AGroupThatFollowsAnotherIsCarriedByItsMotion) {
+  const std::string text = R"({"format":"repose-pose","version":1,"name":"c","groups":[
+    {"name":"forearm","select":{"parts":[5]},"follows":"upper",
+     "rotation":{"axis":[0,1,0],"angle_deg":90,"pivot":[0,0,-30]}},
+    {"name":"upper","select":{"parts":[4]},
+     "rotation":{"axis":[1,0,0],"angle_deg":90,"pivot":[0,0,0]},"translation":[5,0,0]},
+    {"name":"body","select":{"rest":true},"fixed":true}]})";
+  const Pose pose = parsePose(text, "c");
+  const auto m = pose.frames()[0].second;
+  const Eigen::Isometry3d own = pose.groups[0].transform.isometry();
+  EXPECT_TRUE(m[0].isApprox(m[1] * own));
+  // The wrist at (0,0,-60): about the elbow's y to (-30,0,-30), then the shoulder's x to
+  // (-30,30,0), then +5 in x.
+  EXPECT_LT((m[0] * Eigen::Vector3d(0, 0, -60) - Eigen::Vector3d(-25, 30, 0)).norm(), 1e-12);
+  EXPECT_EQ(poseToJson(parsePose(poseToJson(pose), "again")), poseToJson(pose));
+  auto error = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    t.replace(t.find(from), from.size(), to);
+    return errorOf(t);
+  };
+  EXPECT_EQ(error(R"("follows":"upper")", R"("follows":"uper")")
+                .rfind("p.json: groups[0].follows: no group is named \"uper\"", 0),
+            0u);
+  EXPECT_EQ(error(R"("follows":"upper")", R"("follows":"forearm")")
+                .rfind("p.json: groups[0].follows: a group cannot follow itself", 0),
+            0u);
+  EXPECT_EQ(error(R"("select":{"parts":[4]},)", R"("select":{"parts":[4]},"follows":"forearm",)")
+                .rfind("p.json: groups[0].follows: the chain", 0),
+            0u);
+  EXPECT_EQ(error(R"("fixed":true)", R"("fixed":true,"follows":"upper")")
+                .rfind("p.json: groups[2].follows: a fixed group", 0),
+            0u);
+  // Built in code, a cycle is refused by frames() too.
+  Pose cycle = pose;
+  cycle.groups[1].follows = "forearm";
+  EXPECT_THROW(cycle.frames(), Error);
+}
+
+// Posing several joints of a limb at once: each joint's group turns about all its axes, the
+// shoulder's keeps the upper arm and carries the elbow's (forearm and hand), whichever is set
+// first; angles survive setting a joint again; a part's group gives way; the written pose names
+// every joint and axis and poses like the numbers.
+TEST(PoseFile, JointGroupsChainAlongTheLimbAndTurnAboutEveryAxis) {
+  repose::PhantomOptions po;
+  po.voxelMm = 8;
+  const Skeleton skeleton = parseSkeleton(Phantom(po).skeletonJson(), "skeleton.json");
+  LabelTable parts;
+  Label handLabel;
+  handLabel.value = 7;
+  handLabel.name = "hand_left";
+  parts.set(handLabel);
+  using Parts = std::vector<std::string>;
+  auto group = [](const Pose& p, const std::string& name) -> const PoseGroup& {
+    for (const PoseGroup& g : p.groups)
+      if (g.name == name) return g;
+    throw Error("no group " + name);
+  };
+  for (const bool elbowFirst : {false, true}) {
+    Pose pose;
+    pose.name = "chain";
+    PoseGroup hand;  // a part's group on the hand: the elbow's group takes the hand over
+    hand.name = "hand";
+    hand.select.parts = {7};
+    pose.groups.push_back(hand);
+    const std::vector<std::string> order =
+        elbowFirst ? std::vector<std::string>{"elbow_left", "shoulder_left"}
+                   : std::vector<std::string>{"shoulder_left", "elbow_left"};
+    for (const std::string& joint : order)
+      EXPECT_EQ(setJointGroup(pose, skeleton, joint, parts), joint);
+    ASSERT_EQ(pose.groups.size(), 3u) << poseToJson(pose);  // shoulder, elbow, rest
+    EXPECT_EQ(group(pose, "shoulder_left").select.partNames, Parts{"upper_arm_left"});
+    EXPECT_EQ(group(pose, "elbow_left").select.partNames, (Parts{"forearm_left", "hand_left"}));
+    EXPECT_EQ(group(pose, "elbow_left").follows, "shoulder_left");
+    EXPECT_EQ(group(pose, "shoulder_left").follows, "");
+    EXPECT_TRUE(group(pose, "rest").fixed);
+    // A turn per axis, named.
+    const SkeletonJoint& shoulder = *skeleton.find("shoulder_left");
+    const PoseTransform& t = group(pose, "shoulder_left").transform;
+    ASSERT_EQ(t.then.size() + 1, shoulder.axes.size());
+    EXPECT_EQ(t.pivotJoint, "shoulder_left");
+    // The limb's rotation first, flexion last, whatever order the file lists them in.
+    EXPECT_EQ(t.axisName, "shoulder_left.rotation");
+    EXPECT_EQ(t.then.back().axisName, "shoulder_left.flexion");
+    EXPECT_EQ(jointTurnAxes(shoulder), (Parts{"rotation", "abduction", "flexion"}));
+  }
+  // Resolved and posed: abduction 90 at the shoulder, flexion 90 at the elbow.
+  Pose pose;
+  pose.name = "chain";
+  setJointGroup(pose, skeleton, "shoulder_left", parts);
+  setJointGroup(pose, skeleton, "elbow_left", parts);
+  Pose resolved = pose;
+  resolvePoseJoints(resolved, skeleton);
+  const SkeletonJoint& shoulder = *skeleton.find("shoulder_left");
+  const SkeletonJoint& elbow = *skeleton.find("elbow_left");
+  const SkeletonJoint& wrist = *skeleton.find("wrist_left");
+  auto axisIndex = [](const SkeletonJoint& j, const std::string& axis) {
+    const std::vector<std::string> axes = jointTurnAxes(j);
+    return std::size_t(std::find(axes.begin(), axes.end(), axis) - axes.begin());
+  };
+  auto setAngle = [](PoseGroup& g, std::size_t k, double angle) {
+    (k == 0 ? g.transform.angleDeg : g.transform.then[k - 1].angleDeg) = angle;
+  };
+  for (PoseGroup& g : resolved.groups) {
+    if (g.name == "shoulder_left") setAngle(g, axisIndex(shoulder, "abduction"), 90);
+    if (g.name == "elbow_left") setAngle(g, axisIndex(elbow, "flexion"), 90);
+  }
+  const auto m = resolved.frames()[0].second;
+  const Eigen::Isometry3d abduct = Eigen::Translation3d(shoulder.centre) *
+                                   Eigen::AngleAxisd(M_PI / 2, *shoulder.axis("abduction")) *
+                                   Eigen::Translation3d(-shoulder.centre);
+  const Eigen::Isometry3d flex = Eigen::Translation3d(elbow.centre) *
+                                 Eigen::AngleAxisd(M_PI / 2, *elbow.axis("flexion")) *
+                                 Eigen::Translation3d(-elbow.centre);
+  EXPECT_LT((m[1] * wrist.centre - abduct * (flex * wrist.centre)).norm(), 1e-9);
+  EXPECT_LT((m[1] * elbow.centre - abduct * elbow.centre).norm(), 1e-9);
+  // Named again: the same as built by name, angles aside; setting a joint again keeps them.
+  Pose named = resolved;
+  nameJointGroups(named, skeleton);
+  EXPECT_FALSE(named.groups[0].transform.pivotJoint.empty());
+  EXPECT_EQ(named.groups[1].transform.axisName, pose.groups[1].transform.axisName);
+  for (std::size_t k = 0; k < named.groups[0].transform.then.size(); ++k)
+    EXPECT_EQ(named.groups[0].transform.then[k].axisName,
+              pose.groups[0].transform.then[k].axisName);
+  setJointGroup(named, skeleton, "elbow_left", parts);
+  Pose again = named;
+  resolvePoseJoints(again, skeleton);
+  EXPECT_TRUE(again.frames()[0].second[1].isApprox(m[1], 1e-12));
+  // The single-axis form of a joint becomes the joint's group, with its angle.
+  Pose single;
+  single.groups.push_back(jointGroup(skeleton, "elbow_left", "flexion", 40));
+  setJointGroup(single, skeleton, "elbow_left", parts);
+  EXPECT_EQ(
+      group(single, "elbow_left").transform.angleDeg +
+          [&] {
+            double sum = 0;
+            for (const PoseTurn& u : group(single, "elbow_left").transform.then) sum += u.angleDeg;
+            return sum;
+          }(),
+      40);
+  EXPECT_THROW(group(single, "elbow_left.flexion"), Error);
+  EXPECT_THROW(setJointGroup(single, skeleton, "tail", parts), Error);
+  EXPECT_EQ(jointOfGroup(skeleton, "elbow_left.flexion"), "elbow_left");
+  EXPECT_EQ(jointOfGroup(skeleton, "elbow_left"), "elbow_left");
+  EXPECT_EQ(jointOfGroup(skeleton, "elbow_left.abduction"), "");
+  EXPECT_EQ(jointOfGroup(skeleton, "group 1"), "");
 }

@@ -16,6 +16,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <chrono>
 
 #include <vtkNew.h>
@@ -353,4 +356,106 @@ TEST(vtkSlicerReposeLogicLive, RefiningForTheFrameAndAddingASeparation) {
   EXPECT_FALSE(logic->AddPoseSeparation(pose, "torso", "torso", "sphere:0,0,0,10"));
   ASSERT_TRUE(logic->Undo());
   EXPECT_EQ(separations(), 0u);
+}
+
+// Posing by joint through the Logic: the shoulder's and then the elbow's groups chain (the
+// elbow's follows the shoulder's, the shoulder's keeps the upper arm), each with a turn per axis;
+// the shoulder's abduction set to 90 degrees carries the elbow's group and the wrist's joint with
+// it, undo takes it back; a several-axis group is not moved by a matrix. A follower moved by the
+// transform widget keeps the motion it is given, its own transform being what is left after the
+// group it follows.
+TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
+  const PhantomFolder phantom("live-joints");
+  vtkNew<vtkSlicerReposeLogic> logic;
+  auto* seg = logic->AddSegmentation(phantom.G, phantom.S);
+  ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
+  auto* pose = logic->NewPose("joints");
+  ASSERT_TRUE(pose);
+  ASSERT_EQ(logic->SetPoseJoint(pose, phantom.S, "shoulder_left"), "shoulder_left")
+      << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->SetPoseJoint(pose, phantom.S, "elbow_left"), "elbow_left");
+  EXPECT_EQ(logic->SetPoseJoint(pose, phantom.S, "tail"), "");
+  EXPECT_NE(logic->GetLastErrorMessage().find("tail"), std::string::npos);
+  const auto joints = vtkSlicerReposeLogic::GetJointsBeside(phantom.S);
+  const auto shoulder = std::find_if(joints.begin(), joints.end(),
+                                     [](const auto& j) { return j.name == "shoulder_left"; });
+  ASSERT_NE(shoulder, joints.end());
+  const auto turns = logic->GetPoseGroupTurns(pose, "shoulder_left");
+  ASSERT_EQ(turns.size(), shoulder->axes.size());
+  for (std::size_t k = 0; k < turns.size(); ++k)  // named until the rig resolves them
+    EXPECT_EQ(turns[k].axisName, "shoulder_left." + shoulder->axes[k]);
+  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  if (logic->GetLivePose() != pose) {
+    ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
+    ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  }
+  ASSERT_EQ(logic->GetLivePose(), pose);
+  auto jointAt = [&](const std::string& name) {
+    for (const auto& j : logic->GetLiveJoints())
+      if (j.name == name) return Eigen::Vector3d(j.centre[0], j.centre[1], j.centre[2]);
+    ADD_FAILURE() << "no joint " << name;
+    return Eigen::Vector3d(0, 0, 0);
+  };
+  const Eigen::Vector3d wristRest = jointAt("wrist_left");
+  const std::size_t abduction =
+      std::size_t(std::find(shoulder->axes.begin(), shoulder->axes.end(), "abduction") -
+                  shoulder->axes.begin());
+  ASSERT_LT(abduction, shoulder->axes.size());
+  EXPECT_FALSE(logic->SetPoseGroupTurnAngle(pose, "shoulder_left", 9, 10));
+  ASSERT_TRUE(logic->SetPoseGroupTurnAngle(pose, "shoulder_left", int(abduction), 90))
+      << logic->GetLastErrorMessage();
+  EXPECT_EQ(logic->GetPoseGroupTurns(pose, "shoulder_left")[abduction].angleDeg, 90);
+  // The elbow's group (its own turns at 0) moves with the shoulder's.
+  vtkNew<vtkMatrix4x4> shoulderMotion, elbowMotion;
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, "shoulder_left", shoulderMotion));
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, "elbow_left", elbowMotion));
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      EXPECT_NEAR(elbowMotion->GetElement(i, j), shoulderMotion->GetElement(i, j), 1e-9);
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) m(i, j) = shoulderMotion->GetElement(i, j);
+  const Eigen::Vector3d wristExpected = (m * wristRest.homogeneous()).head<3>();
+  EXPECT_LT((jointAt("wrist_left") - wristExpected).norm(), 1.0);
+  EXPECT_GT((jointAt("wrist_left") - wristRest).norm(), 100.0);
+  EXPECT_FALSE(logic->SetPoseGroupMatrix(pose, "shoulder_left", shoulderMotion));
+  EXPECT_NE(logic->GetLastErrorMessage().find("several axes"), std::string::npos);
+  ASSERT_TRUE(logic->Undo());
+  EXPECT_LT((jointAt("wrist_left") - wristRest).norm(), 1.0);
+
+  // A chain of single-axis groups in a pose file: the widget's matrix is the follower's motion.
+  const std::string chain = phantom.dir.file("chain.pose.json");
+  repose::writeTextFileAtomically(chain, R"({"format":"repose-pose","version":1,"name":"chain",
+    "groups":[
+      {"name":"upper","select":{"parts":["upper_arm_left"]},
+       "rotation":{"axis":[0,1,0],"angle_deg":40,"pivot":[-148,0,1030]}},
+      {"name":"lower","select":{"parts":["forearm_left","hand_left"]},"follows":"upper",
+       "rotation":{"axis":[1,0,0],"angle_deg":20,"pivot":[-176,-14,806]}},
+      {"name":"rest","select":{"rest":true},"fixed":true}]})");
+  auto* chained = logic->AddPose(chain);
+  ASSERT_TRUE(chained) << logic->GetLastErrorMessage();
+  vtkNew<vtkMatrix4x4> upper, lower;
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "upper", upper));
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "lower", lower));
+  const repose::Pose parsed = repose::readPoseFile(chain);
+  const Eigen::Matrix4d expectedLower =
+      (parsed.groups[0].transform.isometry() * parsed.groups[1].transform.isometry()).matrix();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) EXPECT_NEAR(lower->GetElement(i, j), expectedLower(i, j), 1e-9);
+  vtkNew<vtkTransform> drag;  // the widget: the lower arm's motion, then 30 mm up
+  drag->PostMultiply();
+  drag->SetMatrix(lower);
+  drag->Translate(0, 0, 30);
+  ASSERT_TRUE(logic->SetPoseGroupMatrix(chained, "lower", drag->GetMatrix()))
+      << logic->GetLastErrorMessage();
+  vtkNew<vtkMatrix4x4> after, upperAfter;
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "lower", after));
+  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "upper", upperAfter));
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      EXPECT_NEAR(after->GetElement(i, j), drag->GetMatrix()->GetElement(i, j), 1e-9);
+      EXPECT_NEAR(upperAfter->GetElement(i, j), upper->GetElement(i, j), 1e-12);
+    }
 }

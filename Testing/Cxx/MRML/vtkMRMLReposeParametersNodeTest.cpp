@@ -43,6 +43,8 @@ void fillNonDefault(vtkMRMLReposeParametersNode* node) {
   node->SetSelectedCageVertices({12, 3, 7, 3});
   node->SetSelectedBodyPart(5);
   node->SetLabelOpacity(0.35);
+  node->SetShowBodyParts(true);
+  node->SetShowJoints(false);
 }
 
 void expectEqualFields(vtkMRMLReposeParametersNode* a, vtkMRMLReposeParametersNode* b) {
@@ -61,6 +63,8 @@ void expectEqualFields(vtkMRMLReposeParametersNode* a, vtkMRMLReposeParametersNo
   EXPECT_EQ(a->GetSelectedCageVertices(), b->GetSelectedCageVertices());
   EXPECT_EQ(a->GetSelectedBodyPart(), b->GetSelectedBodyPart());
   EXPECT_EQ(a->GetLabelOpacity(), b->GetLabelOpacity());
+  EXPECT_EQ(a->GetShowBodyParts(), b->GetShowBodyParts());
+  EXPECT_EQ(a->GetShowJoints(), b->GetShowJoints());
 }
 
 const char* const kFieldNames[] = {"InputSegmentationNodeID",
@@ -77,7 +81,9 @@ const char* const kFieldNames[] = {"InputSegmentationNodeID",
                                    "ActiveGroup",
                                    "SelectedCageVertices",
                                    "SelectedBodyPart",
-                                   "LabelOpacity"};
+                                   "LabelOpacity",
+                                   "ShowBodyParts",
+                                   "ShowJoints"};
 
 }  // namespace
 
@@ -87,6 +93,8 @@ TEST(vtkMRMLReposeParametersNode, DefaultsAndSetGet) {
   EXPECT_EQ(node->GetCageDilationMm(), 10.0);
   EXPECT_EQ(node->GetTransferMeshSizeMm(), 0.0);
   EXPECT_EQ(node->GetOutputMemoryBudgetMB(), 0);  // automatic: half the physical memory
+  EXPECT_FALSE(node->GetShowBodyParts());         // the labels alone until asked
+  EXPECT_TRUE(node->GetShowJoints());
   EXPECT_TRUE(node->GetInputSegmentationPath().empty());
   fillNonDefault(node);
   EXPECT_EQ(node->GetInputSegmentationNodeID(), "vtkMRMLSegmentationNode1");
@@ -207,6 +215,8 @@ TEST(vtkMRMLReposeParametersNode, ReadJsonPartialClampsAndRejectsBadInput) {
   EXPECT_FALSE(node->ReadJSON(R"({"ImagePath": "c", "CageVertexCount": "many"})", &error));
   EXPECT_NE(error.find("CageVertexCount"), std::string::npos) << error;
   EXPECT_FALSE(node->ReadJSON(R"({"CageVertexCount": 3.5})", &error));
+  EXPECT_FALSE(node->ReadJSON(R"({"ShowJoints": 1})", &error));  // a switch is true or false
+  EXPECT_NE(error.find("ShowJoints"), std::string::npos) << error;
   EXPECT_FALSE(node->ReadJSON(R"({"SelectedCageVertices": [1, "two"]})", &error));
   EXPECT_NE(error.find("SelectedCageVertices"), std::string::npos) << error;
   EXPECT_FALSE(node->ReadJSON(R"({"ImagePath": "c", "CageVertexCont": 7})", &error));

@@ -28,6 +28,13 @@ struct PoseSelection {
   bool rest = false;                   // every cage vertex and part no other group selects
 };
 
+// A further turn of a transform about the same pivot (PoseTransform::then).
+struct PoseTurn {
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // unit length
+  double angleDeg = 0;
+  std::string axisName;  // a joint's axis by name ("shoulder_left.abduction") until resolved
+};
+
 struct PoseTransform {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();  // unit length
   double angleDeg = 0;
@@ -37,7 +44,11 @@ struct PoseTransform {
   // one of its axes ("elbow_left.flexion"). resolvePoseJoints turns them into pivot and axis and
   // clears them; until then the transform has no motion (Pose::frames throws).
   std::string pivotJoint, axisName;
-  bool namesJoints() const { return !pivotJoint.empty() || !axisName.empty(); }
+  // More turns about the same pivot ("then" in the pose file), each applied after the one before
+  // it, about its axis as given (the rest body's axes, not turned by the earlier turns): a joint
+  // moved about several of its axes at once, flexion then abduction then rotation.
+  std::vector<PoseTurn> then;
+  bool namesJoints() const;
   Eigen::Isometry3d isometry() const;
 };
 
@@ -46,6 +57,10 @@ struct PoseGroup {
   PoseSelection select;
   bool fixed = false;       // stays in place (its transform is the identity)
   PoseTransform transform;  // the pose's transform when there are no keyframes
+  // The group this one is carried by, "" for none: its motion is this group's own transform
+  // followed by that group's motion (a chain of joints: the forearm turns at the elbow and goes
+  // where the shoulder takes the upper arm). No cycles; a fixed group follows nothing.
+  std::string follows;
 };
 
 struct PoseKeyframe {
@@ -66,8 +81,10 @@ struct Pose {
   std::vector<PoseSeparation> separations;
   std::vector<PoseGroup> groups;
   std::vector<PoseKeyframe> keyframes;
-  // One frame per keyframe (groups it does not name keep their base transform), or the base.
-  // Throws repose::Error when a transform still names a joint (resolvePoseJoints first).
+  // One frame per keyframe (groups it does not name keep their base transform), or the base;
+  // each group's motion composed along its chain of `follows`. Throws repose::Error when a
+  // transform still names a joint (resolvePoseJoints first), or for a group that follows an
+  // unknown group or itself round a cycle.
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames() const;
 };
 
@@ -91,10 +108,34 @@ std::vector<std::string> jointDistalParts(const Skeleton& skeleton, const std::s
 // as clinical goniometry tables give them, rounded out), for the workbench's joint sliders:
 // e.g. elbow flexion 0..150, shoulder abduction -30..180; -180..180 for an unknown pair.
 std::pair<double, double> jointRangeDeg(const std::string& joint, const std::string& axis);
-// The inverse of resolving for joint groups: every group named "<joint>.<axis>" of the skeleton
-// gets its pivot and axis back as names (in its base transform and keyframes), so the pose file
-// written poses any rigged body.
+// The inverse of resolving for joint groups: every group named "<joint>.<axis>" or "<joint>" of
+// the skeleton gets its pivot back as the joint's name and each turn's axis as the name of the
+// joint's axis it equals (in its base transform and keyframes), so the pose file written poses
+// any rigged body.
 void nameJointGroups(Pose& pose, const Skeleton& skeleton);
+
+// Posing a limb by its joints, several at once. Adds (or keeps) the group named `joint` that
+// turns the joint about every axis of the skeleton's joint (a turn per axis in jointTurnAxes'
+// order, "then" after the first; angles 0 for a new group) and fits it into the chain of joint
+// groups already in the pose:
+// - it selects the joint's distal parts (jointDistalParts) except those of joint groups below
+//   it, which then follow it;
+// - a joint group above it gives up those parts, and the new group follows it;
+// - any other group selecting one of those parts (by name or, through `partLabels`, by label)
+//   gives way, with its keyframe entries; a fixed "rest" group keeps the rest of the body.
+// Joint groups are those named after a joint of the skeleton ("elbow_left") or one of its axes
+// ("elbow_left.flexion", the single-axis form). Returns the group's name. Throws repose::Error
+// as jointGroup does.
+std::string setJointGroup(Pose& pose, const Skeleton& skeleton, const std::string& joint,
+                          const LabelTable& partLabels);
+// The order a joint group's turns take (setJointGroup), whatever order skeleton.json lists the
+// axes in: the limb's own rotation first, then abduction (the neck's lateral bend), then flexion,
+// each about its axis at rest. Composed so, the motion is the joint coordinate system's of
+// Grood & Suntay and the ISB: flexion about the proximal segment's axis, abduction about the
+// floating axis, rotation about the distal segment's own axis.
+std::vector<std::string> jointTurnAxes(const SkeletonJoint& joint);
+// The joint a group of the pose turns (by its name, either form), "" when it is no joint group.
+std::string jointOfGroup(const Skeleton& skeleton, const std::string& group);
 
 // Whether two poses have the same handle groups (names, fixed, selections) in the same order:
 // a rig prepared for one solves frames of the other.
