@@ -276,7 +276,10 @@ void qSlicerReposeCageInteraction::update() {
   vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLivePose() : nullptr;
   vtkNew<vtkMatrix4x4> unused;
   const std::string group = p ? p->GetActiveGroup() : std::string();
-  const std::vector<int> vertices = pose && d->Logic->GetPoseGroupMatrix(pose, group, unused)
+  // Only a group one matrix can move: a joint's group turning about several axes has its
+  // sliders (SetPoseGroupMatrix refuses it).
+  const std::vector<int> vertices = pose && d->Logic->GetPoseGroupMatrix(pose, group, unused) &&
+                                            d->Logic->GetPoseGroupTurns(pose, group).size() == 1
                                         ? d->Logic->GetLiveGroupVertices(group)
                                         : std::vector<int>{};
   if (vertices.empty() || !cage) {

@@ -45,7 +45,7 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeCageInteraction : public
   void clearSelection();
 
   // The translate/rotate widget of the active group (enabled only while a movable group of the
-  // live pose is active).
+  // live pose is active, and not for a joint's group of several axes: its sliders turn it).
   vtkBoxWidget2* transformWidget() const;
   bool isDragging() const;
 

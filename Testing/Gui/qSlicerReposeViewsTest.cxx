@@ -586,10 +586,12 @@ class qSlicerReposeViewsTest : public QObject {
     slider->setSliderDown(true);
     for (int angle = 15; angle <= 90; angle += 15) slider->setValue(angle);
     slider->setSliderDown(false);
-    // The shoulder's sliders kept their angles.
+    // The shoulder's sliders kept their angles. A joint's group of several axes gets no box in
+    // the 3D view (one matrix cannot set its turns): its sliders move it.
     session.node->SetActiveGroup("shoulder_left");
     QCOMPARE(panel->jointAngle("flexion"), 30.0);
     QCOMPARE(panel->jointAngle("abduction"), 90.0);
+    QVERIFY(!views->cageInteraction()->transformWidget()->GetEnabled());
 
     const repose::Skeleton skeleton =
         repose::readSkeleton(session.dir.filePath("skeleton.json").toStdString());

@@ -5,10 +5,12 @@
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/util/Error.h"
+#include "repose/volume/AnatomyColors.h"
 #include "repose/volume/LabelStatistics.h"
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <sstream>
 
 namespace repose {
@@ -55,6 +57,14 @@ void writeColorTable(const Volume& labelMap, const std::string& path) {
         << byte(l.color[1]) << " " << byte(l.color[2]) << " 255\n";
   }
   writeTextFileAtomically(path, out.str());
+}
+
+LabelTable readColorTable(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throwFileError(path, "cannot open");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseColorTable(text.str(), path);
 }
 
 }  // namespace repose

@@ -2,10 +2,15 @@
 #include "repose/volume/AnatomyColors.h"
 
 #include "AnatomyColorRules.h"  // generated from Resources/Colors/anatomy_colors.csv
+#include "repose/util/Error.h"
 #include "repose/util/NameMatch.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -74,9 +79,90 @@ std::array<double, 3> toHsv(const std::array<double, 3>& rgb) {
   return {h * 60, mx > 0 ? d / mx : 0, mx};
 }
 
+// The reference table by normalised name; loaded from $REPOSE_COLOR_TABLE until set in code.
+struct ReferenceColors {
+  std::mutex mutex;
+  bool set = false;
+  std::map<std::string, std::array<double, 3>> byName;
+};
+ReferenceColors& reference() {
+  static ReferenceColors r;
+  return r;
+}
+
+void fill(ReferenceColors& r, const LabelTable& table) {
+  r.byName.clear();
+  for (const Label& l : table.labels())
+    if (l.value != 0 && !l.name.empty()) r.byName.emplace(normalizedLabelName(l.name), l.color);
+  r.set = true;
+}
+
 }  // namespace
 
+LabelTable parseColorTable(const std::string& text, const std::string& source) {
+  LabelTable table;
+  std::istringstream in(text);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    auto fail = [&](const std::string& why) {
+      throw Error(source + ": line " + std::to_string(number) + ": " + why);
+    };
+    std::istringstream fields(line);
+    Label l;
+    std::string name;
+    double rgb[3];
+    if (!(fields >> l.value >> name >> rgb[0] >> rgb[1] >> rgb[2]))
+      fail("expected \"value name R G B A\"");
+    for (int k = 0; k < 3; ++k) {
+      if (!(rgb[k] >= 0 && rgb[k] <= 255)) fail("a colour is 0 to 255");
+      l.color[std::size_t(k)] = rgb[k] / 255.0;
+    }
+    std::replace(name.begin(), name.end(), '_', ' ');
+    l.name = name;
+    if (table.find(l.value)) fail("value " + std::to_string(l.value) + " listed twice");
+    table.set(l);
+  }
+  return table;
+}
+
+void setReferenceColors(const LabelTable& table) {
+  ReferenceColors& r = reference();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  fill(r, table);
+}
+
+void useReferenceColorsFromEnvironment() {
+  ReferenceColors& r = reference();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  r.byName.clear();
+  r.set = false;
+}
+
+std::optional<std::array<double, 3>> referenceColor(const std::string& name) {
+  ReferenceColors& r = reference();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  if (!r.set) {
+    const char* path = std::getenv("REPOSE_COLOR_TABLE");
+    if (!path || !*path) {
+      r.set = true;
+    } else {
+      std::ifstream file(path);
+      if (!file) throw Error(std::string(path) + ": cannot open (REPOSE_COLOR_TABLE)");
+      std::stringstream text;
+      text << file.rdbuf();
+      fill(r, parseColorTable(text.str(), path));
+    }
+  }
+  const auto it = r.byName.find(normalizedLabelName(name));
+  if (it == r.byName.end()) return std::nullopt;
+  return it->second;
+}
+
 std::optional<std::array<double, 3>> anatomyColor(const std::string& name, int value, int variant) {
+  if (variant == 0)
+    if (const auto exact = referenceColor(name)) return exact;
   const ColorRule* rule = ruleFor(name);
   if (!rule) return std::nullopt;
   // Three low-discrepancy walks over the value (golden ratio, sqrt 2, 1/pi fractions) shade

@@ -4,6 +4,7 @@
 // convention or the tissue table, a file's own names and colours kept.
 #include "TestPaths.h"
 
+#include <repose/io/ColorTableIO.h>
 #include <repose/phantom/Phantom.h>
 #include <repose/rig/LabelConvention.h>
 #include <repose/util/Error.h>
@@ -14,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <array>
 #include <cmath>
 #include <fstream>
@@ -237,3 +239,95 @@ TEST(AnatomyColors, NamesComeFromATissueTableOrStayNumbers) {
 
 }  // namespace
 }  // namespace repose
+
+// A reference colour table, as a user with 3D Slicer has its GenericAnatomyColors.txt: the names
+// it lists take its colours exactly (case and '_' aside), other names the rules' shaded class
+// colour; the file is what writeColorTable writes and Slicer reads; a malformed line is refused
+// naming the file and the line; $REPOSE_COLOR_TABLE names the table when none is set, and an
+// unreadable one is an error, not other colours.
+TEST(AnatomyColors, AReferenceColorTableGivesItsColoursByName) {
+  repose::test::ScratchDir dir;
+  const std::string path = (dir.path() / "reference.txt").string();
+  {
+    std::ofstream out(path);
+    out << "# Color table file reference.txt\n# 4 values\n0 background 0 0 0 0\n"
+           "1 liver 10 20 30 255\n2 skeletal_muscle 200 100 50 255\n3 left_kidney 1 2 3 255\n";
+  }
+  const repose::LabelTable table = repose::readColorTable(path);
+  ASSERT_EQ(table.labels().size(), 4u);
+  EXPECT_EQ(table.find(2)->name, "skeletal muscle");
+  EXPECT_DOUBLE_EQ(table.find(1)->color[2], 30 / 255.0);
+  const auto rulesLiver = repose::anatomyColor("liver", 5);  // before the table
+  repose::setReferenceColors(table);
+  const auto liver = repose::LabelTable::defaultColor(5, "Liver");
+  EXPECT_DOUBLE_EQ(liver[0], 10 / 255.0);
+  EXPECT_DOUBLE_EQ(liver[2], 30 / 255.0);
+  EXPECT_EQ(repose::LabelTable::defaultColor(77, "skeletal muscle"),
+            repose::LabelTable::defaultColor(9, "Skeletal_Muscle"));  // one colour, any value
+  // Not listed: the rules, as before.
+  EXPECT_EQ(repose::anatomyColor("spleen", 4), [] {
+    repose::setReferenceColors({});
+    return repose::anatomyColor("spleen", 4);
+  }());
+  repose::setReferenceColors(table);
+  EXPECT_FALSE(repose::referenceColor("spleen"));
+  // A second shade of a listed name (completeLabelNamesAndColors' variants) comes from the rules.
+  EXPECT_EQ(repose::anatomyColor("liver", 5, 1), [&] {
+    repose::setReferenceColors({});
+    return repose::anatomyColor("liver", 5, 1);
+  }());
+
+  // Written by writeColorTable and read back: the same names and colours.
+  repose::VolumeGeometry grid;
+  grid.dims = {2, 2, 2};
+  repose::Volume labels(grid, repose::ScalarType::UInt8);
+  labels.labels() = table;
+  const std::string written = (dir.path() / "written.ctbl").string();
+  repose::writeColorTable(labels, written);
+  const repose::LabelTable back = repose::readColorTable(written);
+  for (const repose::Label& l : table.labels()) {
+    if (l.value == 0) continue;
+    ASSERT_TRUE(back.find(l.value)) << l.value;
+    EXPECT_EQ(back.find(l.value)->name, l.name);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(back.find(l.value)->color[std::size_t(k)], l.color[std::size_t(k)], 0.5 / 255);
+  }
+
+  // Bad files: one line naming the file and what is wrong.
+  auto refused = [&](const std::string& text) {
+    const std::string bad = (dir.path() / "bad.txt").string();
+    std::ofstream(bad) << text;
+    try {
+      repose::readColorTable(bad);
+    } catch (const repose::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(refused("# c\n1 liver 10 20\n").rfind(dir.path().string() + "/bad.txt: line 2:", 0),
+            0u);
+  EXPECT_NE(refused("1 liver 10 20 300 255\n").find("line 1: a colour is 0 to 255"),
+            std::string::npos);
+  EXPECT_NE(refused("1 a 1 2 3 255\n1 b 1 2 3 255\n").find("value 1 listed twice"),
+            std::string::npos);
+  EXPECT_TRUE(repose::parseColorTable("# only a comment\n\n", "empty").empty());
+  EXPECT_THROW(repose::readColorTable((dir.path() / "missing.txt").string()), repose::Error);
+
+  // The environment names the table.
+  ::setenv("REPOSE_COLOR_TABLE", path.c_str(), 1);
+  repose::useReferenceColorsFromEnvironment();
+  EXPECT_DOUBLE_EQ(repose::LabelTable::defaultColor(5, "liver")[1], 20 / 255.0);
+  ::setenv("REPOSE_COLOR_TABLE", (dir.path() / "missing.txt").c_str(), 1);
+  repose::useReferenceColorsFromEnvironment();
+  try {
+    repose::LabelTable::defaultColor(5, "liver");
+    ADD_FAILURE() << "an unreadable REPOSE_COLOR_TABLE was ignored";
+  } catch (const repose::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.txt: cannot open (REPOSE_COLOR_TABLE)"),
+              std::string::npos)
+        << e.what();
+  }
+  ::unsetenv("REPOSE_COLOR_TABLE");
+  repose::useReferenceColorsFromEnvironment();
+  EXPECT_EQ(repose::anatomyColor("liver", 5), rulesLiver);
+}

@@ -17,4 +17,9 @@ namespace repose {
 // file for a negative label value (a colour table cannot index it).
 void writeColorTable(const Volume& labelMap, const std::string& path);
 
+// Reads a Slicer colour table file (.ctbl or .txt; parseColorTable): what writeColorTable
+// writes, or Slicer's own tables such as GenericAnatomyColors.txt. Throws repose::Error naming
+// the file (and the line) when it cannot be read.
+LabelTable readColorTable(const std::string& path);
+
 }  // namespace repose

@@ -2,7 +2,13 @@
 // (Resources/Colors/anatomy_colors.csv: bone ivory, muscle red, fat yellow, arteries red, veins
 // blue...) gets its class's colour, shaded by the label's value so that labels of one class stay
 // distinct and each label keeps its colour from file to file.
+//
+// Before the rules, a reference colour table can give exact colours by name: 3D Slicer's own
+// GenericAnatomyColors.txt (every Slicer installation ships it; Repose does not copy it) or any
+// Slicer colour table, named by $REPOSE_COLOR_TABLE or set in code.
 #pragma once
+
+#include "repose/volume/LabelTable.h"
 
 #include <array>
 #include <optional>
@@ -10,7 +16,24 @@
 
 namespace repose {
 
-// The class colour of `name` shaded for `value` (RGB in [0,1]); nullopt when no rule matches.
+// Slicer's colour table text, as vtkMRMLColorTableStorageNode reads a .ctbl or .txt: '#' comment
+// lines, then "value name R G B [A]" per entry, colours 0-255, '_' in a name read as a space.
+// Throws repose::Error "<source>: line N: <problem>" for a malformed line or a repeated value.
+LabelTable parseColorTable(const std::string& text, const std::string& source);
+
+// The reference colours: a label whose name (compared as the rules compare names) the table
+// lists takes that entry's colour exactly. Process-wide, as Slicer's default colour node is; an
+// empty table clears it. Unless set, the table $REPOSE_COLOR_TABLE names is read at the first
+// colour asked for; a file that cannot be read throws repose::Error naming it, then and at every
+// later colour (never silently the other colours).
+void setReferenceColors(const LabelTable& table);
+// Back to the start: the table $REPOSE_COLOR_TABLE names, read at the next colour asked for.
+void useReferenceColorsFromEnvironment();
+// The reference colour of `name`, nullopt when the table does not list it.
+std::optional<std::array<double, 3>> referenceColor(const std::string& name);
+
+// The reference colour of `name` (variant 0), else the class colour of `name` shaded for `value`
+// (RGB in [0,1]); nullopt when neither the reference table nor a rule knows it.
 // `variant` > 0 gives other shades of the same class, for a table that must keep two labels
 // apart whose shades came out alike (completeLabelNamesAndColors).
 std::optional<std::array<double, 3>> anatomyColor(const std::string& name, int value,
