@@ -332,7 +332,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   // GetLiveSliceMilliseconds.
   vtkSmartPointer<vtkImageData> ComputeLiveSlice(int orientation, double positionMm, int pixels);
   // The body-part map S (or G's body mask) on the same plane and grid, posed the same way: what
-  // the slice views outline when asked (the parameter node's ShowBodyParts).
+  // the slice views outline when asked (the parameter node's ShowBodyParts). The first call
+  // converts S from the segmentation node (a copy of it, held while the pose is live).
   vtkSmartPointer<vtkImageData> ComputeLivePartsSlice(int orientation, double positionMm,
                                                       int pixels);
   // The segmentation's image (CT, MR) on the same plane and grid as ComputeLiveSlice, posed the

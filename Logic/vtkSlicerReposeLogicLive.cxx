@@ -36,8 +36,10 @@ struct vtkSlicerReposeLogic::LiveSession {
   vtkSmartPointer<vtkMRMLReposePoseNode> Pose;
   unsigned long PoseObserverTag = 0;
   std::shared_ptr<const repose::Volume> Labels;  // G
-  std::shared_ptr<const repose::Volume> Parts;   // S (or G's body mask), for the overlay
-  std::shared_ptr<const repose::Volume> Image;   // the segmentation's image, if any
+  // S (or G's body mask) for the outlines: converted from the segmentation node when first
+  // asked for, so a live pose whose outlines are never shown holds no copy of it.
+  std::shared_ptr<const repose::Volume> Parts;
+  std::shared_ptr<const repose::Volume> Image;  // the segmentation's image, if any
   double ImageBackground = 0, ImageWindow = 0, ImageLevel = 0;
   std::shared_ptr<const repose::PoseRig> Rig;
   repose::LabelTable PartLabels;  // S's, for groups selecting parts
@@ -145,7 +147,6 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
           repose::reportProgress(progress, 0, "embedding");
           auto session = std::make_shared<LiveSession>();
           session->Labels = G;
-          session->Parts = S;
           if (image) {
             session->Image = image;
             imageWindow(*image, session->ImageBackground, session->ImageWindow,
@@ -435,10 +436,16 @@ vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLiveSlice(int orienta
 vtkSmartPointer<vtkImageData> vtkSlicerReposeLogic::ComputeLivePartsSlice(int orientation,
                                                                           double positionMm,
                                                                           int pixels) {
-  if (!this->Live || !this->Live->Parts || this->Live->Deformed.rows() == 0 || orientation < 0 ||
-      orientation > 2 || pixels < 2)
+  if (!this->Live || this->Live->Deformed.rows() == 0 || orientation < 0 || orientation > 2 ||
+      pixels < 2)
     return nullptr;
-  const LiveSession& live = *this->Live;
+  LiveSession& live = *this->Live;
+  if (!live.Parts && !this->Guarded<bool>(false, [&] {
+        live.Parts = std::make_shared<const repose::Volume>(vtkSlicerReposeLogicInputs::PartsOf(
+            vtkSlicerReposeLogicInputs::Resolve(this->Scene, live.Pose).Segmentation));
+        return true;
+      }))
+    return nullptr;
   repose::RasterOptions options;
   options.outerFaces = &live.OuterFaces;
   return Conversion::ToImageData(repose::rasterizeLabels(
