@@ -122,6 +122,19 @@ struct Reader : JsonFields {
     return name;
   }
 
+  // A turn's axis: a vector (normalised; not zero) or a joint's axis by name.
+  void axisInto(const json& j, const std::string& field, Eigen::Vector3d& axis,
+                std::string& name) const {
+    if (j.is_string()) {
+      name = jointName(j, field, true);
+      return;
+    }
+    const Eigen::Vector3d v = vector3(j, field);
+    if (v.norm() < 1e-9) fail(field, "zero vector");
+    axis = v.normalized();
+    name.clear();
+  }
+
   // A transform's fields over `base` (keyframes change only what they name).
   PoseTransform transform(const json& j, const std::string& field, PoseTransform t) const {
     if (j.contains("rotation")) {
@@ -129,16 +142,7 @@ struct Reader : JsonFields {
       const json& r = object(j["rotation"], f);
       onlyKeys(r, f, {"axis", "angle_deg", "pivot", "then"});
       // Axis and pivot are numbers, or names of the skeleton's joint and axis.
-      if (r.contains("axis")) {
-        if (r["axis"].is_string()) {
-          t.axisName = jointName(r["axis"], f + ".axis", true);
-        } else {
-          const Eigen::Vector3d axis = vector3(r["axis"], f + ".axis");
-          if (axis.norm() < 1e-9) fail(f + ".axis", "zero vector");
-          t.axis = axis.normalized();
-          t.axisName.clear();
-        }
-      }
+      if (r.contains("axis")) axisInto(r["axis"], f + ".axis", t.axis, t.axisName);
       if (r.contains("angle_deg")) t.angleDeg = number(r["angle_deg"], f + ".angle_deg");
       if (r.contains("pivot")) {
         if (r["pivot"].is_string()) {
@@ -159,13 +163,7 @@ struct Reader : JsonFields {
           onlyKeys(turn, tf, {"axis", "angle_deg"});
           if (!turn.contains("axis")) fail(tf + ".axis", "required");
           PoseTurn u;
-          if (turn["axis"].is_string()) {
-            u.axisName = jointName(turn["axis"], tf + ".axis", true);
-          } else {
-            const Eigen::Vector3d axis = vector3(turn["axis"], tf + ".axis");
-            if (axis.norm() < 1e-9) fail(tf + ".axis", "zero vector");
-            u.axis = axis.normalized();
-          }
+          axisInto(turn["axis"], tf + ".axis", u.axis, u.axisName);
           if (turn.contains("angle_deg")) u.angleDeg = number(turn["angle_deg"], tf + ".angle_deg");
           t.then.push_back(u);
         }
