@@ -310,12 +310,13 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   // Per candidate: its box's rows and slices (grown for a growing tet), and the rows the tet
   // itself is scanned over (mjmin > mjmax: none, a growing tet that only its shell brings to
   // the scanned region).
-  struct Candidates {
-    std::vector<std::int32_t> tet, jmin, jmax, kmin, kmax, mjmin, mjmax;
-    std::vector<raster::TetVertices> vertices;
+  struct Candidate {
+    std::int32_t tet;
+    raster::TetVertices v;
+    std::int32_t jmin, jmax, kmin, kmax, mjmin, mjmax;
   };
   const int selectThreads = resolveThreads(options.threads);
-  std::vector<Candidates> parts(static_cast<std::size_t>(selectThreads));
+  std::vector<std::vector<Candidate>> parts(static_cast<std::size_t>(selectThreads));
   const std::uint8_t* outerFaces = withShell ? shell.outer.data() : nullptr;
   const std::uint8_t* rimFaces = withRims ? shell.pieceFaces.data() : nullptr;
   auto growsAt = [outerFaces, rimFaces](Eigen::Index t) {
@@ -325,7 +326,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
       selectThreads, selectThreads,
       [&](std::int64_t pb, std::int64_t pe) {
         for (std::int64_t part = pb; part < pe; ++part) {
-          Candidates& c = parts[static_cast<std::size_t>(part)];
+          std::vector<Candidate>& c = parts[static_cast<std::size_t>(part)];
           const Eigen::Index tBegin = nt * part / selectThreads,
                              tEnd = nt * (part + 1) / selectThreads;
           // First the outcodes alone, in a loop that does nothing else and has no branch: all
@@ -347,9 +348,10 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
               kept += !(shared & (growsAt(t) ? 0x0Fu : 0xF0u));
             }
           }
-          for (auto* list : {&c.tet, &c.jmin, &c.jmax, &c.kmin, &c.kmax, &c.mjmin, &c.mjmax})
-            list->reserve(kept);
-          c.vertices.reserve(kept);
+          // Sized for all those kept and cut to those taken: filled by index, the appends had
+          // been out-of-line calls costing a twentieth of a slice.
+          c.resize(kept);
+          std::size_t taken = 0;
           for (std::size_t h = 0; h < kept; ++h) {
             // The vertices of the tets a few ahead are fetched while this one is worked on.
             constexpr std::size_t kAhead = 8;
@@ -410,41 +412,38 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             const std::int64_t mj0 = std::max<std::int64_t>(0, raster::ceilToInt(mylo)),
                                mj1 = std::min(in.dims[1] - 1, raster::floorToInt(myhi));
             if (!grows && mj0 > mj1) continue;
-            c.tet.push_back(t);
-            c.vertices.push_back(v);
-            c.kmin.push_back(std::int32_t(std::max(kBegin, raster::ceilToInt(zlo))));
-            c.kmax.push_back(std::int32_t(std::min(kEnd - 1, raster::floorToInt(zhi))));
             // A tet that does not grow is handed to the work items by its own rows.
-            c.jmin.push_back(
-                std::int32_t(grows ? std::max<std::int64_t>(0, raster::ceilToInt(ylo)) : mj0));
-            c.jmax.push_back(
-                std::int32_t(grows ? std::min(in.dims[1] - 1, raster::floorToInt(yhi)) : mj1));
-            c.mjmin.push_back(std::int32_t(mj0));
-            c.mjmax.push_back(std::int32_t(mj1));
+            c[taken++] = Candidate{
+                t,
+                v,
+                std::int32_t(grows ? std::max<std::int64_t>(0, raster::ceilToInt(ylo)) : mj0),
+                std::int32_t(grows ? std::min(in.dims[1] - 1, raster::floorToInt(yhi)) : mj1),
+                std::int32_t(std::max(kBegin, raster::ceilToInt(zlo))),
+                std::int32_t(std::min(kEnd - 1, raster::floorToInt(zhi))),
+                std::int32_t(mj0),
+                std::int32_t(mj1)};
           }
+          c.resize(taken);
         }
       },
       1);
   // Tets of whole pieces (bones, organs) go last, so where a fold of soft tissue overlaps a bone
   // the bone keeps its voxels: soft tissue is what a bend squeezes.
-  std::vector<std::int32_t> candidates, jmin, jmax, kmin, kmax, mjmin, mjmax;
-  std::vector<raster::TetVertices> vertices;
+  std::vector<Candidate> candidates;
   std::size_t total = 0;
-  for (const Candidates& c : parts) total += c.tet.size();
-  for (auto* list : {&candidates, &jmin, &jmax, &kmin, &kmax, &mjmin, &mjmax}) list->reserve(total);
-  vertices.reserve(total);
+  for (const std::vector<Candidate>& c : parts) total += c.size();
+  candidates.reserve(total);
   const bool withPieces = in.pieces && !in.pieces->empty();
   for (const int pass : {0, 1}) {
     if (pass == 1 && !withPieces) break;
-    for (const Candidates& c : parts)
-      for (std::size_t n = 0; n < c.tet.size(); ++n) {
-        if (withPieces && ((*in.pieces)[std::size_t(c.tet[n])] != 0) != (pass == 1)) continue;
-        candidates.push_back(c.tet[n]);
-        vertices.push_back(c.vertices[n]);
-        jmin.push_back(c.jmin[n]), jmax.push_back(c.jmax[n]);
-        kmin.push_back(c.kmin[n]), kmax.push_back(c.kmax[n]);
-        mjmin.push_back(c.mjmin[n]), mjmax.push_back(c.mjmax[n]);
+    for (const std::vector<Candidate>& c : parts) {
+      if (!withPieces) {
+        candidates.insert(candidates.end(), c.begin(), c.end());
+        continue;
       }
+      for (const Candidate& n : c)
+        if (((*in.pieces)[std::size_t(n.tet)] != 0) == (pass == 1)) candidates.push_back(n);
+    }
   }
   // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
   // bands of j-rows across all slices, so every core has work either way.
@@ -464,8 +463,9 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
       std::fill(itemOf.begin() + split * item / slabs, itemOf.begin() + split * (item + 1) / slabs,
                 std::int32_t(item));
     for (std::size_t c = 0; c < candidates.size(); ++c) {
-      const std::int64_t lo = bands ? jmin[c] : kmin[c] - kBegin,
-                         hi = bands ? jmax[c] : kmax[c] - kBegin;
+      const Candidate& n = candidates[c];
+      const std::int64_t lo = bands ? n.jmin : n.kmin - kBegin,
+                         hi = bands ? n.jmax : n.kmax - kBegin;
       if (lo > hi) continue;
       for (std::int32_t item = itemOf[std::size_t(lo)], last = itemOf[std::size_t(hi)];
            item <= last; ++item)
@@ -494,14 +494,26 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             covered.assign(static_cast<std::size_t>(nx * rows * (k1 - k0)), 0);
           ScanTet s;
           const std::vector<std::int32_t>& mine = itemCandidates[std::size_t(slab)];
-          for (const std::int32_t c : mine) {
-            const std::int32_t t = candidates[c];
-            if (kmax[c] < k0 || kmin[c] >= k1 || mjmax[c] < j0 || mjmin[c] >= j1 ||
-                mjmin[c] > mjmax[c] || !raster::prepareTet(in, vertices[c], s))
+          // The vertices of the candidates a few ahead, deformed and at rest, are fetched while
+          // this one is scanned: a slice's tets lie scattered over the vertex arrays.
+          auto fetchAhead = [&](std::size_t m) {
+            constexpr std::size_t kAhead = 6;
+            if (m + kAhead >= mine.size()) return;
+            for (const int u : candidates[std::size_t(mine[m + kAhead])].v) {
+              __builtin_prefetch(&in.out[std::size_t(u)]);
+              __builtin_prefetch(&in.rest[std::size_t(u)]);
+            }
+          };
+          for (std::size_t m = 0; m < mine.size(); ++m) {
+            fetchAhead(m);
+            const Candidate& n = candidates[std::size_t(mine[m])];
+            const std::int32_t t = n.tet;
+            if (n.kmax < k0 || n.kmin >= k1 || n.mjmax < j0 || n.mjmin >= j1 || n.mjmin > n.mjmax ||
+                !raster::prepareTet(in, n.v, s))
               continue;
             const std::uint8_t mark = withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
-            raster::scanTet(s, k0, k1, std::max<std::int64_t>(j0, mjmin[c]),
-                            std::min<std::int64_t>(j1, mjmax[c] + 1),
+            raster::scanTet(s, k0, k1, std::max<std::int64_t>(j0, n.mjmin),
+                            std::min<std::int64_t>(j1, n.mjmax + 1),
                             [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
                                 const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
                               localWrites += i1 - i0 + 1;
@@ -530,12 +542,12 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
           // follows its surface to within a voxel) move with the piece, over the soft tissue
           // that covered them.
-          for (std::size_t n = 0; n < mine.size() && withRims; ++n) {
-            const std::int32_t c = mine[n];
-            const std::int32_t t = candidates[c];
+          for (std::size_t m = 0; m < mine.size() && withRims; ++m) {
+            const Candidate& n = candidates[std::size_t(mine[m])];
+            const std::int32_t t = n.tet;
             const unsigned rim = shell.pieceFaces[std::size_t(t)];
-            if (!rim || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareShell(in, vertices[c], rim, shell.pieceMm, shell.normalToMm,
+            if (!rim || n.kmax < k0 || n.kmin >= k1 || n.jmax < j0 || n.jmin >= j1 ||
+                !raster::prepareShell(in, n.v, rim, shell.pieceMm, shell.normalToMm,
                                       shell.pieceGrowth, s))
               continue;
             scanRim(t);
@@ -550,11 +562,12 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
               continue;
             scanRim(t);
           }
-          for (std::size_t n = 0; n < mine.size() && withShell; ++n) {
-            const std::int32_t c = mine[n];
-            const std::int32_t t = candidates[c];
-            if (!shell.outer[t] || kmax[c] < k0 || kmin[c] >= k1 || jmax[c] < j0 || jmin[c] >= j1 ||
-                !raster::prepareShell(in, vertices[c], shell.outer[t], shell.mm, shell.normalToMm,
+          for (std::size_t m = 0; m < mine.size() && withShell; ++m) {
+            if (shell.outer[candidates[std::size_t(mine[m])].tet]) fetchAhead(m);
+            const Candidate& n = candidates[std::size_t(mine[m])];
+            const std::int32_t t = n.tet;
+            if (!shell.outer[t] || n.kmax < k0 || n.kmin >= k1 || n.jmax < j0 || n.jmin >= j1 ||
+                !raster::prepareShell(in, n.v, shell.outer[t], shell.mm, shell.normalToMm,
                                       shell.boxGrowth, s))
               continue;
             raster::scanTet(s, k0, k1, j0, j1,

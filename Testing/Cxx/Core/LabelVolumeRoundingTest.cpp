@@ -149,7 +149,9 @@ TEST(LabelVolumeRounding, AUniformGrowthGivesEachLabelTheGrownVolume) {
     const double grown = s * s * s * double(rest.at(l));
     EXPECT_NEAR(report.labelTargets.at(l), grown, 1e-6 * grown);
     // Within 0.5 %: label 1, short of voxels at the outline, gives the others little.
-    if (l != 1) EXPECT_LE(std::abs(double(p.at(l)) - grown), std::max(2.5, grown / 200));
+    if (l != 1) {
+      EXPECT_LE(std::abs(double(p.at(l)) - grown), std::max(2.5, grown / 200));
+    }
   }
 }
 
