@@ -86,16 +86,19 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
                                  : vtkSlicerReposeLogicRead::ReadVolume(path);
     for (const repose::Label& l : volume.labels().labels())
       this->VolumeLabelNames.push_back({l.layer, l.value, l.name});
+    // Counted once: naming the labels, telling their convention and the lookup table's values
+    // present all read these counts (each had made its own pass over the whole map).
+    const std::vector<repose::LabelCount> counts =
+        volume.isLabelMap() ? repose::countLabels(volume) : std::vector<repose::LabelCount>();
     // The display's names and colours of labels the file left without (the file's names above).
-    this->VolumeLabelNote =
-        vtkSlicerReposeLogicRead::NameLabels(volume, this->TissueTablePath, path);
+    this->VolumeLabelNote = vtkSlicerReposeLogicRead::NameLabels(
+        volume, this->TissueTablePath, path, volume.isLabelMap() ? &counts : nullptr);
     this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
                                  : vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =
         vtkSlicerReposeVolumeConversion::ToMatrix(volume.geometry().ijkToRas);
     std::vector<int> present;  // layer 0's values, coloured even when the table lacks them
     if (volume.isLabelMap()) {
-      const std::vector<repose::LabelCount> counts = repose::countLabels(volume);
       this->VolumeLabelsPresent = static_cast<int>(counts.size());
       for (const repose::LabelCount& c : counts)
         if (c.layer == 0) present.push_back(c.value);

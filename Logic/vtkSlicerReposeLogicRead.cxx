@@ -21,7 +21,7 @@ repose::Volume ReadVolume(const std::string& path) {
 }
 
 std::string NameLabels(repose::Volume& labels, const std::string& tissuesPath,
-                       const std::string& source) {
+                       const std::string& source, const std::vector<repose::LabelCount>* counts) {
   std::optional<repose::TissueTable> tissues;
   if (!tissuesPath.empty()) {
     try {
@@ -30,7 +30,7 @@ std::string NameLabels(repose::Volume& labels, const std::string& tissuesPath,
       // The pose job reports a broken table; names then come from the convention.
     }
   }
-  return repose::completeLabelNamesAndColors(labels, tissues ? &*tissues : nullptr, source);
+  return repose::completeLabelNamesAndColors(labels, tissues ? &*tissues : nullptr, source, counts);
 }
 
 std::string ReadText(const std::string& path) {

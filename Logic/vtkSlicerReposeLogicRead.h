@@ -5,9 +5,11 @@
 #ifndef vtkSlicerReposeLogicRead_h
 #define vtkSlicerReposeLogicRead_h
 
+#include <repose/volume/LabelStatistics.h>
 #include <repose/volume/Volume.h>
 
 #include <string>
+#include <vector>
 
 namespace vtkSlicerReposeLogicRead {
 
@@ -16,8 +18,10 @@ repose::Volume ReadVolume(const std::string& path);
 // Names and colours for G's labels the file left without (repose::completeLabelNamesAndColors),
 // the names from the tissue table at `tissuesPath` when one is set and reads, else from the label
 // convention G follows. Returns the one-line note ("" when the file named every label).
+// `counts`: the map's label counts when the caller has them, so it is not read again.
 std::string NameLabels(repose::Volume& labels, const std::string& tissuesPath,
-                       const std::string& source);
+                       const std::string& source,
+                       const std::vector<repose::LabelCount>* counts = nullptr);
 // A small text file (a pose, a skeleton, scene.json) whole; repose::Error "path: cannot open".
 std::string ReadText(const std::string& path);
 

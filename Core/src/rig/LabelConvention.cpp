@@ -96,9 +96,10 @@ BoneKind boneFromName(const std::string& n) {
   return BoneKind::None;
 }
 
-std::vector<int> present(const Volume& organs) {
+// Layer 0's labels, from the caller's counts when it has them (one pass over the map fewer).
+std::vector<int> present(const Volume& organs, const std::vector<LabelCount>* counts = nullptr) {
   std::vector<int> out;
-  for (const LabelCount& c : countLabels(organs))
+  for (const LabelCount& c : counts ? *counts : countLabels(organs))
     if (c.layer == 0 && c.value != 0 && c.voxels > 0) out.push_back(c.value);
   return out;
 }
@@ -406,10 +407,11 @@ const char* boneKindName(BoneKind kind) {
   return kBoneNames[int(kind)];
 }
 
-LabelConvention labelConvention(const Volume& organs, const std::string& requested,
-                                const std::string& source) {
-  if (!organs.isLabelMap()) throw Error(source + ": not a label map (float voxels)");
-  const std::vector<int> labels = present(organs);
+namespace {
+
+// labelConvention on the labels present in G (in increasing order), counted by the caller.
+LabelConvention conventionOf(const Volume& organs, const std::vector<int>& labels,
+                             const std::string& requested, const std::string& source) {
   if (labels.empty()) throw Error(source + ": no labelled voxel, nothing to rig");
   LabelConvention c;
   if (requested == "phantom") {
@@ -456,10 +458,19 @@ LabelConvention labelConvention(const Volume& organs, const std::string& request
   return c;
 }
 
+}  // namespace
+
+LabelConvention labelConvention(const Volume& organs, const std::string& requested,
+                                const std::string& source) {
+  if (!organs.isLabelMap()) throw Error(source + ": not a label map (float voxels)");
+  return conventionOf(organs, present(organs), requested, source);
+}
+
 std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissues,
-                                        const std::string& source) {
+                                        const std::string& source,
+                                        const std::vector<LabelCount>* counts) {
   if (!organs.isLabelMap()) return "";
-  const std::vector<int> values = present(organs);
+  const std::vector<int> values = present(organs, counts);
   std::vector<int> unnamed;
   for (const int v : values)
     if (nameOf(organs, v).empty()) unnamed.push_back(v);
@@ -477,7 +488,7 @@ std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissu
     from = "the tissue table";
   } else if (!unnamed.empty()) {
     try {
-      const LabelConvention c = labelConvention(organs, "auto", source);
+      const LabelConvention c = conventionOf(organs, values, "auto", source);
       for (const int v : unnamed)
         if (const auto r = c.roles.find(v);
             r != c.roles.end() && r->second.name != "label_" + std::to_string(v))

@@ -207,6 +207,35 @@ TEST(AnatomyColors, UnnamedIcrpLabelsAreNamedByTheConventionAndColouredByName) {
   }
 }
 
+// A viewer that has counted the labels already hands its counts over: the names, colours and
+// note are those of a count of its own, and only the labels in the counts are named (the map is
+// not read again: one pass on open instead of three at a gigavoxel).
+TEST(AnatomyColors, LabelCountsHandedOverGiveTheSameNamesWithoutReadingTheMapAgain) {
+  PhantomOptions po;
+  po.voxelMm = 8;
+  po.armsResting = true;
+  po.labels = PhantomLabelling::Icrp110;
+  const Volume plain = Phantom(po).makeVolumes().first;
+  Volume own = plain, handed = plain, partial = plain;
+  const std::vector<LabelCount> counts = countLabels(plain);
+  const std::string note = completeLabelNamesAndColors(own, nullptr, "G.nii.gz");
+  EXPECT_EQ(completeLabelNamesAndColors(handed, nullptr, "G.nii.gz", &counts), note);
+  ASSERT_EQ(handed.labels().size(), own.labels().size());
+  for (std::size_t i = 0; i < own.labels().size(); ++i) {
+    EXPECT_EQ(handed.labels().labels()[i].value, own.labels().labels()[i].value);
+    EXPECT_EQ(handed.labels().labels()[i].name, own.labels().labels()[i].name);
+    EXPECT_EQ(handed.labels().labels()[i].color, own.labels().labels()[i].color);
+  }
+  // Counts without one label: that label is left as the file had it (unnamed), so the counts
+  // handed over are what was used.
+  std::vector<LabelCount> fewer = counts;
+  const int dropped = fewer.back().value;
+  fewer.pop_back();
+  completeLabelNamesAndColors(partial, nullptr, "G.nii.gz", &fewer);
+  EXPECT_EQ(partial.labels().find(dropped), nullptr);
+  EXPECT_EQ(partial.labels().size(), own.labels().size() - 1);
+}
+
 TEST(AnatomyColors, NamesComeFromATissueTableOrStayNumbers) {
   VolumeGeometry g;
   g.dims = {4, 4, 4};

@@ -5,6 +5,7 @@
 // TotalSegmentator v2 class names; or a CSV mapping the user's labels to bones.
 #pragma once
 
+#include "repose/volume/LabelStatistics.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 
@@ -70,7 +71,10 @@ LabelConvention labelConvention(const Volume& organs, const std::string& request
 // their own get their structure's colour by that name (LabelTable::defaultColor(value, name)),
 // marked colorGenerated. Returns one line saying where the names came from, "" when the file
 // named every label. Never throws for a G no convention fits: that only leaves the numbers.
+// `counts`: countLabels(organs) when the caller has it already (a viewer opening a file), so the
+// map is not read again; the convention is told from the same labels.
 std::string completeLabelNamesAndColors(Volume& organs, const TissueTable* tissues,
-                                        const std::string& source);
+                                        const std::string& source,
+                                        const std::vector<LabelCount>* counts = nullptr);
 
 }  // namespace repose
