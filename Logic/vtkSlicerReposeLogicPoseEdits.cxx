@@ -204,12 +204,24 @@ bool vtkSlicerReposeLogic::SetPoseGroupTurnAngle(vtkMRMLReposePoseNode* node,
 bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const std::string& group,
                                               vtkMatrix4x4* matrix) {
   this->LastErrorMessage.clear();
-  const std::optional<GroupTransform> old = this->GetPoseGroupTransform(node, group);
-  if (!matrix || !old) {
+  // The pose is parsed once per call: a drag of the 3D box calls this on every mouse move, and
+  // asking the group's transform, turns and carrier apart had parsed it four times.
+  std::optional<repose::Pose> pose;
+  repose::PoseGroup* g = nullptr;
+  if (node) {
+    try {
+      pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
+      g = &findGroup(*pose, group, node->GetName());
+    } catch (const std::exception&) {
+      g = nullptr;
+    }
+  }
+  if (!matrix || !g || g->fixed) {
     this->LastErrorMessage = "pose group \"" + group + "\" cannot be moved (unknown or fixed)";
     return false;
   }
-  if (this->GetPoseGroupTurns(node, group).size() > 1) {
+  const repose::PoseTransform old = currentTransform(*pose, node, *g);
+  if (!old.then.empty()) {
     this->LastErrorMessage =
         "pose group \"" + group + "\" turns about several axes of its joint: its sliders move it";
     return false;
@@ -227,34 +239,41 @@ bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
   }
   // A follower's own part of the motion: what is left after the groups it follows.
   {
-    repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
-    const Eigen::Isometry3d carrier =
-        carriedBy(pose, node, findGroup(pose, group, node->GetName()));
     Eigen::Isometry3d world = Eigen::Isometry3d::Identity();
     world.linear() = R;
     world.translation() = shift;
-    const Eigen::Isometry3d own = carrier.inverse() * world;
+    const Eigen::Isometry3d own = carriedBy(*pose, node, *g).inverse() * world;
     R = own.linear();
     shift = own.translation();
   }
   // x' = R (x - p) + p + T with the group's own pivot p: T = shift + R p - p. The axis keeps the
   // direction it had, so the panel's angle control still turns the same way after a drag.
-  const std::array<double, 3>& pivot = old->pivot;
-  const Eigen::Vector3d p(pivot[0], pivot[1], pivot[2]);
-  const Eigen::Vector3d oldA(old->axis[0], old->axis[1], old->axis[2]);
+  const Eigen::Vector3d& p = old.pivot;
   Eigen::AngleAxisd aa(R);
   Eigen::Vector3d axis = aa.axis();
   double angle = aa.angle() * 180.0 / M_PI;
   if (std::abs(angle) < 1e-9) {
-    axis = oldA;
+    axis = old.axis;
     angle = 0;
-  } else if (axis.dot(oldA) < 0) {
+  } else if (axis.dot(old.axis) < 0) {
     axis = -axis;
     angle = -angle;
   }
-  const Eigen::Vector3d T = shift + R * p - p;
-  return this->SetPoseGroupTransform(node, group, {axis.x(), axis.y(), axis.z()}, angle, pivot,
-                                     {T.x(), T.y(), T.z()});
+  return this->Guarded<bool>(false, [&]() -> bool {
+    // A new transform about the old pivot, as numbers (the box's motion is no joint's named
+    // axis); it has no further turns (checked above).
+    repose::PoseTransform t;
+    t.pivot = old.pivot;
+    if (!(axis.norm() > 0) || !axis.allFinite()) throw repose::Error("the rotation axis is zero");
+    t.axis = axis.normalized();
+    t.angleDeg = angle;
+    t.translation = shift + R * p - p;
+    if (!std::isfinite(angle) || !t.translation.allFinite())
+      throw repose::Error("the transform of group \"" + group + "\" is not finite");
+    setCurrentTransform(*pose, node, *g, t);
+    this->RecordPoseEdit(node, repose::poseToJson(*pose));
+    return true;
+  });
 }
 
 vtkMRMLReposePoseNode* vtkSlicerReposeLogic::NewPose(const std::string& name) {
