@@ -91,8 +91,8 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
     const std::vector<repose::LabelCount> counts =
         volume.isLabelMap() ? repose::countLabels(volume) : std::vector<repose::LabelCount>();
     // The display's names and colours of labels the file left without (the file's names above).
-    this->VolumeLabelNote = vtkSlicerReposeLogicRead::NameLabels(
-        volume, this->TissueTablePath, path, volume.isLabelMap() ? &counts : nullptr);
+    this->VolumeLabelNote =
+        vtkSlicerReposeLogicRead::NameLabels(volume, this->TissueTablePath, path, &counts);
     this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
                                  : vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =

@@ -71,6 +71,23 @@ void setCurrentTransform(repose::Pose& pose, vtkMRMLReposePoseNode* node, repose
     entry->second = t;
 }
 
+// A group's transform from numbers, checked: a rotation axis that is not zero (made unit length),
+// a finite angle, pivot and translation. The panel's controls and the 3D box both set one.
+repose::PoseTransform checkedTransform(const Eigen::Vector3d& axis, double angleDeg,
+                                       const Eigen::Vector3d& pivot,
+                                       const Eigen::Vector3d& translation,
+                                       const std::string& group) {
+  if (!(axis.norm() > 0) || !axis.allFinite()) throw repose::Error("the rotation axis is zero");
+  repose::PoseTransform t;
+  t.axis = axis.normalized();
+  t.angleDeg = angleDeg;
+  t.pivot = pivot;
+  t.translation = translation;
+  if (!std::isfinite(angleDeg) || !pivot.allFinite() || !translation.allFinite())
+    throw repose::Error("the transform of group \"" + group + "\" is not finite");
+  return t;
+}
+
 }  // namespace
 
 void vtkSlicerReposeLogic::RecordPoseEdit(vtkMRMLReposePoseNode* node, const std::string& after) {
@@ -95,17 +112,11 @@ bool vtkSlicerReposeLogic::SetPoseGroupTransform(vtkMRMLReposePoseNode* node,
     if (!node) throw repose::Error("no pose");
     repose::Pose pose = repose::parsePose(node->GetPoseJSON(), node->GetName());
     repose::PoseGroup& g = movableGroup(pose, group, node->GetName());
-    repose::PoseTransform t;
+    repose::PoseTransform t =
+        checkedTransform(Eigen::Vector3d(axis[0], axis[1], axis[2]), angleDeg,
+                         Eigen::Vector3d(pivot[0], pivot[1], pivot[2]),
+                         Eigen::Vector3d(translation[0], translation[1], translation[2]), group);
     t.then = currentTransform(pose, node, g).then;  // a joint group's other axes stay turned
-    t.axis = Eigen::Vector3d(axis[0], axis[1], axis[2]);
-    if (!(t.axis.norm() > 0) || !t.axis.allFinite())
-      throw repose::Error("the rotation axis is zero");
-    t.axis.normalize();
-    t.angleDeg = angleDeg;
-    t.pivot = Eigen::Vector3d(pivot[0], pivot[1], pivot[2]);
-    t.translation = Eigen::Vector3d(translation[0], translation[1], translation[2]);
-    if (!std::isfinite(angleDeg) || !t.pivot.allFinite() || !t.translation.allFinite())
-      throw repose::Error("the transform of group \"" + group + "\" is not finite");
     setCurrentTransform(pose, node, g, t);
     this->RecordPoseEdit(node, repose::poseToJson(pose));
     return true;
@@ -262,15 +273,8 @@ bool vtkSlicerReposeLogic::SetPoseGroupMatrix(vtkMRMLReposePoseNode* node, const
   return this->Guarded<bool>(false, [&]() -> bool {
     // A new transform about the old pivot, as numbers (the box's motion is no joint's named
     // axis); it has no further turns (checked above).
-    repose::PoseTransform t;
-    t.pivot = old.pivot;
-    if (!(axis.norm() > 0) || !axis.allFinite()) throw repose::Error("the rotation axis is zero");
-    t.axis = axis.normalized();
-    t.angleDeg = angle;
-    t.translation = shift + R * p - p;
-    if (!std::isfinite(angle) || !t.translation.allFinite())
-      throw repose::Error("the transform of group \"" + group + "\" is not finite");
-    setCurrentTransform(*pose, node, *g, t);
+    setCurrentTransform(*pose, node, *g,
+                        checkedTransform(axis, angle, old.pivot, shift + R * p - p, group));
     this->RecordPoseEdit(node, repose::poseToJson(*pose));
     return true;
   });
