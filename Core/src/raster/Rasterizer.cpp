@@ -349,7 +349,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
             }
           }
           // Sized for all those kept and cut to those taken: filled by index, the appends had
-          // been out-of-line calls costing a twentieth of a slice.
+          // been out-of-line calls, visible in a profile of the live slice.
           c.resize(kept);
           std::size_t taken = 0;
           for (std::size_t h = 0; h < kept; ++h) {
