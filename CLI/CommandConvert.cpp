@@ -34,6 +34,7 @@ int runConvert(const Args& args) {
   const ReadOptions r = readOptionsWithin(parseMemoryBudget(p.get("memory")));
   w.progress = terminalProgress();
   const Volume volume = readVolume(in, r);
+  if (formatForPath(out) == FileFormat::DicomFile) w.sourceDicom = dicomSourceOf(in);
   writeVolume(volume, out, w);
   const nlohmann::json description = describeVolume(volume, out);
   if (p.has("json"))

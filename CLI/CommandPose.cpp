@@ -131,8 +131,9 @@ int runPose(const Args& args) {
               "0")
       .option("output-format", "FORMAT",
               "the posed label maps as nii.gz (each with a 3D Slicer colour table, .ctbl), "
-              "seg.nrrd (Slicer segmentations: names, colours, terminology), both, or auto "
-              "(seg.nrrd when --input is a .seg.nrrd, else nii.gz)",
+              "seg.nrrd (Slicer segmentations: names, colours, terminology), both, dcmseg "
+              "(DICOM SEG, patient and study from a DICOM input), or auto (seg.nrrd when "
+              "--input is a .seg.nrrd, else nii.gz)",
               "auto")
       .option("cage-vertices", "N", "cage size", "300")
       .option("dilate-mm", "MM", "cage distance from the body", "10")
@@ -219,8 +220,9 @@ int runPose(const Args& args) {
   if (p.get("label-volumes") != "preserve" && p.get("label-volumes") != "nearest")
     throw UsageError{"--label-volumes must be preserve or nearest"};
   const std::string format = p.get("output-format");
-  if (format != "auto" && format != "nii.gz" && format != "seg.nrrd" && format != "both")
-    throw UsageError{"--output-format must be auto, nii.gz, seg.nrrd or both"};
+  if (format != "auto" && format != "nii.gz" && format != "seg.nrrd" && format != "both" &&
+      format != "dcmseg")
+    throw UsageError{"--output-format must be auto, nii.gz, seg.nrrd, both or dcmseg"};
   const LabelMapFiles labelMapFiles = labelMapFilesFor(format, p.get("input"));
   for (const char* in : {"input", "parts", "image", "pose"})
     if (p.has(in) && fs::exists(p.get(in)) && fs::exists(outDir) &&
@@ -337,6 +339,7 @@ int runPose(const Args& args) {
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
     FrameWriteOptions wo;
     wo.labelMapFiles = labelMapFiles;
+    if (labelMapFiles == LabelMapFiles::DicomSeg) wo.sourceDicom = dicomSourceOf(p.get("input"));
     if (p.has("scene")) {  // a Slicer scene of the frame, with the rig kept in the scene folder
       const fs::path scene = fs::absolute(p.get("scene"));
       wo.sceneInputLabels = fs::absolute(p.get("input")).string();

@@ -243,6 +243,8 @@ void runJob(Worker& worker, std::int64_t t, std::size_t f, const TaskPlan& plan,
   posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
   FrameWriteOptions wo;
   wo.labelMapFiles = fo.labelMapFiles;
+  if (wo.labelMapFiles == LabelMapFiles::DicomSeg)
+    wo.sourceDicom = dicomSourceOf(worker.subject(t).organs);
   const fs::path scene = fs::absolute(worker.sceneFolder(t));
   wo.sceneInputLabels = fs::absolute(worker.subject(t).organs).string();
   wo.sceneCage = (scene / "cage.vtk").string();
@@ -269,8 +271,8 @@ int runSweep(const Args& args) {
            "(G.nii.gz in the folder, else the input rig.json names)")
       .option("poses", "LIST", "a file of pose files (*.pose.json), one per line")
       .option("out", "DIR", "output folder (created if missing; its parent must exist)")
-      .option("output-format", "FORMAT", "the posed label maps: nii.gz, seg.nrrd, both or auto",
-              "auto")
+      .option("output-format", "FORMAT",
+              "the posed label maps: nii.gz, seg.nrrd, both, dcmseg or auto", "auto")
       .option("threads", "N", "worker threads per rank (0: all cores / ranks on this machine)", "0")
       .flag("resume", "skip jobs whose outputs are complete (checked against their report.json)")
       .flag("json", "print sweep.json on stdout (rank 0)");
@@ -279,8 +281,9 @@ int runSweep(const Args& args) {
   for (const char* required : {"subjects", "poses", "out"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
   const std::string format = p.get("output-format");
-  if (format != "auto" && format != "nii.gz" && format != "seg.nrrd" && format != "both")
-    throw UsageError{"--output-format must be auto, nii.gz, seg.nrrd or both"};
+  if (format != "auto" && format != "nii.gz" && format != "seg.nrrd" && format != "both" &&
+      format != "dcmseg")
+    throw UsageError{"--output-format must be auto, nii.gz, seg.nrrd, both or dcmseg"};
 
   const std::unique_ptr<SweepComm> comm = makeSweepComm();
   const auto start = Clock::now();

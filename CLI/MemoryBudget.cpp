@@ -10,6 +10,7 @@
 #include "repose/util/Error.h"
 
 #include <algorithm>
+#include <iostream>
 #include <cstdlib>
 #include <sstream>
 
@@ -40,6 +41,7 @@ double parseMemoryBudget(const std::string& text) {
 ReadOptions readOptionsWithin(double budget, bool progress) {
   ReadOptions r;
   if (progress) r.progress = terminalProgress();
+  r.note = [](const std::string& n) { std::cerr << "repose: note: " << n << "\n"; };
   // Never 0 (no limit): a budget already used up refuses every read.
   r.memoryLimitBytes = std::max(1.0, budget - peakResidentBytes());
   return r;

@@ -163,9 +163,9 @@ std::string poseXml() {
          "",
          "auto",
          "The label maps in the results folder: NIfTI with a colour table, Slicer "
-         "segmentations, both, or as the input.",
+         "segmentations, both, DICOM SEG, or as the input.",
          false,
-         {"auto", "nii.gz", "seg.nrrd", "both"}}}},
+         {"auto", "nii.gz", "seg.nrrd", "both", "dcmseg"}}}},
       {"Rig",
        true,
        {{"integer", "", "cageVertices", "Cage vertices", "", "300", "The cage's size."},

@@ -82,8 +82,9 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
   this->LastErrorMessage.clear();
   try {
     if (path.empty()) throw repose::Error("no input file given");
+    std::vector<std::string> readNotes;
     repose::Volume volume = held ? vtkSlicerReposeVolumeConversion::FromImageData(held)
-                                 : vtkSlicerReposeLogicRead::ReadVolume(path);
+                                 : vtkSlicerReposeLogicRead::ReadVolume(path, &readNotes);
     for (const repose::Label& l : volume.labels().labels())
       this->VolumeLabelNames.push_back({l.layer, l.value, l.name});
     // Counted once: naming the labels, telling their convention and the lookup table's values
@@ -93,6 +94,9 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
     // The display's names and colours of labels the file left without (the file's names above).
     this->VolumeLabelNote =
         vtkSlicerReposeLogicRead::NameLabels(volume, this->TissueTablePath, path, &counts);
+    for (const std::string& n : readNotes)  // a SEG's grid, a fractional SEG thresholded
+      this->VolumeLabelNote =
+          n + (this->VolumeLabelNote.empty() ? "" : "\n") + this->VolumeLabelNote;
     this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
                                  : vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =

@@ -11,8 +11,9 @@
 
 namespace vtkSlicerReposeLogicRead {
 
-repose::Volume ReadVolume(const std::string& path) {
+repose::Volume ReadVolume(const std::string& path, std::vector<std::string>* notes) {
   repose::ReadOptions options;
+  if (notes) options.note = [notes](const std::string& n) { notes->push_back(n); };
   options.memoryLimitBytes = repose::memoryLeftWithin();
   options.budgetHint =
       "the workbench reads within half the physical memory; free memory, or use the command "

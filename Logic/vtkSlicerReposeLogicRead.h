@@ -14,7 +14,8 @@
 namespace vtkSlicerReposeLogicRead {
 
 // Throws repose::Error naming the file, as repose::readVolume does.
-repose::Volume ReadVolume(const std::string& path);
+// `notes`, when given, gets what the reader decided that the user should know (ReadOptions::note).
+repose::Volume ReadVolume(const std::string& path, std::vector<std::string>* notes = nullptr);
 // Names and colours for G's labels the file left without (repose::completeLabelNamesAndColors),
 // the names from the tissue table at `tissuesPath` when one is set and reads, else from the label
 // convention G follows. Returns the one-line note ("" when the file named every label).

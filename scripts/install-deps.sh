@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build ccache g++ pkg-config zlib1g-dev
   libeigen3-dev libsuitesparse-dev libcgal-dev
-  libnifti2-dev libteem-dev libgdcm-dev libhdf5-dev
+  libnifti2-dev libteem-dev libgdcm-dev libdcmtk-dev libhdf5-dev
   libvtk9-dev libvtk9-qt-dev qtbase5-dev
   nlohmann-json3-dev libgtest-dev libbenchmark-dev
   python3-dev pybind11-dev

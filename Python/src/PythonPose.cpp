@@ -253,18 +253,22 @@ report.json dict: volumes, masses, distortion, bone rigidity, quality targets).)
                              })
       .def(
           "write",
-          [](const PosedFrame& f, const std::string& folder, const std::string& format) {
+          [](const PosedFrame& f, const std::string& folder, const std::string& format,
+             const std::string& sourceDicom) {
             FrameWriteOptions options;
             options.labelMapFiles = labelMapFilesFor(format, "");
+            options.sourceDicom = sourceDicom.empty() ? "" : dicomSourceOf(sourceDicom);
             options.lockFolder = true;  // a `repose pose` writing there refuses, and so does this
             py::gil_scoped_release release;
             writePosedFrame(f, folder, options);
           },
-          py::arg("folder"), py::arg("output_format") = "nii.gz",
+          py::arg("folder"), py::arg("output_format") = "nii.gz", py::arg("source_dicom") = "",
           "Writes the posed maps (output_format 'nii.gz': posed_G.nii.gz and posed_S.nii.gz, "
           "each with a 3D Slicer colour table .ctbl; 'seg.nrrd': Slicer segmentations; "
-          "'both'), posed_image.nii.gz, transform.nrrd and report.json into the folder, as "
-          "`repose pose` does. Refused while another Repose run writes into the folder.");
+          "'both'; 'dcmseg': DICOM SEG, with the patient and study of source_dicom, a DICOM "
+          "file or folder, when given), posed_image.nii.gz, transform.nrrd and report.json into "
+          "the folder, as `repose pose` does. Refused while another Repose run writes into the "
+          "folder.");
 
   py::class_<Rig>(m, "Rig", R"doc(
 A body rigged for a pose: the cage and transfer mesh (built from the body-part map S, with the

@@ -218,6 +218,8 @@ nibabel gives them); writing into it changes the volume.)doc")
         o.progress = p.fn();
         o.memoryLimitBytes = memoryLeftWithin(memoryBytes.value_or(0.0));
         o.budgetHint = "pass a larger memory_bytes= to read_volume";
+        std::vector<std::string> notes;  // said as Python warnings once the GIL is back
+        o.note = [&notes](const std::string& n) { notes.push_back(n); };
         Volume v;
         try {
           py::gil_scoped_release release;
@@ -226,11 +228,13 @@ nibabel gives them); writing into it changes the volume.)doc")
           p.rethrow();
           throw;
         }
+        for (const std::string& n : notes)
+          if (PyErr_WarnEx(PyExc_UserWarning, n.c_str(), 1) < 0) throw py::error_already_set();
         return v;
       },
       py::arg("path"), py::arg("progress") = py::none(), py::arg("memory_bytes") = py::none(),
       R"doc(Reads a NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), 3D Slicer segmentation
-(.seg.nrrd) or a DICOM series folder into RAS millimetres. Raises repose.Error with the command
+(.seg.nrrd), DICOM SEG file, or a DICOM series folder into RAS millimetres. Raises repose.Error with the command
 line's one-line message (the file and the problem).
 
 memory_bytes: the budget (default: half the physical memory, as the command line's

@@ -118,6 +118,22 @@ def test_reads_stay_within_a_memory_budget(tmp_path, data_dir):
         rp.read_volume(seg, memory_bytes=0)
 
 
+def test_a_dicom_seg_reads_with_its_segments_and_its_grid_said_as_a_warning(tmp_path, data_dir):
+    seg = data_dir / "dcmqi_ct3slice" / "partial_overlaps.dcm"
+    with pytest.warns(UserWarning, match="placed on the grid of its referenced series"):
+        v = rp.read_volume(str(seg))
+    assert v.shape == (512, 512, 3)
+    assert [l["name"] for l in v.labels] == ["GREEN", "LIGHT_BLUE", "DARK_BLUE", "ORANGE", "PURPLE"]
+    assert sorted({l["layer"] for l in v.labels}) == [0, 1, 2]
+    assert all("TerminologyEntry:" in l["tags"] for l in v.labels)
+    # Written back as DICOM SEG and read again: the same voxels, names and layers.
+    out = tmp_path / "back.dcm"
+    rp.write_volume(v, str(out))
+    back = rp.read_volume(str(out))
+    assert np.array_equal(np.asarray(back.array), np.asarray(v.array))
+    assert [(l["name"], l["layer"]) for l in back.labels] == [(l["name"], l["layer"]) for l in v.labels]
+
+
 def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose):
     # 4 mm, not the module's 8 mm phantom: the coarsest whose bones reach the report's
     # 1000-voxel floor, so "all met" includes bones whose rigidity was actually measured.

@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 namespace repose {
@@ -102,56 +103,26 @@ void readPixels(const std::string& file, std::int64_t columns, std::int64_t rows
   }
 }
 
-}  // namespace
+// The slices of one series sorted along their normal, and the grid they make (checked: one
+// orientation, no two slices at one place, even spacing).
+struct SeriesLayout {
+  std::vector<Slice> slices;
+  VolumeGeometry geometry;
+};
 
-Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
+SeriesLayout layoutSeries(const std::string& folder, const gdcm::Scanner& scanner,
+                          const std::vector<std::string>& files) {
   namespace fs = std::filesystem;
-  gdcm::Trace::SetDebug(false);
-  gdcm::Trace::SetWarning(false);
-  gdcm::Trace::SetError(false);
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec)) throwFileError(folder, "not a folder");
-  gdcm::Directory directory;
-  directory.Load(folder, false);
-  const auto& files = directory.GetFilenames();
-  if (files.empty()) throwFileError(folder, "folder holds no files");
-
-  std::vector<std::string> dicomFiles;
-  for (const std::string& f : files)
-    if (io::screenDicomFile(f)) dicomFiles.push_back(f);
-  if (dicomFiles.empty()) throwFileError(folder, "no DICOM image slices found");
-  io::probeDicomFilesInChild(dicomFiles);
-  gdcm::Scanner scanner;
-  for (const gdcm::Tag& t : {kSeriesUid, kPosition, kOrientation, kPixelSpacing, kFrames})
-    scanner.AddTag(t);
-  if (!scanner.Scan(dicomFiles)) throwFileError(folder, "cannot scan the DICOM files");
-
-  std::map<std::string, std::vector<std::string>> series;
-  for (const std::string& f : dicomFiles) {
-    if (!scanner.IsKey(f.c_str())) continue;  // not DICOM (e.g. a DICOMDIR-less README)
-    const char* uid = scanner.GetValue(f.c_str(), kSeriesUid);
-    const char* ipp = scanner.GetValue(f.c_str(), kPosition);
-    if (!ipp) continue;  // not an image slice (SR, presentation state, ...)
-    series[uid ? uid : ""].push_back(f);
-  }
-  if (series.empty()) throwFileError(folder, "no DICOM image slices found");
-  auto chosen = std::max_element(series.begin(), series.end(), [](const auto& a, const auto& b) {
-    return a.second.size() < b.second.size();
-  });
-  for (auto it = series.begin(); it != series.end(); ++it)
-    if (it != chosen && it->second.size() == chosen->second.size())
-      throwFileError(folder, "holds several series of " + std::to_string(it->second.size()) +
-                                 " slices; give the folder of one series");
-
   // Orientation and ordering along the normal, checked for consistency across slices.
-  const std::string& first = chosen->second.front();
+  const std::string& first = files.front();
   const std::vector<double> iop = parseNumbers(scanner.GetValue(first.c_str(), kOrientation));
   if (iop.size() != 6) throwFileError(first, "missing or malformed ImageOrientationPatient");
   const Eigen::Vector3d rowDir = Eigen::Vector3d(iop[0], iop[1], iop[2]).normalized();
   const Eigen::Vector3d colDir = Eigen::Vector3d(iop[3], iop[4], iop[5]).normalized();
   const Eigen::Vector3d normal = rowDir.cross(colDir);
-  std::vector<Slice> slices;
-  for (const std::string& f : chosen->second) {
+  SeriesLayout layout;
+  std::vector<Slice>& slices = layout.slices;
+  for (const std::string& f : files) {
     const std::vector<double> p = parseNumbers(scanner.GetValue(f.c_str(), kPosition));
     const std::vector<double> o = parseNumbers(scanner.GetValue(f.c_str(), kOrientation));
     if (p.size() != 3) throwFileError(f, "malformed ImagePositionPatient");
@@ -193,7 +164,7 @@ Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
   const std::int64_t columns = probe.GetImage().GetDimension(0);
   const std::int64_t rows = probe.GetImage().GetDimension(1);
 
-  VolumeGeometry g;
+  VolumeGeometry& g = layout.geometry;
   g.dims = {columns, rows, static_cast<std::int64_t>(slices.size())};
   Eigen::Matrix4d lps = Eigen::Matrix4d::Identity();
   lps.block<3, 1>(0, 0) = rowDir * spacing[1];  // column index i moves along the row direction
@@ -202,6 +173,85 @@ Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
   lps.block<3, 1>(0, 3) = slices.front().position;
   g.ijkToRas = flipLpsRas(lps);
   g.validate(folder);
+  return layout;
+}
+
+// The DICOM files of a folder (not its subfolders) that pass the screen, probed in a child, and
+// scanned for the tags above. Throws naming the folder when it holds none.
+std::vector<std::string> scanFolder(const std::string& folder, gdcm::Scanner& scanner) {
+  gdcm::Trace::SetDebug(false);
+  gdcm::Trace::SetWarning(false);
+  gdcm::Trace::SetError(false);
+  std::error_code ec;
+  if (!std::filesystem::is_directory(folder, ec)) throwFileError(folder, "not a folder");
+  gdcm::Directory directory;
+  directory.Load(folder, false);
+  const auto& files = directory.GetFilenames();
+  if (files.empty()) throwFileError(folder, "folder holds no files");
+
+  std::vector<std::string> dicomFiles;
+  for (const std::string& f : files)
+    if (io::screenDicomFile(f)) dicomFiles.push_back(f);
+  if (dicomFiles.empty()) throwFileError(folder, "no DICOM image slices found");
+  io::probeDicomFilesInChild(dicomFiles);
+  for (const gdcm::Tag& t : {kSeriesUid, kPosition, kOrientation, kPixelSpacing, kFrames})
+    scanner.AddTag(t);
+  if (!scanner.Scan(dicomFiles)) throwFileError(folder, "cannot scan the DICOM files");
+  return dicomFiles;
+}
+
+// Image slices (files with a position) by SeriesInstanceUID.
+std::map<std::string, std::vector<std::string>> seriesOf(const gdcm::Scanner& scanner,
+                                                         const std::vector<std::string>& files) {
+  std::map<std::string, std::vector<std::string>> series;
+  for (const std::string& f : files) {
+    if (!scanner.IsKey(f.c_str())) continue;  // not DICOM (e.g. a DICOMDIR-less README)
+    const char* uid = scanner.GetValue(f.c_str(), kSeriesUid);
+    const char* ipp = scanner.GetValue(f.c_str(), kPosition);
+    if (!ipp) continue;  // not an image slice (SR, presentation state, segmentation, ...)
+    series[uid ? uid : ""].push_back(f);
+  }
+  return series;
+}
+
+}  // namespace
+
+std::optional<VolumeGeometry> findDicomSeriesGeometry(const std::string& folder,
+                                                      const std::string& seriesUid) {
+  gdcm::Scanner scanner;
+  std::vector<std::string> files;
+  try {
+    files = scanFolder(folder, scanner);
+  } catch (const Error&) {
+    return std::nullopt;  // no DICOM files here: the series is not in this folder
+  }
+  auto series = seriesOf(scanner, files);
+  // GDCM keeps the UID's padding (a trailing NUL or space of an odd-length value).
+  for (auto& [uid, slices] : series) {
+    std::string trimmed = uid;
+    while (!trimmed.empty() && (trimmed.back() == '\0' || trimmed.back() == ' '))
+      trimmed.pop_back();
+    if (trimmed == seriesUid) return layoutSeries(folder, scanner, slices).geometry;
+  }
+  return std::nullopt;
+}
+
+Volume readDicomSeries(const std::string& folder, const ReadOptions& options) {
+  gdcm::Scanner scanner;
+  const std::vector<std::string> dicomFiles = scanFolder(folder, scanner);
+  const auto series = seriesOf(scanner, dicomFiles);
+  if (series.empty()) throwFileError(folder, "no DICOM image slices found");
+  auto chosen = std::max_element(series.begin(), series.end(), [](const auto& a, const auto& b) {
+    return a.second.size() < b.second.size();
+  });
+  for (auto it = series.begin(); it != series.end(); ++it)
+    if (it != chosen && it->second.size() == chosen->second.size())
+      throwFileError(folder, "holds several series of " + std::to_string(it->second.size()) +
+                                 " slices; give the folder of one series");
+  const SeriesLayout layout = layoutSeries(folder, scanner, chosen->second);
+  const std::vector<Slice>& slices = layout.slices;
+  const VolumeGeometry& g = layout.geometry;
+  const std::int64_t columns = g.dims[0], rows = g.dims[1];
 
   // float32 holds every int16 exactly, so it can stage the values until the type is known: 4 bytes
   // a voxel staged, then up to 4 in the volume.

@@ -1,9 +1,14 @@
 // Format dispatch by file name; every reader and writer below reports one-line errors.
 #include "repose/io/VolumeIO.h"
 
+#include "repose/io/DicomSegIO.h"
 #include "repose/io/DicomSeriesIO.h"
 #include "repose/io/NiftiIO.h"
 #include "repose/io/NrrdIO.h"
+#include "repose/util/Error.h"
+
+#include "DcmtkCommon.h"
+#include "DicomScreen.h"
 
 #include <algorithm>
 #include <cctype>
@@ -26,9 +31,20 @@ FileFormat formatForPath(const std::string& path) {
   if (endsWithNoCase(path, ".seg.nrrd")) return FileFormat::SegNrrd;
   if (endsWithNoCase(path, ".nrrd") || endsWithNoCase(path, ".nhdr")) return FileFormat::Nrrd;
   if (endsWithNoCase(path, ".nii") || endsWithNoCase(path, ".nii.gz")) return FileFormat::Nifti;
+  if (endsWithNoCase(path, ".dcm")) return FileFormat::DicomFile;
+  // DICOM files often have no extension at all: known by their content.
+  if (std::filesystem::is_regular_file(path, ec)) {
+    bool dicom = false;
+    try {
+      dicom = io::screenDicomFile(path);
+    } catch (const Error&) {
+      dicom = true;  // DICOM, but corrupt: its reader says how
+    }
+    if (dicom) return FileFormat::DicomFile;
+  }
   throwFileError(path,
-                 "unknown file type (expected .nii, .nii.gz, .nrrd, .nhdr, .seg.nrrd or a "
-                 "DICOM folder)");
+                 "unknown file type (expected .nii, .nii.gz, .nrrd, .nhdr, .seg.nrrd, a DICOM "
+                 "SEG file or a DICOM folder)");
 }
 
 const char* formatName(FileFormat f) {
@@ -41,6 +57,8 @@ const char* formatName(FileFormat f) {
       return "Slicer segmentation (.seg.nrrd)";
     case FileFormat::DicomSeries:
       return "DICOM series";
+    case FileFormat::DicomFile:
+      return "DICOM file";
   }
   return "?";
 }
@@ -55,7 +73,17 @@ Volume readVolume(const std::string& path, const ReadOptions& options) {
     case FileFormat::SegNrrd:
       return readNrrd(path, options);
     case FileFormat::DicomSeries:
+      if (const auto seg = findDicomSegInFolder(path)) return readDicomSeg(*seg, options);
       return readDicomSeries(path, options);
+    case FileFormat::DicomFile: {
+      const std::string sop = io::dicomSopClassOf(path);
+      if (sop == io::kRtStructureSetStorageUid)
+        throwFileError(path,
+                       "an RT Structure Set (contours) is not a volume; Repose reads DICOM "
+                       "segmentations (SEG) and image series");
+      if (sop.empty() || sop == io::kSegmentationStorageUid) return readDicomSeg(path, options);
+      throwFileError(path, "a DICOM image file: give the folder of its series, or a DICOM SEG");
+    }
   }
   throwFileError(path, "unknown file type");
 }
@@ -68,14 +96,45 @@ void writeVolume(const Volume& volume, const std::string& path, const WriteOptio
     case FileFormat::Nrrd:
     case FileFormat::SegNrrd:
       return writeNrrd(volume, path, options);
+    case FileFormat::DicomFile: {
+      DicomSegWriteOptions o;
+      o.progress = options.progress;
+      o.sourceDicom = options.sourceDicom;
+      return writeDicomSeg(volume, path, o);
+    }
     case FileFormat::DicomSeries:
       break;
   }
-  throwFileError(path, "DICOM output is not supported; write NIfTI or NRRD");
+  throwFileError(path, "is a DICOM series folder; write a DICOM SEG (.dcm), NIfTI or NRRD");
+}
+
+std::string dicomSourceOf(const std::string& path) {
+  try {
+    switch (formatForPath(path)) {
+      case FileFormat::DicomFile:
+        return path;
+      case FileFormat::DicomSeries: {
+        if (const auto seg = findDicomSegInFolder(path)) return *seg;
+        std::vector<std::string> files;
+        std::error_code ec;
+        for (std::filesystem::directory_iterator it(path, ec), end; !ec && it != end;
+             it.increment(ec))
+          if (it->is_regular_file(ec)) files.push_back(it->path().string());
+        std::sort(files.begin(), files.end());
+        for (const std::string& f : files)
+          if (!io::dicomSopClassOf(f).empty()) return f;
+        return "";
+      }
+      default:
+        return "";
+    }
+  } catch (const Error&) {
+    return "";
+  }
 }
 
 std::vector<std::string> writableExtensions() {
-  return {".nii", ".nii.gz", ".nrrd", ".nhdr", ".seg.nrrd"};
+  return {".nii", ".nii.gz", ".nrrd", ".nhdr", ".seg.nrrd", ".dcm"};
 }
 
 }  // namespace repose

@@ -138,8 +138,9 @@ nlohmann::json collisionReport(const std::vector<PieceOverlap>& overlaps, const 
 // The report's "outputs": the label maps (the NIfTI when both formats are written), their Slicer
 // companions, and the field.
 nlohmann::json outputFiles(LabelMapFiles files) {
-  const bool nifti = files != LabelMapFiles::SegNrrd, seg = files != LabelMapFiles::Nifti;
-  const char* ext = nifti ? ".nii.gz" : ".seg.nrrd";
+  const bool nifti = files == LabelMapFiles::Nifti || files == LabelMapFiles::Both;
+  const bool seg = files == LabelMapFiles::SegNrrd || files == LabelMapFiles::Both;
+  const char* ext = nifti ? ".nii.gz" : seg ? ".seg.nrrd" : ".dcm";
   nlohmann::json out = {{"posed_labels", std::string("posed_G") + ext},
                         {"posed_parts", std::string("posed_S") + ext},
                         {"transform", "transform.nrrd"}};
@@ -154,11 +155,12 @@ LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inp
   if (choice == "nii.gz") return LabelMapFiles::Nifti;
   if (choice == "seg.nrrd") return LabelMapFiles::SegNrrd;
   if (choice == "both") return LabelMapFiles::Both;
+  if (choice == "dcmseg") return LabelMapFiles::DicomSeg;
   if (choice == "auto")
     return !inputPath.empty() && formatForPath(inputPath) == FileFormat::SegNrrd
                ? LabelMapFiles::SegNrrd
                : LabelMapFiles::Nifti;
-  throw Error("output format '" + choice + "' is not one of auto, nii.gz, seg.nrrd, both");
+  throw Error("output format '" + choice + "' is not one of auto, nii.gz, seg.nrrd, both, dcmseg");
 }
 
 double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volume* image) {
@@ -340,8 +342,9 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
       message.replace(at, hidden.size(), dir.string());
     return Error(message);
   };
-  const bool nifti = files != LabelMapFiles::SegNrrd;
-  const bool seg = files != LabelMapFiles::Nifti;
+  const bool nifti = files == LabelMapFiles::Nifti || files == LabelMapFiles::Both;
+  const bool seg = files == LabelMapFiles::SegNrrd || files == LabelMapFiles::Both;
+  const bool dcm = files == LabelMapFiles::DicomSeg;
   std::string written;
   try {
     for (const auto& [map, stem] :
@@ -351,6 +354,11 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
         writeColorTable(*map, (temp / (std::string(stem) + ".ctbl")).string());
       }
       if (seg) writeVolume(*map, (temp / (std::string(stem) + ".seg.nrrd")).string());
+      if (dcm) {
+        WriteOptions w;
+        w.sourceDicom = options.sourceDicom;
+        writeVolume(*map, (temp / (std::string(stem) + ".dcm")).string(), w);
+      }
     }
     if (frame.image) writeVolume(*frame.image, (temp / "posed_image.nii.gz").string());
     writeDisplacementFieldNrrd(frame.field, frame.grid, (temp / "transform.nrrd").string());
@@ -362,7 +370,9 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
       // Written as it will lie in `dir`: the frame's files relative to it.
       SlicerSceneFiles scene;
       scene.inputLabels = fs::absolute(options.sceneInputLabels).string();
-      scene.posedLabels = (dir / (nifti ? "posed_G.nii.gz" : "posed_G.seg.nrrd")).string();
+      // A DICOM SEG is loaded through Slicer's DICOM database, not a scene: not listed.
+      if (!dcm)
+        scene.posedLabels = (dir / (nifti ? "posed_G.nii.gz" : "posed_G.seg.nrrd")).string();
       if (nifti) scene.colorTable = (dir / "posed_G.ctbl").string();
       scene.transform = (dir / "transform.nrrd").string();
       scene.cage = options.sceneCage;
@@ -389,9 +399,9 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
   // frame does not write are removed (a report never sits beside another run's files), as one
   // commit that a kill cannot leave half done (commitFiles).
   std::vector<CommitStep> steps;
-  for (const char* name :
-       {"posed_G.nii.gz", "posed_G.ctbl", "posed_G.seg.nrrd", "posed_S.nii.gz", "posed_S.ctbl",
-        "posed_S.seg.nrrd", "posed_image.nii.gz", "transform.nrrd", "scene.mrml", "report.json"}) {
+  for (const char* name : {"posed_G.nii.gz", "posed_G.ctbl", "posed_G.seg.nrrd", "posed_S.nii.gz",
+                           "posed_S.ctbl", "posed_S.seg.nrrd", "posed_G.dcm", "posed_S.dcm",
+                           "posed_image.nii.gz", "transform.nrrd", "scene.mrml", "report.json"}) {
     if (fs::exists(temp / name))
       steps.push_back({(temp / name).string(), (dir / name).string()});
     else if (fs::exists(dir / name))

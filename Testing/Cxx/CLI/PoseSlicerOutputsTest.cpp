@@ -6,8 +6,10 @@
 #include "CliTestFiles.h"
 #include "CommandRunner.h"
 #include "TestPaths.h"
+#include "TestVolumes.h"
 
 #include "repose/io/VolumeIO.h"
+#include "repose/volume/SegmentTerminology.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -115,6 +117,28 @@ TEST(PoseSlicerOutputs, ASegmentationComesBackWithItsNamesColoursAndTerminology)
   while (std::getline(ctbl, line))
     if (line.rfind("250 ", 0) == 0) liverLine = line;
   EXPECT_EQ(liverLine, "250 planned_implant 26 230 77 255");
+
+  // DICOM SEG: the same posed voxels, names, colours and codes, read back from posed_G.dcm.
+  const CommandResult dcm = runCommand("repose", common + " --output-format dcmseg");
+  ASSERT_EQ(dcm.exitCode, 0) << dcm.err;
+  EXPECT_EQ(filesIn(dir.file("out")),
+            (std::set<std::string>{"posed_G.dcm", "posed_S.dcm", "transform.nrrd", "report.json"}));
+  report = readJsonFile(dir.file("out/report.json"));
+  EXPECT_EQ(report["outputs"]["posed_labels"], "posed_G.dcm");
+  const Volume posedDicom = readVolume(dir.file("out/posed_G.dcm"));
+  EXPECT_TRUE(sameVoxels(posedDicom, posed));
+  EXPECT_LT(matrixDifference(posedDicom.geometry().ijkToRas, posed.geometry().ijkToRas), 1e-6);
+  ASSERT_EQ(posedDicom.labels().size(), table.size());
+  for (const Label& l : table.labels()) {
+    const Label* p = posedDicom.labels().find(l.value, l.layer);
+    ASSERT_NE(p, nullptr) << l.name;
+    EXPECT_EQ(p->name, l.name);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(p->color[c], l.color[c], 0.5 / 255) << l.name;
+    // DICOM needs codes: a segment without them is coded SCT Tissue.
+    EXPECT_EQ(terminologyFromTags(p->tags),
+              terminologyFromTags(l.tags).value_or(genericTissueTerminology()))
+        << l.name;
+  }
 
   // Both.
   const CommandResult both = runCommand("repose", common + " --output-format both");

@@ -3,6 +3,7 @@
 #include "TestPaths.h"
 #include "TestVolumes.h"
 
+#include "repose/io/DicomSeriesIO.h"
 #include "repose/io/VolumeIO.h"
 
 #include <gtest/gtest.h>
@@ -187,8 +188,18 @@ TEST(DicomSeries, AFileThatMakesGdcmAllocateGigabytesIsRefused) {
   bytes.insert(studyTime, std::string("\x01\x00", 2));
   bytes.resize(4706);
   std::ofstream(dir.file("big.dcm"), std::ios::binary) << bytes;
+  // The file is (was) a SEG, which readVolume gives DCMTK: refused there in one line too.
   try {
     readVolume(dir.path().string());
+    FAIL() << "the file was read";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("big.dcm: "), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+  // GDCM's guard, as a series folder meets it.
+  try {
+    readDicomSeries(dir.path().string());
     FAIL() << "the file was read";
   } catch (const Error& e) {
     const std::string msg = e.what();

@@ -18,9 +18,11 @@ namespace repose {
 
 // The files that hold a frame's posed label maps (docs/FORMATS.md): NIfTI with a 3D Slicer colour
 // table beside each (.ctbl: Slicer ignores a NIfTI's own label table and would show grey values),
-// Slicer segmentations (.seg.nrrd: names, colours and terminology open as segments), or both.
-enum class LabelMapFiles { Nifti, SegNrrd, Both };
-// "nii.gz", "seg.nrrd" or "both"; "auto": .seg.nrrd when the input label map is one, else NIfTI.
+// Slicer segmentations (.seg.nrrd: names, colours and terminology open as segments), both, or
+// DICOM SEG (.dcm: for a PACS, or Slicer's DICOM module; io/DicomSegIO.h).
+enum class LabelMapFiles { Nifti, SegNrrd, Both, DicomSeg };
+// "nii.gz", "seg.nrrd", "both" or "dcmseg"; "auto": .seg.nrrd when the input label map is one,
+// else NIfTI.
 // Throws repose::Error naming the choice otherwise.
 LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inputPath);
 
@@ -84,7 +86,8 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
                      const Volume& parts, const PoseFrameOptions& options = {});
 
 // Writes the frame into `folder` (created; its parent must exist): posed_G and posed_S as
-// frame.labelMapFiles says (posed_G.nii.gz + posed_G.ctbl, posed_G.seg.nrrd, or all three),
+// frame.labelMapFiles says (posed_G.nii.gz + posed_G.ctbl, posed_G.seg.nrrd, all three, or
+// posed_G.dcm),
 // posed_image.nii.gz (with an image), transform.nrrd and report.json, as one unit: an error or an
 // interrupt leaves the folder as it was. Files of ours an earlier run left there and this frame
 // does not write (another label-map format, an image) are removed, so nothing stale remains.
@@ -100,6 +103,9 @@ struct FrameWriteOptions {
   // hold no lock of their own: Python, the workbench). The command line locks its --out for the
   // whole run instead.
   bool lockFolder = false;
+  // DICOM SEG outputs: a DICOM file of the input (its SEG, or a slice of its series) whose
+  // patient and study they take (dicomSourceOf); "": none.
+  std::string sourceDicom;
 };
 // The same, with the label maps and the scene as `options` say (not frame.labelMapFiles).
 // Both return report.json's text as written (its "outputs" name the files written).
