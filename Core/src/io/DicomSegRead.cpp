@@ -22,6 +22,8 @@
 #include <dcmtk/dcmdata/dcxfer.h>
 #include <dcmtk/dcmiod/cielabutil.h>
 
+#include "DcmtkAttributes.h"
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -35,58 +37,24 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-std::string trimmed(const OFString& s) {
-  std::string t(s.c_str());
-  while (!t.empty() && (t.back() == ' ' || t.back() == '\0')) t.pop_back();
-  std::size_t start = 0;
-  while (start < t.size() && t[start] == ' ') ++start;
-  return t.substr(start);
-}
-
-std::string text(DcmItem* item, const DcmTagKey& tag) {
-  OFString v;
-  if (item && item->findAndGetOFStringArray(tag, v).good()) return trimmed(v);
-  return "";
-}
-
-std::vector<double> numbers(DcmItem* item, const DcmTagKey& tag) {
-  std::vector<double> out;
-  DcmElement* e = nullptr;
-  if (!item || item->findAndGetElement(tag, e).bad() || !e) return out;
-  for (unsigned long i = 0; i < e->getVM(); ++i) {
-    Float64 v = 0;
-    if (e->getFloat64(v, i).bad() || !std::isfinite(v)) return {};
-    out.push_back(v);
-  }
-  return out;
-}
-
-// An integer attribute of any integer VR (US, UL, SS, SL, IS).
-long integer(DcmItem* item, const DcmTagKey& tag, long fallback) {
-  long v = 0;
-  if (!item || item->findAndGetLongInt(tag, v).bad() || std::labs(v) > 2000000000L) return fallback;
-  return v;
-}
-
-DcmItem* itemOf(DcmItem* parent, const DcmTagKey& sequence, long index = 0) {
-  DcmItem* out = nullptr;
-  if (parent && parent->findAndGetSequenceItem(sequence, out, index).good()) return out;
-  return nullptr;
-}
+using io::dicomInteger;
+using io::dicomItem;
+using io::dicomNumbers;
+using io::dicomText;
 
 // A functional group macro of a frame: its own, else the shared one.
 DcmItem* groupOf(DcmItem* perFrame, DcmItem* shared, const DcmTagKey& macro) {
-  if (DcmItem* g = itemOf(perFrame, macro)) return g;
-  return itemOf(shared, macro);
+  if (DcmItem* g = dicomItem(perFrame, macro)) return g;
+  return dicomItem(shared, macro);
 }
 
 TerminologyCode codeOf(DcmItem* parent, const DcmTagKey& sequence) {
-  DcmItem* c = itemOf(parent, sequence);
+  DcmItem* c = dicomItem(parent, sequence);
   if (!c) return {};
-  TerminologyCode code{text(c, DCM_CodingSchemeDesignator), text(c, DCM_CodeValue),
-                       text(c, DCM_CodeMeaning)};
-  if (code.value.empty()) code.value = text(c, DCM_LongCodeValue);
-  if (code.value.empty()) code.value = text(c, DCM_URNCodeValue);
+  TerminologyCode code{dicomText(c, DCM_CodingSchemeDesignator), dicomText(c, DCM_CodeValue),
+                       dicomText(c, DCM_CodeMeaning)};
+  if (code.value.empty()) code.value = dicomText(c, DCM_LongCodeValue);
+  if (code.value.empty()) code.value = dicomText(c, DCM_URNCodeValue);
   return code;
 }
 
@@ -274,34 +242,25 @@ std::optional<std::string> findDicomSegInFolder(const std::string& folder) {
 }
 
 Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
-  io::requireReadableFile(path);
-  io::prepareDcmtk(path);
-  if (!io::screenDicomFile(path)) throwFileError(path, "not a DICOM file");
   DcmFileFormat file;
-  const OFCondition loaded = file.loadFile(path.c_str());
-  if (loaded.bad())
-    throwFileError(path, std::string("not a readable DICOM file (") + loaded.text() + ")");
-  DcmDataset* ds = file.getDataset();
-  const std::string sop = text(ds, DCM_SOPClassUID);
-  if (sop != io::kSegmentationStorageUid)
-    throwFileError(path,
-                   "not a DICOM segmentation (SOP class " + (sop.empty() ? "missing" : sop) + ")");
+  DcmDataset* ds =
+      &io::loadDicomOfClass(file, path, io::kSegmentationStorageUid, "a DICOM segmentation");
 
   // Pixel layout.
-  const long rows = integer(ds, DCM_Rows, 0), columns = integer(ds, DCM_Columns, 0);
+  const long rows = dicomInteger(ds, DCM_Rows, 0), columns = dicomInteger(ds, DCM_Columns, 0);
   if (rows <= 0 || columns <= 0) throwFileError(path, "missing or zero Rows/Columns");
-  const std::string type = text(ds, DCM_SegmentationType);
+  const std::string type = dicomText(ds, DCM_SegmentationType);
   const bool fractional = type == "FRACTIONAL";
   if (!fractional && type != "BINARY")
     throwFileError(path, "SegmentationType is '" + type + "' (expected BINARY or FRACTIONAL)");
-  const long bits = integer(ds, DCM_BitsAllocated, 0);
+  const long bits = dicomInteger(ds, DCM_BitsAllocated, 0);
   if (bits != (fractional ? 8 : 1))
     throwFileError(path, "BitsAllocated is " + std::to_string(bits) + " for a " + type +
                              " segmentation (expected " + (fractional ? "8)" : "1)"));
-  const long maxFraction = fractional ? integer(ds, DCM_MaximumFractionalValue, 0) : 1;
+  const long maxFraction = fractional ? dicomInteger(ds, DCM_MaximumFractionalValue, 0) : 1;
   if (fractional && (maxFraction < 1 || maxFraction > 255))
     throwFileError(path, "missing or invalid MaximumFractionalValue");
-  const long frames = integer(ds, DCM_NumberOfFrames, 0);
+  const long frames = dicomInteger(ds, DCM_NumberOfFrames, 0);
   if (frames < 1) throwFileError(path, "NumberOfFrames is missing or zero");
   DcmSequenceOfItems* perFrame = nullptr;
   if (ds->findAndGetSequence(DCM_PerFrameFunctionalGroupsSequence, perFrame).bad() || !perFrame ||
@@ -309,7 +268,7 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
     throwFileError(path, "the per-frame functional groups (" +
                              std::to_string(perFrame ? perFrame->card() : 0) +
                              ") do not match NumberOfFrames (" + std::to_string(frames) + ")");
-  DcmItem* shared = itemOf(ds, DCM_SharedFunctionalGroupsSequence);
+  DcmItem* shared = dicomItem(ds, DCM_SharedFunctionalGroupsSequence);
 
   // Segments, by their SegmentNumber.
   std::map<int, Segment> segments;
@@ -319,7 +278,7 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
     throwFileError(path, "no SegmentSequence");
   for (unsigned long s = 0; s < segmentItems->card(); ++s) {
     DcmItem* item = segmentItems->getItem(s);
-    const long number = integer(item, DCM_SegmentNumber, 0);
+    const long number = dicomInteger(item, DCM_SegmentNumber, 0);
     if (number < 1 || number > 65535)
       throwFileError(path, "segment " + std::to_string(s + 1) + " has no valid SegmentNumber");
     if (segments.count(int(number)))
@@ -328,7 +287,7 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
     seg.number = int(number);
     Label& l = seg.label;
     l.value = seg.number;
-    l.name = text(item, DCM_SegmentLabel);
+    l.name = dicomText(item, DCM_SegmentLabel);
     if (l.name.empty()) l.name = "Segment " + std::to_string(number);
     if (auto rgb = colourOf(item)) {
       l.color = *rgb;
@@ -340,13 +299,13 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
     t.category = codeOf(item, DCM_SegmentedPropertyCategoryCodeSequence);
     t.type = codeOf(item, DCM_SegmentedPropertyTypeCodeSequence);
     // The type modifier sits in the type's code item (current standard) or beside it (older).
-    t.typeModifier = codeOf(itemOf(item, DCM_SegmentedPropertyTypeCodeSequence),
+    t.typeModifier = codeOf(dicomItem(item, DCM_SegmentedPropertyTypeCodeSequence),
                             DCM_SegmentedPropertyTypeModifierCodeSequence);
     if (t.typeModifier.empty())
       t.typeModifier = codeOf(item, DCM_SegmentedPropertyTypeModifierCodeSequence);
     t.region = codeOf(item, DCM_AnatomicRegionSequence);
     t.regionModifier =
-        codeOf(itemOf(item, DCM_AnatomicRegionSequence), DCM_AnatomicRegionModifierSequence);
+        codeOf(dicomItem(item, DCM_AnatomicRegionSequence), DCM_AnatomicRegionModifierSequence);
     if (!t.category.empty() && !t.type.empty()) l.tags = terminologyTag(t);
     segments.emplace(seg.number, std::move(seg));
   }
@@ -362,7 +321,7 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
       if (!io::getReposeLabel(*item, value, layer) || value < 1 || layer < 0 ||
           layer >= int(segments.size()) || !seen.insert({value, layer}).second)
         break;
-      own[int(integer(item, DCM_SegmentNumber, 0))] = {value, layer};
+      own[int(dicomInteger(item, DCM_SegmentNumber, 0))] = {value, layer};
     }
     if (own.size() == segments.size())
       for (auto& entry : segments) {
@@ -379,12 +338,12 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
     DcmItem* item = perFrame->getItem(static_cast<unsigned long>(f));
     const std::string which = "frame " + std::to_string(f + 1);
     const std::vector<double> ipp =
-        numbers(groupOf(item, shared, DCM_PlanePositionSequence), DCM_ImagePositionPatient);
+        dicomNumbers(groupOf(item, shared, DCM_PlanePositionSequence), DCM_ImagePositionPatient);
     if (ipp.size() != 3)
       throwFileError(path, which + " has no plane position (ImagePositionPatient)");
     positions[std::size_t(f)] = Vec3(ipp[0], ipp[1], ipp[2]);
-    const std::vector<double> iop =
-        numbers(groupOf(item, shared, DCM_PlaneOrientationSequence), DCM_ImageOrientationPatient);
+    const std::vector<double> iop = dicomNumbers(
+        groupOf(item, shared, DCM_PlaneOrientationSequence), DCM_ImageOrientationPatient);
     if (iop.size() != 6)
       throwFileError(path, which + " has no plane orientation (ImageOrientationPatient)");
     if (f == 0) {
@@ -397,27 +356,27 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
       plane.rowDir.normalize();
       plane.colDir.normalize();
       DcmItem* measures = groupOf(item, shared, DCM_PixelMeasuresSequence);
-      const std::vector<double> spacing = numbers(measures, DCM_PixelSpacing);
+      const std::vector<double> spacing = dicomNumbers(measures, DCM_PixelSpacing);
       if (spacing.size() != 2 || !(spacing[0] > 0) || !(spacing[1] > 0))
         throwFileError(path, which + " has no valid PixelSpacing");
       plane.rowStep = spacing[0];
       plane.columnStep = spacing[1];
-      const std::vector<double> between = numbers(measures, DCM_SpacingBetweenSlices);
+      const std::vector<double> between = dicomNumbers(measures, DCM_SpacingBetweenSlices);
       if (between.size() == 1 && between[0] > 0) plane.sliceSpacing = between[0];
-      const std::vector<double> thick = numbers(measures, DCM_SliceThickness);
+      const std::vector<double> thick = dicomNumbers(measures, DCM_SliceThickness);
       if (thick.size() == 1 && thick[0] > 0) plane.thickness = thick[0];
     } else {
       for (int c = 0; c < 6; ++c)
         if (std::fabs(iop[c] - orientation0[c]) > 1e-4)
           throwFileError(path, which + " has another orientation than frame 1");
       const std::vector<double> spacing =
-          numbers(groupOf(item, shared, DCM_PixelMeasuresSequence), DCM_PixelSpacing);
+          dicomNumbers(groupOf(item, shared, DCM_PixelMeasuresSequence), DCM_PixelSpacing);
       if (spacing.size() != 2 || std::fabs(spacing[0] - plane.rowStep) > 1e-4 * plane.rowStep ||
           std::fabs(spacing[1] - plane.columnStep) > 1e-4 * plane.columnStep)
         throwFileError(path, which + " has another PixelSpacing than frame 1");
     }
-    long number = integer(groupOf(item, shared, DCM_SegmentIdentificationSequence),
-                          DCM_ReferencedSegmentNumber, -1);
+    long number = dicomInteger(groupOf(item, shared, DCM_SegmentIdentificationSequence),
+                               DCM_ReferencedSegmentNumber, -1);
     if (number == -1 && segments.size() == 1) number = segments.begin()->first;
     auto seg = segments.find(int(number));
     if (number < 0 || seg == segments.end())
@@ -453,7 +412,7 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
   std::vector<Placement> placements;
   VolumeGeometry grid;
   const std::string referenced =
-      text(itemOf(ds, DCM_ReferencedSeriesSequence), DCM_SeriesInstanceUID);
+      dicomText(dicomItem(ds, DCM_ReferencedSeriesSequence), DCM_SeriesInstanceUID);
   if (auto reference = referencedGrid(path, referenced, options)) {
     if (auto placed = placeFrames(*reference, plane, positions, rows, columns)) {
       grid = *reference;
@@ -564,8 +523,9 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
   }
   volume.setLabelMap(true);
   if (fractional && options.note)
-    options.note(path + ": FRACTIONAL segmentation (" + text(ds, DCM_SegmentationFractionalType) +
-                 ", maximum " + std::to_string(maxFraction) + ") thresholded at 0.5");
+    options.note(path + ": FRACTIONAL segmentation (" +
+                 dicomText(ds, DCM_SegmentationFractionalType) + ", maximum " +
+                 std::to_string(maxFraction) + ") thresholded at 0.5");
   return volume;
 }
 

@@ -79,8 +79,8 @@ Volume readVolume(const std::string& path, const ReadOptions& options) {
       const std::string sop = io::dicomSopClassOf(path);
       if (sop == io::kRtStructureSetStorageUid)
         throwFileError(path,
-                       "an RT Structure Set (contours) is not a volume; Repose reads DICOM "
-                       "segmentations (SEG) and image series");
+                       "an RT Structure Set (contours), not a volume: rasterize it with `repose "
+                       "convert` and --reference IMAGE or --spacing-mm MM");
       if (sop.empty() || sop == io::kSegmentationStorageUid) return readDicomSeg(path, options);
       throwFileError(path, "a DICOM image file: give the folder of its series, or a DICOM SEG");
     }

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cstring>
 #include <filesystem>
 
 using namespace repose;
@@ -93,6 +94,50 @@ TEST(ConvertCommand, DicomSeriesToNifti) {
   const Volume ct = readVolume(out);
   EXPECT_EQ(ct.dims(), (std::array<std::int64_t, 3>{512, 512, 3}));
   EXPECT_FALSE(ct.isLabelMap());
+}
+
+TEST(ConvertCommand, DicomSegAndRtStructInAndDicomSegOut) {
+  ScratchDir dir;
+  // A SEG to NIfTI, then the NIfTI back to a SEG with the SEG's patient and study.
+  const std::string seg = dataPath("dcmqi_ct3slice/liver.dcm");
+  const CommandResult in = runCommand(
+      "repose", "convert " + shellQuote(seg) + " " + shellQuote(dir.file("liver.nii.gz")));
+  ASSERT_EQ(in.exitCode, 0) << in.err;
+  EXPECT_NE(in.err.find("repose: note: " + seg + ": placed on the grid of its referenced series"),
+            std::string::npos)
+      << in.err;
+  const CommandResult out =
+      runCommand("repose", "convert " + shellQuote(seg) + " " + shellQuote(dir.file("again.dcm")));
+  ASSERT_EQ(out.exitCode, 0) << out.err;
+  const Volume a = readVolume(dir.file("liver.nii.gz")), b = readVolume(dir.file("again.dcm"));
+  ASSERT_EQ(a.dims(), b.dims());
+  EXPECT_EQ(std::memcmp(a.layerData(), b.layerData(), a.byteSize()), 0);
+  EXPECT_EQ(b.labels().find(1)->name, "Liver");
+
+  // An RT Structure Set needs a grid; with one, its ROIs come out as layered labels.
+  const std::string rtss = dataPath("dicompyler_rt/rtss.dcm");
+  const CommandResult noGrid = runCommand(
+      "repose", "convert " + shellQuote(rtss) + " " + shellQuote(dir.file("rs.seg.nrrd")));
+  EXPECT_EQ(noGrid.exitCode, 2);
+  EXPECT_NE(noGrid.err.find("give its grid with --reference IMAGE or --spacing-mm MM"),
+            std::string::npos)
+      << noGrid.err;
+  const CommandResult notContours =
+      runCommand("repose", "convert " + shellQuote(seg) + " " + shellQuote(dir.file("x.nii.gz")) +
+                               " --spacing-mm 2");
+  EXPECT_EQ(notContours.exitCode, 2);
+  const CommandResult rs =
+      runCommand("repose", "convert " + shellQuote(rtss) + " " +
+                               shellQuote(dir.file("rs.seg.nrrd")) + " --spacing-mm 4");
+  ASSERT_EQ(rs.exitCode, 0) << rs.err;
+  const Volume rois = readVolume(dir.file("rs.seg.nrrd"));
+  EXPECT_EQ(rois.labels().size(), 10u);
+  EXPECT_GT(rois.layers(), 1);
+  ASSERT_TRUE(rois.labels().find(1, 0));
+  EXPECT_EQ(rois.labels().find(1, 0)->name, "BODY");
+  // Read as a volume, it says how to rasterize it.
+  const CommandResult info = runCommand("repose", "info " + shellQuote(rtss));
+  EXPECT_NE(info.err.find("rasterize it with `repose convert`"), std::string::npos) << info.err;
 }
 
 TEST(ConvertCommand, BadInputFailsWithOneLineAndNoOutput) {
