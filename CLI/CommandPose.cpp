@@ -251,7 +251,15 @@ int runPose(const Args& args) {
 
   // The inputs are held in core for the whole job: each read refuses, with the numbers, what the
   // budget cannot hold; the frames are checked against what is left (checkGrid below).
-  const Volume organs = readVolume(p.get("input"), readOptionsWithin(budget, !quiet));
+  // What the reader decided about the input (a DICOM SEG's grid, a fractional SEG thresholded):
+  // said at once, and kept in each frame's report ("input_notes").
+  std::vector<std::string> inputNotes;
+  ReadOptions organsRead = readOptionsWithin(budget, !quiet);
+  organsRead.note = [&inputNotes, say = organsRead.note](const std::string& n) {
+    inputNotes.push_back(n);
+    if (say) say(n);
+  };
+  const Volume organs = readVolume(p.get("input"), organsRead);
   Volume parts = readVolume(p.get("parts"), readOptionsWithin(budget, !quiet));
   if (const std::string w = nameBodyPartsByRigConvention(parts, p.get("parts")); !w.empty())
     std::cerr << "repose pose: warning: " << w << "\n";
@@ -336,6 +344,11 @@ int runPose(const Args& args) {
     };
     PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
     posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
+    if (!inputNotes.empty()) {
+      json withNotes = json::parse(posed.reportJson);
+      withNotes["input_notes"] = inputNotes;
+      posed.reportJson = withNotes.dump();
+    }
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
     FrameWriteOptions wo;
     wo.labelMapFiles = labelMapFiles;

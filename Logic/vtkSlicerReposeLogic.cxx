@@ -77,6 +77,7 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
   this->VolumeLookupTable = nullptr;
   this->VolumeLabelNames.clear();
   this->VolumeLabelNote.clear();
+  this->VolumeReadNotes.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath = path;  // before the node is told, so its Modified does not reload
   this->LastErrorMessage.clear();
@@ -94,9 +95,7 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
     // The display's names and colours of labels the file left without (the file's names above).
     this->VolumeLabelNote =
         vtkSlicerReposeLogicRead::NameLabels(volume, this->TissueTablePath, path, &counts);
-    for (const std::string& n : readNotes)  // a SEG's grid, a fractional SEG thresholded
-      this->VolumeLabelNote =
-          n + (this->VolumeLabelNote.empty() ? "" : "\n") + this->VolumeLabelNote;
+    this->VolumeReadNotes = readNotes;  // a SEG's grid, a fractional SEG thresholded
     this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
                                  : vtkSlicerReposeVolumeConversion::ToImageData(volume);
     this->VolumeIJKToRASMatrix =
@@ -128,6 +127,7 @@ void vtkSlicerReposeLogic::ClearVolume() {
   this->VolumeLookupTable = nullptr;
   this->VolumeLabelNames.clear();
   this->VolumeLabelNote.clear();
+  this->VolumeReadNotes.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath.clear();
   this->LastErrorMessage.clear();
@@ -170,6 +170,10 @@ std::string vtkSlicerReposeLogic::GetVolumeSummary() const {
     out << "\nNames: "
         << (colon == std::string::npos ? this->VolumeLabelNote
                                        : this->VolumeLabelNote.substr(colon + 2));
+  }
+  for (const std::string& note : this->VolumeReadNotes) {  // the same, for what the reader said
+    const bool named = note.rfind(this->VolumePath + ": ", 0) == 0;
+    out << "\nNote: " << (named ? note.substr(this->VolumePath.size() + 2) : note);
   }
   return out.str();
 }

@@ -396,6 +396,7 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::string TissueTablePath;
   std::string LastRigSummary;
   std::string VolumeLabelNote;  // where the labels' names came from, when not from the file
+  std::vector<std::string> VolumeReadNotes;  // what the reader decided (ReadOptions::note)
   std::string LastRefinementSummary;
   std::vector<int> RefinementVertices;
   std::vector<double> RefinementErrors;

@@ -785,7 +785,8 @@ void qSlicerReposeModuleWidget::onAngleChanged(int angle) {
 }
 
 QStringList qSlicerReposeModuleWidget::inputFileFilters() {
-  return {"Label maps (*.nii *.nii.gz *.nrrd *.nhdr *.seg.nrrd)"};
+  return {"Label maps (*.nii *.nii.gz *.nrrd *.nhdr *.seg.nrrd *.dcm)",
+          "DICOM segmentations (*.dcm)"};
 }
 
 void qSlicerReposeModuleWidget::updateWidgetFromMRML() {

@@ -11,6 +11,12 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/volume/SegmentTerminology.h"
 
+// clang-format off
+#include <dcmtk/config/osconfig.h>
+// clang-format on
+#include <dcmtk/dcmdata/dcdeftag.h>
+#include <dcmtk/dcmdata/dcfilefo.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -118,13 +124,30 @@ TEST(PoseSlicerOutputs, ASegmentationComesBackWithItsNamesColoursAndTerminology)
     if (line.rfind("250 ", 0) == 0) liverLine = line;
   EXPECT_EQ(liverLine, "250 planned_implant 26 230 77 255");
 
-  // DICOM SEG: the same posed voxels, names, colours and codes, read back from posed_G.dcm.
-  const CommandResult dcm = runCommand("repose", common + " --output-format dcmseg");
+  // DICOM SEG in and out: the segmentation as a DICOM SEG of liver.dcm's patient, posed into
+  // posed_G.dcm: the same posed voxels, names, colours and codes, and the same patient.
+  WriteOptions asDicom;
+  asDicom.sourceDicom = dataPath("dcmqi_ct3slice/liver.dcm");
+  writeVolume(G, dir.file("G.dcm"), asDicom);
+  std::string dicomCommon = common;
+  dicomCommon.replace(dicomCommon.find(shellQuote(dir.file("G.seg.nrrd"))),
+                      shellQuote(dir.file("G.seg.nrrd")).size(), shellQuote(dir.file("G.dcm")));
+  const CommandResult dcm = runCommand("repose", dicomCommon + " --output-format dcmseg");
   ASSERT_EQ(dcm.exitCode, 0) << dcm.err;
   EXPECT_EQ(filesIn(dir.file("out")),
             (std::set<std::string>{"posed_G.dcm", "posed_S.dcm", "transform.nrrd", "report.json"}));
   report = readJsonFile(dir.file("out/report.json"));
   EXPECT_EQ(report["outputs"]["posed_labels"], "posed_G.dcm");
+  {
+    DcmFileFormat in, out;
+    ASSERT_TRUE(in.loadFile(asDicom.sourceDicom.c_str()).good());
+    ASSERT_TRUE(out.loadFile(dir.file("out/posed_G.dcm").c_str()).good());
+    OFString a, b;
+    in.getDataset()->findAndGetOFString(DCM_PatientID, a);
+    out.getDataset()->findAndGetOFString(DCM_PatientID, b);
+    EXPECT_FALSE(a.empty());
+    EXPECT_EQ(std::string(a.c_str()), std::string(b.c_str()));
+  }
   const Volume posedDicom = readVolume(dir.file("out/posed_G.dcm"));
   EXPECT_TRUE(sameVoxels(posedDicom, posed));
   EXPECT_LT(matrixDifference(posedDicom.geometry().ijkToRas, posed.geometry().ijkToRas), 1e-6);

@@ -94,6 +94,22 @@ TEST(vtkSlicerReposeLogic, LoadsSlicerSegmentationsInLps) {
   EXPECT_NE(logic->GetVolumeSummary().find("Layers: 2"), std::string::npos);
 }
 
+TEST(vtkSlicerReposeLogic, LoadsADicomSegAndSaysWhichGridItTook) {
+  vtkNew<vtkSlicerReposeLogic> logic;
+  const std::string path = repose::test::dataPath("dcmqi_ct3slice/partial_overlaps.dcm");
+  ASSERT_TRUE(logic->LoadVolume(path)) << logic->GetLastErrorMessage();
+  expectMatchesCore(logic, path);
+  EXPECT_EQ(logic->GetVolumeLabelNames().size(), 5u);
+  const std::string summary = logic->GetVolumeSummary();
+  EXPECT_NE(summary.find("Layers: 3"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\nNote: placed on the grid of its referenced series in "),
+            std::string::npos)
+      << summary;
+  // The next file's summary has no note of this one.
+  ASSERT_TRUE(logic->LoadVolume(repose::test::dataPath("slicer_seg/Segmentation.seg.nrrd")));
+  EXPECT_EQ(logic->GetVolumeSummary().find("Note:"), std::string::npos);
+}
+
 TEST(vtkSlicerReposeLogic, MissingOrBadFileGivesOneLineError) {
   vtkNew<vtkSlicerReposeLogic> logic;
   ASSERT_TRUE(logic->LoadVolume(repose::test::dataPath("totalsegmentator/example_seg.nii.gz")));
