@@ -426,6 +426,21 @@ Volume readDicomSeg(const std::string& path, const ReadOptions& options) {
   if (placements.empty()) {
     grid = ownGrid(path, plane, positions, rows, columns);
     auto placed = placeFrames(grid, plane, positions, rows, columns);
+    if (!placed && plane.sliceSpacing > 0) {
+      // A SpacingBetweenSlices the frames do not keep (copied from another series, rounded):
+      // the frames' own spacing, said.
+      FramePlane measured = plane;
+      measured.sliceSpacing = 0;
+      VolumeGeometry own = ownGrid(path, measured, positions, rows, columns);
+      if (auto fits = placeFrames(own, plane, positions, rows, columns)) {
+        if (options.note)
+          options.note(path + ": its frames are not " + std::to_string(plane.sliceSpacing) +
+                       " mm apart as SpacingBetweenSlices says; their own spacing of " +
+                       std::to_string(own.spacing()[2]) + " mm is used");
+        grid = own;
+        placed = std::move(fits);
+      }
+    }
     if (!placed) {
       // Name the first frame that does not fit, for the user.
       for (long f = 0; f < frames; ++f)

@@ -28,6 +28,8 @@
 #include <dcmtk/dcmseg/segdoc.h>
 #include <dcmtk/dcmseg/segment.h>
 
+#include "DcmtkAttributes.h"
+
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
@@ -52,8 +54,46 @@ void check(const std::string& path, const OFCondition& c, const std::string& wha
     throwFileError(path, "cannot write the DICOM segmentation: " + what + " (" + c.text() + ")");
 }
 
+// A name as DICOM's LO (SegmentLabel, CodeMeaning): no backslash (the value separator) or
+// control characters, at most 64 characters (not cutting a UTF-8 sequence).
+std::string longString(std::string s) {
+  for (char& c : s)
+    if (c == '\\')
+      c = '/';
+    else if (static_cast<unsigned char>(c) < 32)
+      c = ' ';
+  if (s.size() > 64) {
+    std::size_t end = 64;
+    while (end > 0 && (static_cast<unsigned char>(s[end]) & 0xC0) == 0x80) --end;
+    s.resize(end);
+  }
+  return s;
+}
+
+// A code DICOM takes: a value and scheme of at most 16 characters (SH) and a meaning.
+bool usable(const TerminologyCode& c) {
+  return !c.value.empty() && c.value.size() <= 16 && !c.scheme.empty() && c.scheme.size() <= 16 &&
+         !c.meaning.empty() && c.value.find('\\') == std::string::npos &&
+         c.scheme.find('\\') == std::string::npos;
+}
+
 CodeSequenceMacro codeMacro(const TerminologyCode& c) {
-  return CodeSequenceMacro(c.value.c_str(), c.scheme.c_str(), c.meaning.c_str());
+  return CodeSequenceMacro(c.value.c_str(), c.scheme.c_str(), longString(c.meaning).c_str());
+}
+
+// The segment's codes as DICOM can hold them: a category and type it cannot hold give way to
+// SCT "Tissue" (both, so they stay a pair); a modifier or region it cannot hold is left out.
+SegmentTerminology dicomTerminology(const std::string& tags) {
+  SegmentTerminology t = terminologyFromTags(tags).value_or(genericTissueTerminology());
+  if (!usable(t.category) || !usable(t.type)) {
+    const SegmentTerminology generic = genericTissueTerminology();
+    t.category = generic.category;
+    t.type = generic.type;
+  }
+  for (TerminologyCode* c : {&t.typeModifier, &t.region, &t.regionModifier})
+    if (!usable(*c)) *c = {};
+  if (t.region.empty()) t.regionModifier = {};
+  return t;
 }
 
 // The values of one slice of a layer: calls fn(value, pixel) for every non-zero voxel.
@@ -67,6 +107,7 @@ struct SegmentOut {
   int layer = 0, value = 0;
   Uint16 number = 0;
   Label label;
+  std::string dicomName;  // SegmentLabel as written
 };
 
 }  // namespace
@@ -98,7 +139,7 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
   // Segments: every label of the table and every value present, by (layer, value).
   std::map<std::pair<int, int>, SegmentOut> segments;
   for (const Label& l : volume.labels().labels())
-    if (l.value != 0) segments[{l.layer, l.value}] = {l.layer, l.value, 0, l};
+    if (l.value != 0) segments[{l.layer, l.value}] = {l.layer, l.value, 0, l, ""};
   for (const LabelCount& c : countLabels(volume))
     if (!segments.count({c.layer, c.value})) {
       Label l;
@@ -107,7 +148,7 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
       l.name = "Segment_" + std::to_string(c.value);
       l.color = LabelTable::defaultColor(c.value);
       l.colorGenerated = true;
-      segments[{c.layer, c.value}] = {c.layer, c.value, 0, l};
+      segments[{c.layer, c.value}] = {c.layer, c.value, 0, l, ""};
     }
   if (segments.empty()) throwFileError(path, "the label map has no label to write as a segment");
   if (segments.size() > 65535) throwFileError(path, "more than 65535 labels");
@@ -148,16 +189,23 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
   if (!orientation) throwFileError(path, "cannot write the DICOM segmentation: orientation");
   check(path, seg->addForAllFrames(*orientation), "plane orientation");
 
+  bool anyNonAscii = false;
   for (auto& [key, s] : segments) {
     const Label& l = s.label;
-    const SegmentTerminology t = terminologyFromTags(l.tags).value_or(genericTissueTerminology());
+    const SegmentTerminology t = dicomTerminology(l.tags);
+    const std::string name =
+        longString(l.name.empty() ? "Segment_" + std::to_string(l.value) : l.name);
+    // dcmseg checks names as plain ASCII: one beyond it is set in the dataset afterwards.
+    std::string ascii = name;
+    for (char& c : ascii)
+      if (static_cast<unsigned char>(c) > 127) c = '?';
+    anyNonAscii = anyNonAscii || ascii != name;
+    s.dicomName = name;
     DcmSegment* segment = nullptr;
     check(path,
-          DcmSegment::create(
-              segment,
-              l.name.empty() ? ("Segment_" + std::to_string(l.value)).c_str() : l.name.c_str(),
-              codeMacro(t.category), codeMacro(t.type), DcmSegTypes::SAT_AUTOMATIC, "Repose"),
-          "segment " + l.name);
+          DcmSegment::create(segment, ascii.c_str(), codeMacro(t.category), codeMacro(t.type),
+                             DcmSegTypes::SAT_AUTOMATIC, "Repose"),
+          "segment " + name);
     std::unique_ptr<DcmSegment> owned(segment);
     if (!t.typeModifier.empty())
       segment->getSegmentedPropertyTypeModifierCode().push_back(
@@ -209,7 +257,14 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
     frameContent.setDimensionIndexValues(Uint32(k + 1), 1);
     OFVector<FGBase*> groups{position.get(), &frameContent};
     check(path, seg->addFrame(mask.data(), number, groups), "frame");
-    packed.resize(static_cast<std::size_t>((frames + 1) * pixels + 7) / 8, 0);
+    const std::int64_t bytes = ((frames + 1) * pixels + 7) / 8;
+    if (bytes > std::int64_t(0xFFFFFFFE))
+      throwFileError(path,
+                     "the frames need more than the 4 GB a DICOM object's pixel data can "
+                     "hold (" +
+                         std::to_string(frames + 1) + " frames of " + std::to_string(columns) +
+                         "x" + std::to_string(rows) + "); write NIfTI or .seg.nrrd");
+    packed.resize(static_cast<std::size_t>(bytes), 0);
     for (std::int64_t i = 0; i < pixels; ++i)
       if (mask[std::size_t(i)]) {
         const std::int64_t bit = frames * pixels + i;
@@ -263,6 +318,19 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
   DcmFileFormat file;
   check(path, seg->writeDataset(*file.getDataset()), "checking the object");
   DcmDataset* ds = file.getDataset();
+  // Names beyond ASCII: in UTF-8 when the object has no character set of its own (from the
+  // source DICOM); else they would be read in that one, so those characters stay '?'.
+  if (anyNonAscii) {
+    const std::string charset = io::dicomText(ds, DCM_SpecificCharacterSet);
+    if (charset.empty() || charset == "ISO_IR 192") {
+      ds->putAndInsertString(DCM_SpecificCharacterSet, "ISO_IR 192");
+      DcmSequenceOfItems* named = nullptr;
+      ds->findAndGetSequence(DCM_SegmentSequence, named);
+      for (const auto& [key, s] : segments)
+        if (DcmItem* item = named ? named->getItem(s.number - 1) : nullptr)
+          item->putAndInsertString(DCM_SegmentLabel, s.dicomName.c_str());
+    }
+  }
   if (packed.size() % 2) packed.push_back(0);
   check(path, ds->putAndInsertUint8Array(DCM_PixelData, packed.data(), packed.size()),
         "pixel data");

@@ -100,6 +100,17 @@ VolumeGeometry spanningGrid(const std::string& path, const std::vector<Roi>& roi
   return g;
 }
 
+// The integer index at or above (ceil) or below (floor) x, clamped to [lo, hi] before the
+// conversion: a contour far off the grid must not overflow an integer (undefined behaviour).
+std::int64_t clampedCeil(double x, std::int64_t lo, std::int64_t hi) {
+  if (std::isnan(x)) return lo;
+  return static_cast<std::int64_t>(std::clamp(std::ceil(x), double(lo), double(hi)));
+}
+std::int64_t clampedFloor(double x, std::int64_t lo, std::int64_t hi) {
+  if (std::isnan(x)) return lo;
+  return static_cast<std::int64_t>(std::clamp(std::floor(x), double(lo), double(hi)));
+}
+
 // A run of voxels of one row: [start, start + length) in volume index order.
 struct Run {
   std::int64_t start;
@@ -149,7 +160,7 @@ std::vector<Run> rasterize(const std::string& path, const Roi& roi, const Volume
   const double reach = 0.5 * planeGap / kStep + 1e-6;  // in slices
   const std::int64_t d0 = grid.dims[0], d1 = grid.dims[1];
   std::vector<double> crossings;
-  for (std::int64_t k = std::max<std::int64_t>(0, std::int64_t(std::floor(planes.front() - reach)));
+  for (std::int64_t k = clampedFloor(planes.front() - reach, 0, grid.dims[2]);
        k < grid.dims[2] && double(k) <= planes.back() + reach; ++k) {
     const auto nearest = std::min_element(planes.begin(), planes.end(), [&](double a, double b) {
       return std::fabs(a - double(k)) < std::fabs(b - double(k));
@@ -165,8 +176,7 @@ std::vector<Run> rasterize(const std::string& path, const Roi& roi, const Volume
           yMax = std::max(yMax, q.y());
         }
       }
-    for (std::int64_t j = std::max<std::int64_t>(0, std::int64_t(std::ceil(yMin)));
-         j < d1 && double(j) <= yMax; ++j) {
+    for (std::int64_t j = clampedCeil(yMin, 0, d1); j < d1 && double(j) <= yMax; ++j) {
       // Even-odd: every edge that crosses the row's centre line toggles inside and outside; a
       // vertex exactly on the line counts for the edge above it only (half-open).
       crossings.clear();
@@ -182,9 +192,8 @@ std::vector<Run> rasterize(const std::string& path, const Roi& roi, const Volume
       }
       std::sort(crossings.begin(), crossings.end());
       for (std::size_t c = 0; c + 1 < crossings.size(); c += 2) {
-        const std::int64_t i0 = std::max<std::int64_t>(0, std::int64_t(std::ceil(crossings[c])));
-        const std::int64_t i1 =
-            std::min<std::int64_t>(d0, std::int64_t(std::ceil(crossings[c + 1])));
+        const std::int64_t i0 = clampedCeil(crossings[c], 0, d0);
+        const std::int64_t i1 = clampedCeil(crossings[c + 1], 0, d0);
         if (i1 > i0) runs.push_back({i0 + d0 * (j + d1 * k), i1 - i0});
       }
     }

@@ -185,6 +185,28 @@ TEST(DicomSeg, OddFrameSizesSparseFramesAndSeveralSegmentsArePlacedByPosition) {
   EXPECT_NE(rgb255(v.labels().labels()[0].color), rgb255(v.labels().labels()[1].color));
 }
 
+TEST(DicomSeg, ASpacingBetweenSlicesTheFramesDoNotKeepGivesWayToTheirOwnAndIsSaid) {
+  TinySeg t;
+  t.spacingBetweenSlices = "3";
+  t.segments = 1;
+  t.positions = {{0, 0, 0}, {0, 0, 2}, {0, 0, 6}};
+  t.segmentOfFrame = {1, 1, 1};
+  t.frames.assign(3, std::vector<std::uint8_t>(15, 1));
+  ScratchDir dir;
+  writeTinySeg(t, dir.file("spacing.dcm"));
+  std::vector<std::string> notes;
+  ReadOptions options;
+  options.note = [&](const std::string& n) { notes.push_back(n); };
+  const Volume v = readVolume(dir.file("spacing.dcm"), options);
+  EXPECT_EQ(v.dims()[2], 4);  // z = 0, 2, 4 (no frame), 6
+  EXPECT_NEAR(v.geometry().spacing()[2], 2, 1e-9);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("not 3.000000 mm apart as SpacingBetweenSlices says"), std::string::npos)
+      << notes[0];
+  EXPECT_EQ(v.valueAsDouble(v.index(2, 1, 2)), 0);
+  EXPECT_EQ(v.valueAsDouble(v.index(2, 1, 3)), 1);
+}
+
 TEST(DicomSeg, FractionalPixelsAreThresholdedAtHalfTheMaximumAndTheReaderSaysSo) {
   TinySeg t;
   t.fractional = true;
@@ -248,9 +270,11 @@ TEST(DicomSeg, BrokenFilesAreRefusedWithOneLineNamingTheFileAndTheProblem) {
     cases.push_back({"moreframes.dcm", "do not match NumberOfFrames (3)", t});
   }
   {
-    TinySeg t = base();
-    t.positions[1] = {0, 0, 1.3};
-    cases.push_back({"offgrid.dcm", "frame 2 is not on the grid of the other frames", t});
+    TinySeg t = base();  // 2 mm apart as said, and 1.3 mm: no spacing holds all three
+    t.positions.push_back({0, 0, 3.3});
+    t.segmentOfFrame.push_back(1);
+    t.frames.push_back(t.frames[0]);
+    cases.push_back({"offgrid.dcm", "frame 3 is not on the grid of the other frames", t});
   }
   for (const Case& c : cases) {
     const std::string path = dir.file(c.name);
@@ -422,6 +446,32 @@ TEST(DicomSegWrite, OddSlicesAndValuesThatAreNotOneToNComeBackAndPatientAndStudy
     EXPECT_FALSE(attribute(out, fresh).empty());
   }
   EXPECT_EQ(attribute(out, DCM_Manufacturer), "Repose");
+}
+
+TEST(DicomSegWrite, NamesAndCodesDicomCannotHoldAreMadeFitRatherThanRefused) {
+  VolumeGeometry g;
+  g.dims = {4, 4, 1};
+  Volume v(g, ScalarType::UInt8);
+  v.setLabelMap(true);
+  v.data<std::uint8_t>()[0] = 1;
+  v.data<std::uint8_t>()[1] = 2;
+  Label longName;
+  longName.value = 1;
+  longName.name = std::string(70, 'x') + "\\tail";
+  longName.tags =
+      "TerminologyEntry:ctx~SCT^12345678901234567890^Too long a code~SCT^1^Type~^^~ctx~^^~^^|";
+  v.labels().set(longName);
+  Label accented;
+  accented.value = 2;
+  accented.name = "muscle, m\u00fcscle";
+  v.labels().set(accented);
+  ScratchDir dir;
+  writeVolume(v, dir.file("names.dcm"));
+  const Volume back = readVolume(dir.file("names.dcm"));
+  EXPECT_EQ(back.labels().find(1)->name, std::string(64, 'x'));
+  EXPECT_EQ(back.labels().find(2)->name, accented.name);  // UTF-8 (ISO_IR 192)
+  // The category code was too long for DICOM: both codes give way to SCT Tissue.
+  EXPECT_EQ(terminologyFromTags(back.labels().find(1)->tags), genericTissueTerminology());
 }
 
 TEST(DicomSegWrite, WhatDicomCannotHoldIsRefusedAndNothingIsWritten) {
