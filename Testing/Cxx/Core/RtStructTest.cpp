@@ -206,3 +206,33 @@ TEST(RtStruct, BrokenStructureSetsAreRefusedWithOneLineNamingTheFileAndTheProble
   EXPECT_NE(message.find(cut), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
 }
+
+TEST(RtStruct, OnTheReferencedSeriesGridEachContourFillsItsOwnSlice) {
+  // A structure set drawn on ct-3slice: its series UID referenced, a square on each CT slice.
+  DcmFileFormat ct;
+  ASSERT_TRUE(ct.loadFile(dataPath("dcmqi_ct3slice/ct-3slice/01.dcm").c_str()).good());
+  OFString series;
+  ct.getDataset()->findAndGetOFString(DCM_SeriesInstanceUID, series);
+  const Volume image = readVolume(dataPath("dcmqi_ct3slice/ct-3slice"));
+  TinyRoi roi;
+  roi.name = "square";
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d ras = image.geometry().voxelToRas(100, 200, k);
+    // 10 x 20 voxels of 0.810547 mm, corners between voxel centres (LPS = RAS with x, y negated).
+    const double x0 = -ras.x() - 0.4, y0 = -ras.y() - 0.4;
+    roi.contours.push_back(square(x0, y0, x0 + 10 * 0.810547, y0 + 20 * 0.810547, ras.z()));
+  }
+  ScratchDir dir;
+  writeTinyRtStruct({roi}, dir.file("rs.dcm"), series.c_str());
+  RtStructOptions o;
+  o.reference = dataPath("dcmqi_ct3slice/ct-3slice");
+  const Volume v = readRtStruct(dir.file("rs.dcm"), o);
+  ASSERT_EQ(v.dims(), image.dims());
+  EXPECT_LT(matrixDifference(v.geometry().ijkToRas, image.geometry().ijkToRas), 1e-9);
+  std::int64_t inside = 0;
+  for (std::int64_t i = 0; i < v.numVoxels(); ++i) inside += v.valueAsDouble(i) == 1;
+  EXPECT_EQ(inside, 3 * 10 * 20);
+  EXPECT_EQ(v.valueAsDouble(v.index(100, 200, 0)), 1);
+  EXPECT_EQ(v.valueAsDouble(v.index(109, 219, 2)), 1);
+  EXPECT_EQ(v.valueAsDouble(v.index(110, 219, 2)), 0);
+}
