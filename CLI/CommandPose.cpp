@@ -253,10 +253,9 @@ int runPose(const Args& args) {
   // budget cannot hold; the frames are checked against what is left (checkGrid below).
   // What the reader decided about the input (a DICOM SEG's grid, a fractional SEG thresholded):
   // said at once, and kept in each frame's report ("input_notes").
-  std::vector<std::string> inputNotes;
   ReadOptions organsRead = readOptionsWithin(budget, !quiet);
-  organsRead.note = [&inputNotes, say = organsRead.note](const std::string& n) {
-    inputNotes.push_back(n);
+  organsRead.note = [&request, say = organsRead.note](const std::string& n) {
+    request.organsNotes.push_back(n);
     if (say) say(n);
   };
   const Volume organs = readVolume(p.get("input"), organsRead);
@@ -344,11 +343,6 @@ int runPose(const Args& args) {
     };
     PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
     posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
-    if (!inputNotes.empty()) {
-      json withNotes = json::parse(posed.reportJson);
-      withNotes["input_notes"] = inputNotes;
-      posed.reportJson = withNotes.dump();
-    }
     const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
     FrameWriteOptions wo;
     wo.labelMapFiles = labelMapFiles;

@@ -77,7 +77,15 @@ class Worker {
     if (subjectIndex_ != task / std::int64_t(poses_.size())) {
       organs_.reset(), parts_.reset();
       subjectIndex_ = -1;
-      organs_ = readVolume(s.organs, readOptionsWithin(settings_.budget, false));
+      // What the reader decides about G (a DICOM SEG's grid...) is said once and kept in the
+      // reports of all its jobs, as `repose pose` keeps it.
+      organsNotes_.clear();
+      ReadOptions organsRead = readOptionsWithin(settings_.budget, false);
+      organsRead.note = [this, say = organsRead.note](const std::string& n) {
+        organsNotes_.push_back(n);
+        if (say) say(n);
+      };
+      organs_ = readVolume(s.organs, organsRead);
       parts_ = readVolume(s.parts, readOptionsWithin(settings_.budget, false));
       nameBodyPartsByRigConvention(*parts_, s.parts);
       requirePoseableLabels(*organs_, s.organs);
@@ -89,6 +97,7 @@ class Worker {
     request.partsPath = s.parts;
     request.skeleton = skeletonFor(s.parts, "");
     request.settings.threads = settings_.threads;
+    request.organsNotes = organsNotes_;
     job_.emplace(readPoseFile(pose(task).path), *organs_, *parts_, std::move(request));
     jobTask_ = task;
     return *job_;
@@ -123,6 +132,7 @@ class Worker {
   const std::vector<SweepPose>& poses_;
   const Settings& settings_;
   std::int64_t subjectIndex_ = -1, jobTask_ = -1;
+  std::vector<std::string> organsNotes_;  // what G's reader said (ReadOptions::note)
   std::optional<Volume> organs_, parts_;
   std::optional<PoseJob> job_;
   std::unique_ptr<PoseRig> rig_;

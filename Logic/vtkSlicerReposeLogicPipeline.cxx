@@ -244,6 +244,10 @@ std::shared_ptr<const repose::PoseJob> vtkSlicerReposeLogic::PoseJobFor(
   request.partsPath = this->PartsPath();
   request.tissuesPath = this->TissueTablePath;
   request.skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
+  // What G's reader decided (a DICOM SEG's grid...), kept in the export's report.json as the
+  // command line keeps it.
+  if (!seg->GetLabelMapFileName().empty() && seg->GetLabelMapFileName() == this->VolumePath)
+    request.organsNotes = this->VolumeReadNotes;
   if (this->ParameterNode) {
     request.settings.cageVertices = this->ParameterNode->GetCageVertexCount();
     request.settings.dilateMm = this->ParameterNode->GetCageDilationMm();

@@ -6,7 +6,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -16,7 +22,8 @@ namespace repose {
 
 namespace detail {
 void (*commitStepHook)(std::size_t step) = nullptr;
-}
+void (*commitSyncHook)(const std::string& path) = nullptr;
+}  // namespace detail
 
 namespace {
 
@@ -27,8 +34,32 @@ void hook(std::size_t step) {
   if (detail::commitStepHook) detail::commitStepHook(step);
 }
 
+// Makes what `path` (a file, or a folder's entries) holds reach the disk, so a power cut or a
+// crash of the machine cannot undo it: a rename alone survives a kill of the process, but the
+// file system may write the new name before the file's data, and a cut between the two leaves an
+// empty or partial file under the published name. A folder whose file system cannot sync folders
+// (EINVAL: some network and FUSE file systems) is left as it is; any other failure means the
+// data may not be on the disk, and throws repose::Error naming `target`.
+void syncToDisk(const fs::path& path, bool folder, const std::string& target) {
+  if (detail::commitSyncHook) detail::commitSyncHook(path.string());
+  const int fd = ::open(path.c_str(), folder ? O_RDONLY | O_DIRECTORY : O_RDONLY);
+  if (fd < 0)
+    throwFileError(target, "cannot write to the disk: " + std::string(std::strerror(errno)));
+  const int rc = ::fsync(fd);
+  const int error = errno;
+  ::close(fd);
+  if (rc != 0 && !(folder && (error == EINVAL || error == ENOTSUP)))
+    throwFileError(target, "cannot write to the disk: " + std::string(std::strerror(error)));
+}
+
+fs::path folderOf(const fs::path& file) {
+  const fs::path parent = file.parent_path();
+  return parent.empty() ? fs::path(".") : parent;
+}
+
 // Written whole or not at all (a rename within the folder), so a kill never leaves half a
-// journal that would read as a decision.
+// journal that would read as a decision; on the disk before it is renamed into place, and its
+// name on the disk before the first step.
 void writeWhole(const fs::path& path, const std::string& text, const std::string& target) {
   const fs::path part = path.string() + ".part";
   {
@@ -36,9 +67,25 @@ void writeWhole(const fs::path& path, const std::string& text, const std::string
     f << text;
     if (!f.flush()) throwFileError(target, "cannot write in the output folder");
   }
+  syncToDisk(part, false, target);
   std::error_code ec;
   fs::rename(part, path, ec);
   if (ec) throwFileError(target, "cannot write in the output folder: " + ec.message());
+  syncToDisk(folderOf(path), true, target);
+}
+
+// Before a commit publishes them: every file it moves, on the disk.
+void syncSources(const std::vector<CommitStep>& steps) {
+  std::error_code ec;
+  for (const CommitStep& s : steps)
+    if (!s.from.empty() && fs::is_regular_file(s.from, ec)) syncToDisk(s.from, false, s.to);
+}
+
+// After: the folders the commit changed, so the new names (and removals) are on the disk too.
+void syncTargets(const std::vector<CommitStep>& steps) {
+  std::set<fs::path> folders;
+  for (const CommitStep& s : steps) folders.insert(folderOf(s.to));
+  for (const fs::path& f : folders) syncToDisk(f, true, (f / "").string());
 }
 
 // A step done again after a kill is harmless: a file already moved is no longer in its
@@ -78,10 +125,12 @@ std::optional<Journal> readJournal(const fs::path& folder) {
 void commitFiles(const std::vector<std::string>& folders, const std::vector<CommitStep>& steps,
                  const std::string& target) {
   std::error_code ec;
+  syncSources(steps);
   // One rename alone is atomic already.
   if (steps.size() == 1) {
     apply(steps[0], ec);
     if (ec) throwFileError(steps[0].to, "cannot move the output into place: " + ec.message());
+    syncTargets(steps);
     return;
   }
   if (folders.empty()) throw Error("commitFiles: no temporary folder");
@@ -109,6 +158,9 @@ void commitFiles(const std::vector<std::string>& folders, const std::vector<Comm
     }
     hook(i + 1);
   }
+  // The moves on the disk before the journal goes: a machine that stops between the two
+  // finishes the commit again on the next output into the folder, which is harmless.
+  syncTargets(steps);
   // Done: the journal goes first, so what is left of the folders is plain leftovers.
   fs::remove(journal, ec);
 }
@@ -130,6 +182,11 @@ std::optional<std::size_t> recoverKilledCommit(const fs::path& folder) {
   for (const CommitStep& step : journal->steps) {
     moved += apply(step, ec);
     if (ec) return moved;  // left as it is, for a later run to finish (the same files, once)
+  }
+  try {
+    syncTargets(journal->steps);
+  } catch (const Error&) {
+    return moved;  // the journal stays, for a later run to finish the commit again
   }
   fs::remove(first / kJournal, ec);
   for (const std::string& f : journal->folders) fs::remove_all(f, ec);

@@ -238,6 +238,7 @@ std::string PoseJob::completeReport(const std::string& reportJson, bool sceneReu
                                     const PoseRig& rig) const {
   nlohmann::json report = nlohmann::json::parse(reportJson);
   report["input"] = request_.organsName;
+  if (!request_.organsNotes.empty()) report["input_notes"] = request_.organsNotes;
   report["scene_reused"] = sceneReused;
   const CageDeformation& d = rig.deformation();
   report["green_coordinates"] = {{"read", d.coordinatesRead()},

@@ -70,7 +70,7 @@ std::vector<SweepSubject> readSweepSubjects(const std::string& listPath) {
     if (!fs::exists(s.parts))
       listError(listPath, l.number,
                 l.path.string() + " has no S.nii.gz (rig it: repose rig --input G --out FOLDER)");
-    for (const char* g : {"G.nii.gz", "G.nii", "G.nrrd", "G.seg.nrrd"}) {
+    for (const char* g : {"G.nii.gz", "G.nii", "G.nrrd", "G.seg.nrrd", "G.dcm"}) {
       if (fs::exists(l.path / g)) {
         s.organs = (l.path / g).string();
         break;

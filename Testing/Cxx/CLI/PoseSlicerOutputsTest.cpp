@@ -129,6 +129,21 @@ TEST(PoseSlicerOutputs, ASegmentationComesBackWithItsNamesColoursAndTerminology)
   WriteOptions asDicom;
   asDicom.sourceDicom = dataPath("dcmqi_ct3slice/liver.dcm");
   writeVolume(G, dir.file("G.dcm"), asDicom);
+  {
+    // With a SpacingBetweenSlices its frames do not keep (copied from another series): the reader
+    // places the frames by their own spacing and says so, and the report keeps what it said.
+    DcmFileFormat seg;
+    ASSERT_TRUE(seg.loadFile(dir.file("G.dcm").c_str()).good());
+    // All of it: saved over the file it was read from, a PixelData left to be read later is lost.
+    ASSERT_TRUE(seg.loadAllDataIntoMemory().good());
+    DcmItem *shared = nullptr, *measures = nullptr;
+    ASSERT_TRUE(seg.getDataset()
+                    ->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0)
+                    .good());
+    ASSERT_TRUE(shared->findAndGetSequenceItem(DCM_PixelMeasuresSequence, measures, 0).good());
+    ASSERT_TRUE(measures->putAndInsertString(DCM_SpacingBetweenSlices, "7.5").good());
+    ASSERT_TRUE(seg.saveFile(dir.file("G.dcm").c_str(), EXS_LittleEndianExplicit).good());
+  }
   std::string dicomCommon = common;
   dicomCommon.replace(dicomCommon.find(shellQuote(dir.file("G.seg.nrrd"))),
                       shellQuote(dir.file("G.seg.nrrd")).size(), shellQuote(dir.file("G.dcm")));
@@ -138,6 +153,10 @@ TEST(PoseSlicerOutputs, ASegmentationComesBackWithItsNamesColoursAndTerminology)
             (std::set<std::string>{"posed_G.dcm", "posed_S.dcm", "transform.nrrd", "report.json"}));
   report = readJsonFile(dir.file("out/report.json"));
   EXPECT_EQ(report["outputs"]["posed_labels"], "posed_G.dcm");
+  ASSERT_EQ(report["input_notes"].size(), 1u) << report.dump();
+  const std::string note = report["input_notes"][0].get<std::string>();
+  EXPECT_NE(note.find("G.dcm: its frames are not 7.5"), std::string::npos) << note;
+  EXPECT_NE(dcm.err.find("repose: note: " + note), std::string::npos) << dcm.err;
   {
     DcmFileFormat in, out;
     ASSERT_TRUE(in.loadFile(asDicom.sourceDicom.c_str()).good());

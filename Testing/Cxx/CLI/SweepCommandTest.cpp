@@ -7,6 +7,7 @@
 #include "CommandRunner.h"
 #include "TestPaths.h"
 
+#include "repose/io/DicomSegIO.h"
 #include "repose/io/VolumeIO.h"
 
 #include <gtest/gtest.h>
@@ -202,4 +203,63 @@ TEST(SweepCommand, EachJobWritesWhatPoseWritesAFailedPoseIsRecordedResumeRedoesN
               withoutTimings(readJsonFile(outMpi + "/" + job + "/report.json"))["quality"])
         << job;
   }
+}
+
+namespace {
+
+// Same grid and the same value at every voxel, whatever the scalar types.
+bool sameLabels(const Volume& a, const Volume& b) {
+  if (a.geometry().dims != b.geometry().dims ||
+      !a.geometry().ijkToRas.isApprox(b.geometry().ijkToRas, 1e-6))
+    return false;
+  for (std::int64_t v = 0; v < a.numVoxels(); ++v)
+    if (a.valueAsDouble(v) != b.valueAsDouble(v)) return false;
+  return true;
+}
+
+}  // namespace
+
+// A study for a PACS: `--output-format dcmseg` gives every job its posed G and S as DICOM SEG,
+// which read back as the label maps `repose pose` writes for the same job through the same scene;
+// the report lists the SEG files, so --resume finds the job complete.
+TEST(SweepCommand, DicomSegOutputsAreThePosedMapsAndResumeFindsThemComplete) {
+  ScratchDir dir("sweep-dcmseg");
+  const CommandResult ph =
+      runCommand("repose", "phantom --voxel 8 --out " + shellQuote(dir.file("alpha")));
+  ASSERT_EQ(ph.exitCode, 0) << ph.err;
+  std::ofstream(dir.file("subjects.txt")) << "alpha\n";
+  std::ofstream(dir.file("poses.txt")) << suitePoseFile("elbow90") << "\n";
+  const std::string out = dir.file("out");
+  const std::string args = "sweep --subjects " + shellQuote(dir.file("subjects.txt")) +
+                           " --poses " + shellQuote(dir.file("poses.txt")) + " --out " +
+                           shellQuote(out) + " --output-format dcmseg --json";
+  const CommandResult r = runCommand("repose", args);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["done"], 1);
+  const std::string job = out + "/alpha/elbow90";
+  for (const char* name : {"posed_G.dcm", "posed_S.dcm"}) {
+    EXPECT_TRUE(isDicomSegFile(job + "/" + name)) << name;
+    EXPECT_FALSE(fs::exists(job + "/" + std::string(name).replace(7, 4, ".nii.gz"))) << name;
+  }
+  const nlohmann::json report = readJsonFile(job + "/report.json");
+  const std::string outputs = report["outputs"].dump();
+  EXPECT_NE(outputs.find("posed_G.dcm"), std::string::npos) << outputs;
+
+  // The same job by `repose pose` through the sweep's scene, written as NIfTI.
+  std::string sceneFolder;
+  for (const auto& e : fs::directory_iterator(out + "/alpha/scenes")) sceneFolder = e.path();
+  ASSERT_TRUE(fs::exists(sceneFolder + "/scene.json")) << sceneFolder;
+  const std::string single = dir.file("single");
+  const CommandResult pr = runCommand(
+      "repose", "pose --input " + shellQuote(dir.file("alpha/G.nii.gz")) + " --parts " +
+                    shellQuote(dir.file("alpha/S.nii.gz")) + " --pose " +
+                    shellQuote(suitePoseFile("elbow90")) + " --scene " + shellQuote(sceneFolder) +
+                    " --out " + shellQuote(single) + " --output-format nii.gz");
+  ASSERT_EQ(pr.exitCode, 0) << pr.err;
+  EXPECT_TRUE(sameLabels(readVolume(job + "/posed_G.dcm"), readVolume(single + "/posed_G.nii.gz")));
+  EXPECT_TRUE(sameLabels(readVolume(job + "/posed_S.dcm"), readVolume(single + "/posed_S.nii.gz")));
+
+  const CommandResult again = runCommand("repose", args + " --resume");
+  ASSERT_EQ(again.exitCode, 0) << again.err;
+  EXPECT_EQ(nlohmann::json::parse(again.out)["skipped"], 1);
 }

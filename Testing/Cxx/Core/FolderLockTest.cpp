@@ -209,3 +209,66 @@ TEST(AtomicOutput, AKillDuringTheFinalRenamesIsFinishedByTheNextRunNeverLeftMixe
         << killAfter;
   }
 }
+
+// A power cut is not a kill: the file system may put a renamed name on the disk before the file's
+// data. So every file a commit publishes reaches the disk before the commit's first rename, the
+// journal before it is relied on, and the output folder after the last rename; and the journal
+// is still there when the folder is synced (a cut before that finishes the commit again). One
+// output alone (a single rename) is synced the same way.
+TEST(AtomicOutput, ACommitPutsItsFilesOnTheDiskBeforeItPublishesThemAndItsFolderAfter) {
+  ScratchDir dir;
+  const fs::path folder = fs::canonical(dir.path());
+  static std::vector<std::string> events;
+  events.clear();
+  detail::commitSyncHook = [](const std::string& path) {
+    std::error_code ec;
+    const bool journal = fs::exists(fs::path(path) / ".repose-commit", ec) ||
+                         fs::path(path).filename() == ".repose-commit.part";
+    events.push_back("sync " + fs::path(path).filename().string() + (journal ? " +journal" : ""));
+  };
+  detail::commitStepHook = [](std::size_t step) {
+    events.push_back("step " + std::to_string(step));
+  };
+  {
+    AtomicOutput a((folder / "posed_G.nii.gz").string()), b((folder / "report.json").string());
+    std::ofstream(a.tempPath()) << "labels";
+    std::ofstream(b.tempPath()) << "{}";
+    commitTogether({&a, &b});
+  }
+  detail::commitStepHook = nullptr;
+  const std::string top = folder.filename().string();
+  auto at = [&](const std::string& e) {
+    return std::find(events.begin(), events.end(), e) - events.begin();
+  };
+  const auto n = std::ptrdiff_t(events.size());
+  ASSERT_LT(at("sync posed_G.nii.gz"), n);
+  ASSERT_LT(at("sync report.json"), n);
+  ASSERT_LT(at("sync .repose-commit.part +journal"), n);
+  ASSERT_LT(at("step 0"), n);
+  ASSERT_LT(at("step 2"), n);
+  EXPECT_LT(at("sync posed_G.nii.gz"), at("step 0"));
+  EXPECT_LT(at("sync report.json"), at("step 0"));
+  EXPECT_LT(at("sync .repose-commit.part +journal"), at("step 0"));
+  // The journal's folder (a temporary one) synced after the journal's rename, before step 0.
+  const auto tempSynced = std::find_if(events.begin(), events.end(),
+                                       [](const std::string& e) {
+                                         return e.rfind("sync .repose-tmp-", 0) == 0 &&
+                                                e.find("+journal") != std::string::npos;
+                                       }) -
+                          events.begin();
+  EXPECT_LT(tempSynced, at("step 0"));
+  // The output folder after the last rename, while the journal still decides.
+  ASSERT_LT(at("sync " + top), n);
+  EXPECT_LT(at("step 2"), at("sync " + top));
+  EXPECT_EQ(contentOf(folder / "posed_G.nii.gz"), "labels");
+  // One output alone: its file before the rename, its folder after.
+  events.clear();
+  {
+    AtomicOutput one((folder / "alone.txt").string());
+    std::ofstream(one.tempPath()) << "x";
+    one.commit();
+    EXPECT_TRUE(fs::exists(folder / "alone.txt"));
+  }
+  detail::commitSyncHook = nullptr;
+  EXPECT_EQ(events, (std::vector<std::string>{"sync alone.txt", "sync " + top}));
+}

@@ -53,12 +53,17 @@ void commitTogether(const std::vector<AtomicOutput*>& outputs);
 // before it leaves every target as it was; one killed after it is finished by the next output
 // into the folder (removeStaleTemporaries). The caller removes its temporary folders afterwards.
 // A step that fails (not a kill) throws repose::Error naming its file, `target` for the journal.
+// Durable as well: the moved files and the journal reach the disk (fsync) before the first step,
+// and the changed folders after the last, so a power cut cannot leave an empty or partial file
+// under a published name either.
 void commitFiles(const std::vector<std::string>& temporaryFolders,
                  const std::vector<CommitStep>& steps, const std::string& target);
 namespace detail {
 // For tests only: called after the journal is written (0) and after each step (1, 2, ...), e.g.
 // to kill the process there.
 extern void (*commitStepHook)(std::size_t step);
+// For tests only: called with each file or folder commitFiles makes reach the disk, before it.
+extern void (*commitSyncHook)(const std::string& path);
 }  // namespace detail
 
 // Writes `text` to `path` through an AtomicOutput: the whole file or nothing. Throws repose::Error.

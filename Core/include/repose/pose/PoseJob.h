@@ -78,6 +78,9 @@ struct PoseJobRequest {
                          // the rigid labels and the joints' refinement
   int jointRings = -1;   // -1: the pose file's
   bool autoSeparate = true;
+  // What G's reader decided (ReadOptions::note: a DICOM SEG's grid, a fractional SEG
+  // thresholded), kept in every report of the job as "input_notes".
+  std::vector<std::string> organsNotes;
 };
 
 // One pose of one body, decided: everything above, resolved once. G and S must outlive the job.
@@ -111,7 +114,8 @@ class PoseJob {
   // The frame options the job decides (the tissue table and its name); the caller adds output
   // spacing, image, progress and warnings.
   PoseFrameOptions frameOptions() const;
-  // report.json completed with what the job knows: the input, whether the rig came from a scene,
+  // report.json completed with what the job knows: the input and what its reader decided
+  // ("input_notes", when it said anything), whether the rig came from a scene,
   // the joint rings, the separations, the skeleton, and whether the rig's Green coordinates were
   // read from a file (CageDeformation::coordinatesRead) or computed, and why.
   std::string completeReport(const std::string& reportJson, bool sceneReused,
