@@ -161,10 +161,11 @@ std::vector<TaskPlan> planTasks(SweepComm& comm, Worker& worker, std::int64_t ta
       plan["frames"] = frames;
       bool complete = settings.resume;
       for (const std::string& f : frames)
-        complete =
-            complete && sweepJobComplete(sweepJobFolder(settings.outDir, worker.subject(t),
-                                                        worker.pose(t), f, frames.size() == 1),
-                                         worker.subject(t).organs);
+        complete = complete &&
+                   sweepJobComplete(sweepJobFolder(settings.outDir, worker.subject(t),
+                                                   worker.pose(t), f, frames.size() == 1),
+                                    worker.subject(t).organs,
+                                    labelMapFilesFor(settings.format, worker.subject(t).organs));
       if (!complete) plan["key"] = worker.job(t).sceneKey();
     } catch (const std::exception& e) {
       plan["error"] = oneLine(e);
@@ -354,7 +355,9 @@ int runSweep(const Args& args) {
     r.folder = fs::relative(dir, settings.outDir).string();
     const auto jobStart = Clock::now();
     try {
-      if (settings.resume && sweepJobComplete(dir, worker.subject(ref.task).organs)) {
+      if (settings.resume &&
+          sweepJobComplete(dir, worker.subject(ref.task).organs,
+                           labelMapFilesFor(settings.format, worker.subject(ref.task).organs))) {
         r.status = "skipped";
         readSweepFigures(r, (fs::path(dir) / "report.json").string());
       } else {

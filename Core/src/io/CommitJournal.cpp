@@ -25,23 +25,14 @@ void (*commitStepHook)(std::size_t step) = nullptr;
 void (*commitSyncHook)(const std::string& path) = nullptr;
 }  // namespace detail
 
-namespace {
-
-const char* const kJournal = ".repose-commit";        // in the first folder: the decision
-const char* const kMember = ".repose-commit-member";  // in the others: the first folder's path
-
-void hook(std::size_t step) {
-  if (detail::commitStepHook) detail::commitStepHook(step);
-}
-
 // Makes what `path` (a file, or a folder's entries) holds reach the disk, so a power cut or a
 // crash of the machine cannot undo it: a rename alone survives a kill of the process, but the
 // file system may write the new name before the file's data, and a cut between the two leaves an
 // empty or partial file under the published name. A folder whose file system cannot sync folders
 // (EINVAL: some network and FUSE file systems) is left as it is; any other failure means the
 // data may not be on the disk, and throws repose::Error naming `target`.
-void syncToDisk(const fs::path& path, bool folder, const std::string& target) {
-  if (detail::commitSyncHook) detail::commitSyncHook(path.string());
+void syncToDisk(const std::string& path, bool folder, const std::string& target) {
+  if (detail::commitSyncHook) detail::commitSyncHook(path);
   const int fd = ::open(path.c_str(), folder ? O_RDONLY | O_DIRECTORY : O_RDONLY);
   if (fd < 0)
     throwFileError(target, "cannot write to the disk: " + std::string(std::strerror(errno)));
@@ -50,6 +41,15 @@ void syncToDisk(const fs::path& path, bool folder, const std::string& target) {
   ::close(fd);
   if (rc != 0 && !(folder && (error == EINVAL || error == ENOTSUP)))
     throwFileError(target, "cannot write to the disk: " + std::string(std::strerror(error)));
+}
+
+namespace {
+
+const char* const kJournal = ".repose-commit";        // in the first folder: the decision
+const char* const kMember = ".repose-commit-member";  // in the others: the first folder's path
+
+void hook(std::size_t step) {
+  if (detail::commitStepHook) detail::commitStepHook(step);
 }
 
 fs::path folderOf(const fs::path& file) {
@@ -67,11 +67,11 @@ void writeWhole(const fs::path& path, const std::string& text, const std::string
     f << text;
     if (!f.flush()) throwFileError(target, "cannot write in the output folder");
   }
-  syncToDisk(part, false, target);
+  syncToDisk(part.string(), false, target);
   std::error_code ec;
   fs::rename(part, path, ec);
   if (ec) throwFileError(target, "cannot write in the output folder: " + ec.message());
-  syncToDisk(folderOf(path), true, target);
+  syncToDisk(folderOf(path).string(), true, target);
 }
 
 // Before a commit publishes them: every file it moves, on the disk.
@@ -85,7 +85,7 @@ void syncSources(const std::vector<CommitStep>& steps) {
 void syncTargets(const std::vector<CommitStep>& steps) {
   std::set<fs::path> folders;
   for (const CommitStep& s : steps) folders.insert(folderOf(s.to));
-  for (const fs::path& f : folders) syncToDisk(f, true, (f / "").string());
+  for (const fs::path& f : folders) syncToDisk(f.string(), true, (f / "").string());
 }
 
 // A step done again after a kill is harmless: a file already moved is no longer in its

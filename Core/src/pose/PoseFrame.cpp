@@ -163,6 +163,20 @@ LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inp
   throw Error("output format '" + choice + "' is not one of auto, nii.gz, seg.nrrd, both, dcmseg");
 }
 
+std::vector<std::string> labelMapFileNames(LabelMapFiles files) {
+  std::vector<std::string> names;
+  const nlohmann::json outputs = outputFiles(files);  // held: items() only refers to it
+  for (const auto& [key, value] : outputs.items()) {
+    if (key == "transform") continue;
+    if (value.is_string()) names.push_back(value.get<std::string>());
+    for (const auto& v : value)
+      if (value.is_array() && v.is_string()) names.push_back(v.get<std::string>());
+  }
+  std::sort(names.begin(), names.end());
+  names.erase(std::unique(names.begin(), names.end()), names.end());
+  return names;
+}
+
 double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volume* image) {
   return double(scalarSize(organs.scalarType())) + double(scalarSize(parts.scalarType())) + 12 +
          (image ? double(scalarSize(image->scalarType())) : 0);
@@ -391,8 +405,15 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
   throwIfInterrupted();
   std::error_code ec;
   if (!fs::exists(dir)) {
+    // The files on the disk before the folder appears under its name, and the name after (a
+    // power cut must not leave a frame folder of empty files; AtomicOutput.h, commitFiles).
+    for (fs::directory_iterator it(temp, ec), end; !ec && it != end; it.increment(ec))
+      if (it->is_regular_file(ec))
+        syncToDisk(it->path().string(), false, (dir / it->path().filename()).string());
+    syncToDisk(temp.string(), true, folder);
     fs::rename(temp, dir, ec);
     if (ec) throwFileError(folder, "cannot move the frame into place: " + ec.message());
+    syncToDisk(dir.parent_path().empty() ? "." : dir.parent_path().string(), true, folder);
     return written;
   }
   // An existing folder (a re-run): its files are replaced, the report last, and ours that this

@@ -1,5 +1,7 @@
 #include "repose/pose/Sweep.h"
 
+#include "repose/pose/PoseFrame.h"
+
 #include "repose/io/AtomicOutput.h"
 #include "repose/util/Error.h"
 
@@ -120,7 +122,8 @@ std::string sweepJobFolder(const std::string& outDir, const SweepSubject& subjec
   return dir.string();
 }
 
-bool sweepJobComplete(const std::string& jobFolder, const std::string& organsPath) {
+bool sweepJobComplete(const std::string& jobFolder, const std::string& organsPath,
+                      LabelMapFiles labelMaps) {
   const fs::path dir = jobFolder;
   std::ifstream in(dir / "report.json");
   if (!in) return false;
@@ -136,6 +139,8 @@ bool sweepJobComplete(const std::string& jobFolder, const std::string& organsPat
         if (v.is_string()) files.push_back(v.get<std::string>());
   }
   if (files.empty()) return false;
+  for (const std::string& f : labelMapFileNames(labelMaps))
+    if (std::find(files.begin(), files.end(), f) == files.end()) return false;
   for (const std::string& f : files) {
     std::error_code ec;
     const auto size = fs::file_size(dir / f, ec);

@@ -221,7 +221,8 @@ bool sameLabels(const Volume& a, const Volume& b) {
 
 // A study for a PACS: `--output-format dcmseg` gives every job its posed G and S as DICOM SEG,
 // which read back as the label maps `repose pose` writes for the same job through the same scene;
-// the report lists the SEG files, so --resume finds the job complete.
+// the report lists the SEG files, so --resume finds the job complete, and a resume asking for
+// another format does it again in that format.
 TEST(SweepCommand, DicomSegOutputsAreThePosedMapsAndResumeFindsThemComplete) {
   ScratchDir dir("sweep-dcmseg");
   const CommandResult ph =
@@ -262,4 +263,17 @@ TEST(SweepCommand, DicomSegOutputsAreThePosedMapsAndResumeFindsThemComplete) {
   const CommandResult again = runCommand("repose", args + " --resume");
   ASSERT_EQ(again.exitCode, 0) << again.err;
   EXPECT_EQ(nlohmann::json::parse(again.out)["skipped"], 1);
+
+  // Resumed asking for NIfTI: the SEG job is not what was asked, so it is done again, in NIfTI,
+  // and the SEG files go (a report never sits beside another run's files).
+  std::string asNifti = args;
+  const std::string format = "--output-format dcmseg";
+  asNifti.replace(asNifti.find(format), format.size(), "--output-format nii.gz");
+  const CommandResult third = runCommand("repose", asNifti + " --resume");
+  ASSERT_EQ(third.exitCode, 0) << third.err;
+  EXPECT_EQ(nlohmann::json::parse(third.out)["done"], 1);
+  EXPECT_TRUE(
+      sameLabels(readVolume(job + "/posed_G.nii.gz"), readVolume(single + "/posed_G.nii.gz")));
+  EXPECT_FALSE(fs::exists(job + "/posed_G.dcm"));
+  EXPECT_EQ(nlohmann::json::parse(runCommand("repose", asNifti + " --resume").out)["skipped"], 1);
 }

@@ -3,6 +3,7 @@
 #include "TestPaths.h"
 #include "repose/io/AtomicOutput.h"
 #include "repose/io/FolderLock.h"
+#include "repose/pose/PoseFrame.h"
 #include "repose/util/Error.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 using namespace repose;
@@ -271,4 +273,49 @@ TEST(AtomicOutput, ACommitPutsItsFilesOnTheDiskBeforeItPublishesThemAndItsFolder
   }
   detail::commitSyncHook = nullptr;
   EXPECT_EQ(events, (std::vector<std::string>{"sync alone.txt", "sync " + top}));
+}
+
+// A posed frame written into a new folder is renamed into place as a whole folder, not through a
+// commit: its files reach the disk before the folder appears under its name, and the folder's
+// parent after; into an existing folder it is a commit (above).
+TEST(AtomicOutput, ANewFrameFolderIsOnTheDiskBeforeItAppears) {
+  ScratchDir dir;
+  const fs::path folder = fs::canonical(dir.path());
+  PosedFrame frame;
+  frame.name = "rest";
+  frame.grid.dims = {3, 2, 2};
+  frame.organs = Volume(frame.grid, ScalarType::UInt8);
+  frame.organs.setLabelMap(true);
+  frame.parts = Volume(frame.grid, ScalarType::UInt8);
+  frame.parts.setLabelMap(true);
+  frame.field.assign(3 * 12, 0.0f);
+  frame.reportJson = "{}";
+  static std::vector<std::string> synced;
+  synced.clear();
+  static fs::path frameFolder;
+  frameFolder = folder / "frame";
+  detail::commitSyncHook = [](const std::string& path) {
+    // Where it is when synced: in the hidden folder (a file) or the frame folder's parent.
+    synced.push_back(fs::path(path).filename().string() +
+                     (fs::exists(frameFolder) ? " (frame in place)" : ""));
+  };
+  writePosedFrame(frame, frameFolder.string());
+  detail::commitSyncHook = nullptr;
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(frameFolder)) files.push_back(e.path().filename());
+  std::sort(files.begin(), files.end());
+  ASSERT_FALSE(files.empty());
+  ASSERT_GE(synced.size(), files.size() + 2);
+  // Every file of the frame (each writer syncs its own file too), and the hidden folder they are
+  // in, before the frame is in place; then the folder holding the frame, once, after.
+  std::set<std::string> before(synced.begin(), synced.end() - 1);
+  std::set<std::string> expected(files.begin(), files.end());
+  ASSERT_EQ(synced[synced.size() - 2].rfind(".repose-tmp-", 0), 0u) << synced[synced.size() - 2];
+  expected.insert(synced[synced.size() - 2]);
+  EXPECT_EQ(before, expected);
+  EXPECT_EQ(synced.back(), folder.filename().string() + " (frame in place)");
+  EXPECT_EQ(
+      std::count_if(synced.begin(), synced.end(),
+                    [](const std::string& s) { return s.find("in place") != std::string::npos; }),
+      1);
 }

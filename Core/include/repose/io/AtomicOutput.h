@@ -58,11 +58,16 @@ void commitTogether(const std::vector<AtomicOutput*>& outputs);
 // under a published name either.
 void commitFiles(const std::vector<std::string>& temporaryFolders,
                  const std::vector<CommitStep>& steps, const std::string& target);
+// Makes what `path` holds reach the disk (fsync): a file's data, or with `folder` a folder's
+// entries (names made, renamed or removed). Throws repose::Error naming `target` when it cannot,
+// except for a folder on a file system that cannot sync folders (EINVAL, ENOTSUP).
+void syncToDisk(const std::string& path, bool folder, const std::string& target);
+
 namespace detail {
 // For tests only: called after the journal is written (0) and after each step (1, 2, ...), e.g.
 // to kill the process there.
 extern void (*commitStepHook)(std::size_t step);
-// For tests only: called with each file or folder commitFiles makes reach the disk, before it.
+// For tests only: called with each file or folder syncToDisk makes reach the disk, before it.
 extern void (*commitSyncHook)(const std::string& path);
 }  // namespace detail
 

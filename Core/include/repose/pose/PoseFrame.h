@@ -25,6 +25,9 @@ enum class LabelMapFiles { Nifti, SegNrrd, Both, DicomSeg };
 // else NIfTI.
 // Throws repose::Error naming the choice otherwise.
 LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inputPath);
+// The label-map files of a frame written as `files` (posed_G and posed_S in its formats, and the
+// colour tables beside NIfTI): what a report of that format lists among its outputs.
+std::vector<std::string> labelMapFileNames(LabelMapFiles files);
 
 struct PoseFrameOptions {
   const Volume* image = nullptr;  // on G's grid, posed alongside (trilinear)

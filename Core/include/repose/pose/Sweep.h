@@ -12,6 +12,8 @@
 
 namespace repose {
 
+enum class LabelMapFiles;  // repose/pose/PoseFrame.h
+
 struct SweepSubject {
   std::string name;    // the folder's name: DIR/<name>/ holds its outputs
   std::string folder;  // absolute
@@ -36,10 +38,13 @@ std::vector<SweepPose> readSweepPoses(const std::string& listPath);
 std::string sweepJobFolder(const std::string& outDir, const SweepSubject& subject,
                            const SweepPose& pose, const std::string& frameName, bool oneFrame);
 
-// A job's outputs are complete when its report.json reads, names this G as its input, and every
-// file of its "outputs" is there and not empty (the frame's files are moved in with the report
-// last, so a report only sits beside the files it names).
-bool sweepJobComplete(const std::string& jobFolder, const std::string& organsPath);
+// A job's outputs are complete when its report.json reads, names this G as its input, lists the
+// label-map files of `files` among its outputs (a job written in another format, say NIfTI
+// before a resume asking for DICOM SEG, is done again), and every file of its "outputs" is there
+// and not empty (the frame's files are moved in with the report last, so a report only sits
+// beside the files it names).
+bool sweepJobComplete(const std::string& jobFolder, const std::string& organsPath,
+                      LabelMapFiles files);
 
 // The scene folder of a subject's rig: DIR/<subject>/scenes/<16 hex digits of the key's hash>
 // (a subject's poses that cut or refine differently need different rigs).
