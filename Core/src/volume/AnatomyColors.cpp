@@ -6,8 +6,10 @@
 #include "repose/util/NameMatch.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -90,6 +92,84 @@ ReferenceColors& reference() {
   return r;
 }
 
+// A version folder's numbers ("Slicer-5.10" -> {5, 10}), compared as numbers, not text.
+std::vector<int> versionOf(const std::string& folderName) {
+  std::vector<int> numbers;
+  std::size_t at = folderName.find('-');
+  while (at != std::string::npos && at + 1 < folderName.size()) {
+    std::size_t end = at + 1;
+    while (end < folderName.size() && std::isdigit(static_cast<unsigned char>(folderName[end])))
+      ++end;
+    if (end == at + 1) break;
+    int n = 0;  // capped, so a folder named with a long run of digits cannot overflow
+    for (std::size_t d = at + 1; d < end; ++d) n = std::min(n * 10 + (folderName[d] - '0'), 99999);
+    numbers.push_back(n);
+    at = end < folderName.size() && folderName[end] == '.' ? end : std::string::npos;
+  }
+  return numbers;
+}
+
+// In one Slicer installation (its top folder, or a macOS bundle's Contents), the newest
+// share/Slicer-X.Y/ColorFiles/<name>; "" when there is none.
+std::string colorFileIn(const std::filesystem::path& root, const std::string& name) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::string best;
+  std::vector<int> bestVersion;
+  for (const fs::path& top : {root, root / "Contents"})
+    for (fs::directory_iterator it(top / "share", ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string folder = it->path().filename().string();
+      if (folder.rfind("Slicer-", 0) != 0) continue;
+      const fs::path file = it->path() / "ColorFiles" / name;
+      if (!fs::is_regular_file(file, ec)) continue;
+      const std::vector<int> version = versionOf(folder);
+      if (best.empty() || version > bestVersion) best = file.string(), bestVersion = version;
+    }
+  return best;
+}
+
+}  // namespace
+
+std::string findSlicerColorTable(const std::string& name) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // The installation that launched us (Slicer's launcher sets SLICER_HOME for what it starts).
+  if (const char* home = std::getenv("SLICER_HOME"); home && *home)
+    if (std::string f = colorFileIn(home, name); !f.empty()) return f;
+  // The Slicer on the PATH (often a link to the installation's launcher).
+  if (const char* path = std::getenv("PATH")) {
+    std::stringstream dirs(path);
+    for (std::string dir; std::getline(dirs, dir, ':');) {
+      if (dir.empty()) continue;
+      const fs::path launcher = fs::path(dir) / "Slicer";
+      if (!fs::exists(launcher, ec)) continue;
+      const fs::path real = fs::canonical(launcher, ec);
+      if (ec) continue;
+      for (const fs::path& root : {real.parent_path(), real.parent_path().parent_path()})
+        if (std::string f = colorFileIn(root, name); !f.empty()) return f;
+    }
+  }
+  // Where the installers put it: a Slicer* folder in /opt, /usr/local, the home folder or its
+  // Applications, or /Applications (macOS); the newest version among them.
+  std::vector<fs::path> places{"/opt", "/usr/local", "/Applications"};
+  if (const char* h = std::getenv("HOME"); h && *h)
+    places.push_back(h), places.push_back(fs::path(h) / "Applications");
+  std::string best;
+  std::vector<int> bestVersion;
+  for (const fs::path& place : places)
+    for (fs::directory_iterator it(place, ec), end; !ec && it != end; it.increment(ec)) {
+      if (it->path().filename().string().rfind("Slicer", 0) != 0 || !it->is_directory(ec)) continue;
+      const std::string f = colorFileIn(it->path(), name);
+      if (f.empty()) continue;
+      const std::vector<int> version =
+          versionOf(fs::path(f).parent_path().parent_path().filename().string());
+      if (best.empty() || version > bestVersion) best = f, bestVersion = version;
+    }
+  return best;
+}
+
+namespace {
+
 void fill(ReferenceColors& r, const LabelTable& table) {
   r.byName.clear();
   for (const Label& l : table.labels())
@@ -144,15 +224,19 @@ std::optional<std::array<double, 3>> referenceColor(const std::string& name) {
   ReferenceColors& r = reference();
   const std::lock_guard<std::mutex> lock(r.mutex);
   if (!r.set) {
-    const char* path = std::getenv("REPOSE_COLOR_TABLE");
-    if (!path || !*path) {
+    // $REPOSE_COLOR_TABLE, else Slicer's own table when Slicer is installed; set but empty:
+    // none (the rules alone).
+    const char* named = std::getenv("REPOSE_COLOR_TABLE");
+    const std::string path = named ? std::string(named) : findSlicerColorTable();
+    if (path.empty()) {
       r.set = true;
     } else {
+      const std::string source = path + (named ? " (REPOSE_COLOR_TABLE)" : " (3D Slicer's)");
       std::ifstream file(path);
-      if (!file) throw Error(std::string(path) + ": cannot open (REPOSE_COLOR_TABLE)");
+      if (!file) throw Error(path + ": cannot open" + (named ? " (REPOSE_COLOR_TABLE)" : ""));
       std::stringstream text;
       text << file.rdbuf();
-      fill(r, parseColorTable(text.str(), path));
+      fill(r, parseColorTable(text.str(), named ? path : source));
     }
   }
   const auto it = r.byName.find(normalizedLabelName(name));

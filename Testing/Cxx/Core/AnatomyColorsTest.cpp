@@ -18,8 +18,10 @@
 #include <cstdlib>
 #include <array>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -356,7 +358,90 @@ TEST(AnatomyColors, AReferenceColorTableGivesItsColoursByName) {
               std::string::npos)
         << e.what();
   }
-  ::unsetenv("REPOSE_COLOR_TABLE");
+  // Set but empty: no table, whatever Slicer this machine has.
+  ::setenv("REPOSE_COLOR_TABLE", "", 1);
   repose::useReferenceColorsFromEnvironment();
   EXPECT_EQ(repose::anatomyColor("liver", 5), rulesLiver);
+  ::unsetenv("REPOSE_COLOR_TABLE");
+  repose::useReferenceColorsFromEnvironment();
+}
+
+namespace {
+
+// Sets an environment variable for a scope, then puts it back as it was.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const std::string* value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = old;
+    if (value)
+      ::setenv(name, value->c_str(), 1);
+    else
+      ::unsetenv(name);
+  }
+  ~ScopedEnv() {
+    if (old_)
+      ::setenv(name_, old_->c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::optional<std::string> old_;
+};
+
+void writeTable(const std::filesystem::path& file, int green) {
+  std::filesystem::create_directories(file.parent_path());
+  std::ofstream(file) << "# a Slicer colour table (made up for the test)\n0 Background 0 0 0 0\n"
+                      << "1 liver 10 " << green << " 30 255\n";
+}
+
+}  // namespace
+
+// With no REPOSE_COLOR_TABLE, a Slicer installation's own GenericAnatomyColors.txt gives the
+// colours: the installation that launched us (SLICER_HOME), else the Slicer on the PATH, else one
+// in the usual places; its newest share/Slicer-X.Y (5.10 after 5.9, as numbers); a macOS bundle's
+// Contents too. No Slicer found: the rules.
+TEST(AnatomyColors, SlicersOwnTableIsFoundInItsInstallation) {
+  namespace fs = std::filesystem;
+  repose::test::ScratchDir dir;
+  const fs::path home = dir.path() / "Slicer-5.10.0-linux-amd64";
+  writeTable(home / "share/Slicer-5.9/ColorFiles/GenericAnatomyColors.txt", 59);
+  writeTable(home / "share/Slicer-5.10/ColorFiles/GenericAnatomyColors.txt", 60);
+  const std::string homeText = home.string(), empty;
+  const ScopedEnv noTable("REPOSE_COLOR_TABLE", nullptr), slicer("SLICER_HOME", &homeText);
+  // Nothing of this machine's: no Slicer on the PATH, a home without one.
+  const std::string nowhere = (dir.path() / "nowhere").string();
+  const ScopedEnv path("PATH", &nowhere), user("HOME", &nowhere);
+  EXPECT_EQ(repose::findSlicerColorTable(),
+            (home / "share/Slicer-5.10/ColorFiles/GenericAnatomyColors.txt").string());
+  repose::useReferenceColorsFromEnvironment();
+  EXPECT_DOUBLE_EQ(repose::LabelTable::defaultColor(5, "Liver")[1], 60 / 255.0);
+
+  // A macOS bundle on the PATH through a link to its launcher.
+  const fs::path bundle = dir.path() / "Slicer.app";
+  writeTable(bundle / "Contents/share/Slicer-5.8/ColorFiles/GenericAnatomyColors.txt", 58);
+  fs::create_directories(bundle / "Contents/MacOS");
+  std::ofstream(bundle / "Contents/MacOS/Slicer") << "";
+  fs::create_directories(dir.path() / "bin");
+  fs::create_symlink(bundle / "Contents/MacOS/Slicer", dir.path() / "bin/Slicer");
+  const std::string bin = (dir.path() / "bin").string();
+  {
+    const ScopedEnv noHome("SLICER_HOME", nullptr), onPath("PATH", &bin);
+    EXPECT_EQ(repose::findSlicerColorTable(),
+              (bundle / "Contents/share/Slicer-5.8/ColorFiles/GenericAnatomyColors.txt").string());
+  }
+  // In the home folder, where the Linux tarball is often unpacked.
+  {
+    const std::string userHome = dir.path().string();
+    const ScopedEnv noHome("SLICER_HOME", nullptr), inHome("HOME", &userHome);
+    const std::string found = repose::findSlicerColorTable();
+    // /opt or /usr/local may hold a newer Slicer on a developer's machine; here, ours.
+    if (found.rfind("/opt", 0) != 0 && found.rfind("/usr/local", 0) != 0)
+      EXPECT_EQ(found, (home / "share/Slicer-5.10/ColorFiles/GenericAnatomyColors.txt").string());
+  }
+  // A table that does not exist in the installation: nothing found.
+  EXPECT_EQ(repose::findSlicerColorTable("NoSuchTable.txt"), "");
+  repose::setReferenceColors({});
+  repose::useReferenceColorsFromEnvironment();
 }

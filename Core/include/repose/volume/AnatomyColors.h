@@ -4,8 +4,9 @@
 // distinct and each label keeps its colour from file to file.
 //
 // Before the rules, a reference colour table can give exact colours by name: 3D Slicer's own
-// GenericAnatomyColors.txt (every Slicer installation ships it; Repose does not copy it) or any
-// Slicer colour table, named by $REPOSE_COLOR_TABLE or set in code.
+// GenericAnatomyColors.txt (every Slicer installation ships it; Repose does not copy it, it
+// finds it: findSlicerColorTable) or any Slicer colour table, named by $REPOSE_COLOR_TABLE or
+// set in code.
 #pragma once
 
 #include "repose/volume/LabelTable.h"
@@ -24,11 +25,19 @@ LabelTable parseColorTable(const std::string& text, const std::string& source);
 // The reference colours: a label whose name (compared as the rules compare names) the table
 // lists takes that entry's colour exactly. Process-wide, as Slicer's default colour node is; an
 // empty table clears it. Unless set, the table $REPOSE_COLOR_TABLE names is read at the first
-// colour asked for; a file that cannot be read throws repose::Error naming it, then and at every
-// later colour (never silently the other colours).
+// colour asked for, or with that variable unset, Slicer's GenericAnatomyColors.txt when a Slicer
+// installation is found (set but empty: no table, the rules alone); a file that cannot be read
+// throws repose::Error naming it, then and at every later colour (never silently the other
+// colours).
 void setReferenceColors(const LabelTable& table);
-// Back to the start: the table $REPOSE_COLOR_TABLE names, read at the next colour asked for.
+// Back to the start: the table $REPOSE_COLOR_TABLE names (or Slicer's), read at the next colour
+// asked for.
 void useReferenceColorsFromEnvironment();
+// Slicer's colour table `name` in a 3D Slicer installation, "" when none is found: the newest
+// share/Slicer-X.Y/ColorFiles/<name> of $SLICER_HOME (Slicer's launcher sets it), else of the
+// Slicer on the PATH, else of a Slicer* folder in /opt, /usr/local, ~, ~/Applications or
+// /Applications (a macOS bundle's Contents too), the newest version among those.
+std::string findSlicerColorTable(const std::string& name = "GenericAnatomyColors.txt");
 // The reference colour of `name`, nullopt when the table does not list it.
 std::optional<std::array<double, 3>> referenceColor(const std::string& name);
 
