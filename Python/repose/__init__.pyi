@@ -21,6 +21,8 @@ class Volume:
     @property
     def array(self) -> npt.NDArray[Any]: ...
     affine: npt.NDArray[np.float64]
+    # What the reader said about the file, on a Volume read_volume returned (absent otherwise).
+    read_notes: List[str]
     @property
     def shape(self) -> Tuple[int, int, int]: ...
     @property

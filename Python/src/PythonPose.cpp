@@ -52,6 +52,13 @@ PoseJobRequest requestFrom(const std::string& tissuesPath, bool tissuesAuto,
   return request;
 }
 
+// What read_volume's reader said about G (Volume.read_notes; none for a Volume made otherwise),
+// for the job's reports ("input_notes", as `repose pose` keeps them).
+std::vector<std::string> readNotesOf(const py::object& organs) {
+  if (!py::hasattr(organs, "read_notes")) return {};
+  return organs.attr("read_notes").cast<std::vector<std::string>>();
+}
+
 // Each warning of a frame (PoseFrameOptions::warn) as a Python warning, once the GIL is back.
 void issueWarnings(const std::string& frame, const std::vector<std::string>& lines) {
   if (lines.empty()) return;
@@ -275,16 +282,18 @@ A body rigged for a pose: the cage and transfer mesh (built from the body-part m
 separations the pose asks for, bones and one-part organs as whole pieces), embedded, the pose's
 groups resolved. Each frame of the pose is then a few solves: `deform` gives the posed cage and
 mesh, `pose_frame` the full-resolution volumes and report.)doc")
-      .def(py::init([](const Volume& organs, const Volume& parts, const Pose& named,
+      .def(py::init([](const py::object& organsObject, const Volume& parts, const Pose& named,
                        int cageVertices, double dilateMm, double meshMm,
                        const std::string& tissuesPath, bool tissuesAuto,
                        const std::string& tissuesCsv, bool wholeOrgans, int jointRings, int threads,
                        const py::object& skeleton, bool autoSeparate, const py::object& progress,
                        const std::string& partsPath) {
+             const Volume& organs = organsObject.cast<const Volume&>();
              if (!isIntegerType(organs.scalarType()))
                throw Error("the organ map holds float voxels, not labels");
              PoseJobRequest request =
                  requestFrom(tissuesPath, tissuesAuto, tissuesCsv, skeleton, partsPath);
+             request.organsNotes = readNotesOf(organsObject);
              request.settings.cageVertices = cageVertices;
              request.settings.dilateMm = dilateMm;
              request.settings.meshMm = meshMm;
@@ -447,6 +456,7 @@ slabs), so label maps larger than memory can be posed.)doc")
         PoseJobRequest request =
             requestFrom(tissuesPath, tissuesAuto, "", py::none(), scene.inputs.parts);
         request.organsName = scene.inputs.organs;
+        request.organsNotes = readNotesOf(organsObject);
         request.settings.threads = threads;
         request.jointRings = jointRings;
         auto r = std::make_unique<Rig>();

@@ -121,7 +121,9 @@ py::array arrayView(Volume& v, py::handle owner) {
 }  // namespace
 
 void bindVolumes(py::module_& m) {
-  py::class_<Volume>(m, "Volume", R"doc(
+  // dynamic_attr: read_volume keeps what the reader said about the file (read_notes) on the
+  // Volume it returns, so a Rig built from it writes them into its reports.
+  py::class_<Volume>(m, "Volume", py::dynamic_attr(), R"doc(
 A 3D volume in physical space: voxels, the 4x4 IJK->RAS affine (millimetres), and for a label
 map its label table. `array` is a numpy view of the voxels (shape (I, J, K), Fortran order, as
 nibabel gives them); writing into it changes the volume.)doc")
@@ -230,12 +232,17 @@ nibabel gives them); writing into it changes the volume.)doc")
         }
         for (const std::string& n : notes)
           if (PyErr_WarnEx(PyExc_UserWarning, n.c_str(), 1) < 0) throw py::error_already_set();
-        return v;
+        py::object volume = py::cast(std::move(v));
+        volume.attr("read_notes") = notes;
+        return volume;
       },
       py::arg("path"), py::arg("progress") = py::none(), py::arg("memory_bytes") = py::none(),
       R"doc(Reads a NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), 3D Slicer segmentation
 (.seg.nrrd), DICOM SEG file, or a DICOM series folder into RAS millimetres. Raises repose.Error with the command
-line's one-line message (the file and the problem).
+line's one-line message (the file and the problem). What the reader decided about the file (the
+grid a DICOM SEG was placed on, a FRACTIONAL SEG thresholded) is said as a UserWarning and kept
+in the Volume's `read_notes` (a list of lines), which a Rig built from it writes into its
+reports as "input_notes".
 
 memory_bytes: the budget (default: half the physical memory, as the command line's
 --memory). The read may use what the budget leaves beyond the process's resident memory; a file

@@ -122,6 +122,8 @@ def test_a_dicom_seg_reads_with_its_segments_and_its_grid_said_as_a_warning(tmp_
     seg = data_dir / "dcmqi_ct3slice" / "partial_overlaps.dcm"
     with pytest.warns(UserWarning, match="placed on the grid of its referenced series"):
         v = rp.read_volume(str(seg))
+    # The same lines stay with the volume, for the reports of a rig built from it.
+    assert len(v.read_notes) == 1 and "placed on the grid of its referenced series" in v.read_notes[0]
     assert v.shape == (512, 512, 3)
     assert [l["name"] for l in v.labels] == ["GREEN", "LIGHT_BLUE", "DARK_BLUE", "ORANGE", "PURPLE"]
     assert sorted({l["layer"] for l in v.labels}) == [0, 1, 2]
@@ -165,6 +167,24 @@ def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose):
     assert report["green_coordinates"]["read"], report["green_coordinates"]
     field = frame.field
     assert field.shape == frame.organs.shape + (3,) and np.isfinite(field).all()
+
+
+def test_what_the_reader_said_about_g_is_in_every_frames_report(tmp_path, phantom):
+    """A Rig keeps G's read_notes (what read_volume's reader decided about the file) and writes
+    them into each frame's report as input_notes, as `repose pose` does; a file the reader had
+    nothing to say about gives none."""
+    rp.write_volume(phantom["organs"], str(tmp_path / "G.nii.gz"))
+    g = rp.read_volume(str(tmp_path / "G.nii.gz"))
+    assert g.read_notes == []
+    pose = rp.Pose.read(str(POSES / "elbow90.pose.json"))
+    quiet = rp.build_rig(g, phantom["parts"], pose, skeleton=phantom["skeleton"])
+    assert "input_notes" not in quiet.pose_frame(g, phantom["parts"]).report
+    # As a DICOM SEG placed on its referenced series' grid would have it (that reader's own
+    # note: test_a_dicom_seg_reads_with_its_segments_and_its_grid_said_as_a_warning).
+    note = "G.dcm: the segmentation is placed on the grid of its referenced series"
+    g.read_notes = [note]
+    rig = rp.build_rig(g, phantom["parts"], pose, skeleton=phantom["skeleton"])
+    assert rig.pose_frame(g, phantom["parts"]).report["input_notes"] == [note]
 
 
 def test_a_frame_write_refuses_a_folder_another_run_writes_into(tmp_path, phantom, elbow_rig):

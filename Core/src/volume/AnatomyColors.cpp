@@ -109,23 +109,30 @@ std::vector<int> versionOf(const std::string& folderName) {
   return numbers;
 }
 
+// The newest of the colour files offered, by their share/Slicer-X.Y folder's version.
+struct NewestColorFile {
+  std::string file;  // "" until one is offered
+  std::vector<int> version;
+  void offer(const std::string& candidate, const std::vector<int>& candidateVersion) {
+    if (!candidate.empty() && (file.empty() || candidateVersion > version))
+      file = candidate, version = candidateVersion;
+  }
+};
+
 // In one Slicer installation (its top folder, or a macOS bundle's Contents), the newest
-// share/Slicer-X.Y/ColorFiles/<name>; "" when there is none.
-std::string colorFileIn(const std::filesystem::path& root, const std::string& name) {
+// share/Slicer-X.Y/ColorFiles/<name> (file "" when there is none).
+NewestColorFile colorFileIn(const std::filesystem::path& root, const std::string& name) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  std::string best;
-  std::vector<int> bestVersion;
+  NewestColorFile newest;
   for (const fs::path& top : {root, root / "Contents"})
     for (fs::directory_iterator it(top / "share", ec), end; !ec && it != end; it.increment(ec)) {
       const std::string folder = it->path().filename().string();
       if (folder.rfind("Slicer-", 0) != 0) continue;
       const fs::path file = it->path() / "ColorFiles" / name;
-      if (!fs::is_regular_file(file, ec)) continue;
-      const std::vector<int> version = versionOf(folder);
-      if (best.empty() || version > bestVersion) best = file.string(), bestVersion = version;
+      if (fs::is_regular_file(file, ec)) newest.offer(file.string(), versionOf(folder));
     }
-  return best;
+  return newest;
 }
 
 }  // namespace
@@ -135,7 +142,7 @@ std::string findSlicerColorTable(const std::string& name) {
   std::error_code ec;
   // The installation that launched us (Slicer's launcher sets SLICER_HOME for what it starts).
   if (const char* home = std::getenv("SLICER_HOME"); home && *home)
-    if (std::string f = colorFileIn(home, name); !f.empty()) return f;
+    if (std::string f = colorFileIn(home, name).file; !f.empty()) return f;
   // The Slicer on the PATH (often a link to the installation's launcher).
   if (const char* path = std::getenv("PATH")) {
     std::stringstream dirs(path);
@@ -146,7 +153,7 @@ std::string findSlicerColorTable(const std::string& name) {
       const fs::path real = fs::canonical(launcher, ec);
       if (ec) continue;
       for (const fs::path& root : {real.parent_path(), real.parent_path().parent_path()})
-        if (std::string f = colorFileIn(root, name); !f.empty()) return f;
+        if (std::string f = colorFileIn(root, name).file; !f.empty()) return f;
     }
   }
   // Where the installers put it: a Slicer* folder in /opt, /usr/local, the home folder or its
@@ -154,18 +161,14 @@ std::string findSlicerColorTable(const std::string& name) {
   std::vector<fs::path> places{"/opt", "/usr/local", "/Applications"};
   if (const char* h = std::getenv("HOME"); h && *h)
     places.push_back(h), places.push_back(fs::path(h) / "Applications");
-  std::string best;
-  std::vector<int> bestVersion;
+  NewestColorFile newest;
   for (const fs::path& place : places)
     for (fs::directory_iterator it(place, ec), end; !ec && it != end; it.increment(ec)) {
       if (it->path().filename().string().rfind("Slicer", 0) != 0 || !it->is_directory(ec)) continue;
-      const std::string f = colorFileIn(it->path(), name);
-      if (f.empty()) continue;
-      const std::vector<int> version =
-          versionOf(fs::path(f).parent_path().parent_path().filename().string());
-      if (best.empty() || version > bestVersion) best = f, bestVersion = version;
+      const NewestColorFile in = colorFileIn(it->path(), name);
+      newest.offer(in.file, in.version);
     }
-  return best;
+  return newest.file;
 }
 
 namespace {
