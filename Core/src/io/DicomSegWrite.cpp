@@ -19,6 +19,7 @@
 // clang-format on
 #include <dcmtk/dcmdata/dcdeftag.h>
 #include <dcmtk/dcmdata/dcfilefo.h>
+#include <dcmtk/dcmdata/dcpixel.h>
 #include <dcmtk/dcmdata/dcuid.h>
 #include <dcmtk/dcmfg/fgfracon.h>
 #include <dcmtk/dcmfg/fgpixmsr.h>
@@ -242,13 +243,27 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
 
   // Frames, slice by slice: one per segment present in the slice; a slice with none gets an
   // empty frame of the first segment, and so does a segment with no voxel, so the grid and every
-  // segment come back on reading.
+  // segment come back on reading. dcmseg keeps each frame's bits; what each frame holds is noted
+  // here (its slice, layer and value, 0 for an empty frame) so that the pixel data written at
+  // the end is made from the volume once dcmseg's frames are freed: the largest objects held at
+  // once are then two copies of the frames' bits, not three.
   const std::int64_t pixels = std::int64_t(rows) * columns;
-  std::vector<Uint8> packed;
-  std::int64_t frames = 0;
+  struct FrameSource {
+    std::int64_t k;
+    int layer, value;
+  };
+  std::vector<FrameSource> sources;
   std::vector<Uint8> mask(static_cast<std::size_t>(pixels));
   std::map<Uint16, bool> hasFrame;
-  auto addFrame = [&](Uint16 number, std::int64_t k) {
+  auto addFrame = [&](Uint16 number, std::int64_t k, int layer, int value) {
+    const std::int64_t frames = std::int64_t(sources.size());
+    const std::int64_t bytes = ((frames + 1) * pixels + 7) / 8;
+    if (bytes > std::int64_t(0xFFFFFFFE))
+      throwFileError(path,
+                     "the frames need more than the 4 GB a DICOM object's pixel data can "
+                     "hold (" +
+                         std::to_string(frames + 1) + " frames of " + std::to_string(columns) +
+                         "x" + std::to_string(rows) + "); write NIfTI or .seg.nrrd");
     const Eigen::Vector3d p = (lps * Eigen::Vector4d(0, 0, double(k), 1)).head<3>();
     std::unique_ptr<FGPlanePosPatient> position(FGPlanePosPatient::createMinimal(
         decimal(path, p[0]).c_str(), decimal(path, p[1]).c_str(), decimal(path, p[2]).c_str()));
@@ -257,21 +272,21 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
     frameContent.setDimensionIndexValues(Uint32(k + 1), 1);
     OFVector<FGBase*> groups{position.get(), &frameContent};
     check(path, seg->addFrame(mask.data(), number, groups), "frame");
-    const std::int64_t bytes = ((frames + 1) * pixels + 7) / 8;
-    if (bytes > std::int64_t(0xFFFFFFFE))
-      throwFileError(path,
-                     "the frames need more than the 4 GB a DICOM object's pixel data can "
-                     "hold (" +
-                         std::to_string(frames + 1) + " frames of " + std::to_string(columns) +
-                         "x" + std::to_string(rows) + "); write NIfTI or .seg.nrrd");
-    packed.resize(static_cast<std::size_t>(bytes), 0);
-    for (std::int64_t i = 0; i < pixels; ++i)
-      if (mask[std::size_t(i)]) {
-        const std::int64_t bit = frames * pixels + i;
-        packed[std::size_t(bit >> 3)] |= Uint8(1u << (bit & 7));
-      }
-    ++frames;
+    sources.push_back({k, layer, value});
     hasFrame[number] = true;
+  };
+  // Calls fn(slice) with slice k of a layer in its own scalar type.
+  auto withSlice = [&](int layer, std::int64_t k, auto&& fn) {
+    switch (type) {
+      case ScalarType::UInt8:
+        return fn(volume.data<std::uint8_t>(layer) + k * pixels);
+      case ScalarType::UInt16:
+        return fn(volume.data<std::uint16_t>(layer) + k * pixels);
+      case ScalarType::Int16:
+        return fn(volume.data<std::int16_t>(layer) + k * pixels);
+      default:
+        return fn(volume.data<std::int32_t>(layer) + k * pixels);
+    }
   };
   std::map<std::pair<int, int>, Uint16> numberOf;
   for (const auto& [key, s] : segments) numberOf[key] = s.number;
@@ -280,40 +295,26 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
     for (int layer = 0; layer < volume.layers(); ++layer) {
       // Values in this slice of this layer, then one frame each.
       std::map<int, std::vector<std::int64_t>> at;
-      auto collect = [&](const auto* data) {
-        forEachLabelled(data + k * pixels, pixels,
-                        [&](int v, std::int64_t p) { at[v].push_back(p); });
-      };
-      switch (type) {
-        case ScalarType::UInt8:
-          collect(volume.data<std::uint8_t>(layer));
-          break;
-        case ScalarType::UInt16:
-          collect(volume.data<std::uint16_t>(layer));
-          break;
-        case ScalarType::Int16:
-          collect(volume.data<std::int16_t>(layer));
-          break;
-        default:
-          collect(volume.data<std::int32_t>(layer));
-          break;
-      }
+      withSlice(layer, k, [&](const auto* slice) {
+        forEachLabelled(slice, pixels, [&](int v, std::int64_t p) { at[v].push_back(p); });
+      });
       for (const auto& [value, where] : at) {
         std::fill(mask.begin(), mask.end(), 0);
         for (std::int64_t p : where) mask[std::size_t(p)] = 1;
-        addFrame(numberOf.at({layer, value}), k);
+        addFrame(numberOf.at({layer, value}), k, layer, value);
         any = true;
       }
     }
     if (!any) {
       std::fill(mask.begin(), mask.end(), 0);
-      addFrame(segments.begin()->second.number, k);
+      addFrame(segments.begin()->second.number, k, 0, 0);
     }
     reportProgress(options.progress, 0.9 * double(k + 1) / double(g.dims[2]), "writing DICOM SEG");
   }
   std::fill(mask.begin(), mask.end(), 0);
   for (const auto& [key, s] : segments)
-    if (!hasFrame[s.number]) addFrame(s.number, 0);
+    if (!hasFrame[s.number]) addFrame(s.number, 0, 0, 0);
+  mask = std::vector<Uint8>();
 
   DcmFileFormat file;
   check(path, seg->writeDataset(*file.getDataset()), "checking the object");
@@ -331,9 +332,40 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
           item->putAndInsertString(DCM_SegmentLabel, s.dicomName.c_str());
     }
   }
-  if (packed.size() % 2) packed.push_back(0);
-  check(path, ds->putAndInsertUint8Array(DCM_PixelData, packed.data(), packed.size()),
-        "pixel data");
+  // The frames' bits one after the other with no padding between frames (see the top of this
+  // file), in place of dcmseg's pixel data, made in the element itself.
+  seg.reset();
+  delete ds->remove(DCM_PixelData);
+  {
+    const std::int64_t bits = std::int64_t(sources.size()) * pixels;
+    const Uint32 bytes = Uint32(((bits + 7) / 8 + 1) / 2 * 2);  // an even length, as DICOM asks
+    auto pixelData = std::make_unique<DcmPixelData>(DCM_PixelData);
+    Uint8* packed = nullptr;  // zeroed by DCMTK
+    check(path, pixelData->createUint8Array(bytes, packed), "pixel data");
+    for (std::size_t f = 0; f < sources.size();) {
+      // The frames of one slice and layer, found in one pass over it.
+      const FrameSource& first = sources[f];
+      std::size_t last = f;
+      while (last + 1 < sources.size() && sources[last + 1].k == first.k &&
+             sources[last + 1].layer == first.layer)
+        ++last;
+      std::map<int, std::int64_t> frameOf;  // value -> frame
+      for (std::size_t n = f; n <= last; ++n)
+        if (sources[n].value != 0) frameOf[sources[n].value] = std::int64_t(n);
+      if (!frameOf.empty())
+        withSlice(first.layer, first.k, [&](const auto* slice) {
+          int lastValue = 0;
+          std::int64_t lastFrame = -1;
+          forEachLabelled(slice, pixels, [&](int v, std::int64_t p) {
+            if (v != lastValue) lastValue = v, lastFrame = frameOf.at(v);
+            const std::int64_t bit = lastFrame * pixels + p;
+            packed[bit >> 3] |= Uint8(1u << (bit & 7));
+          });
+        });
+      f = last + 1;
+    }
+    check(path, ds->insert(pixelData.release(), true), "pixel data");
+  }
   // Repose's value and layer of each segment (private block, DicomSegPrivate.h).
   DcmSequenceOfItems* items = nullptr;
   check(path, ds->findAndGetSequence(DCM_SegmentSequence, items), "segments");
