@@ -117,13 +117,15 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
                                                                      const std::string& image) {
   return this->Guarded<vtkMRMLReposeSegmentationNode*>(
       nullptr, [&]() -> vtkMRMLReposeSegmentationNode* {
-        repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels);
+        std::vector<std::string> readNotes;
+        repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels, &readNotes);
         if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
         // Names and colours the file left out, so the views and the probe tell labels apart.
         vtkSlicerReposeLogicRead::NameLabels(G, this->TissueTablePath, labels);
         auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
         node->SetName(stemOf(labels));
         node->SetLabelMap(Conversion::ToImageData(G));
+        node->SetLabelMapReadNotes(readNotes);
         for (const auto& [path, setter] :
              {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
               std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
@@ -245,9 +247,8 @@ std::shared_ptr<const repose::PoseJob> vtkSlicerReposeLogic::PoseJobFor(
   request.tissuesPath = this->TissueTablePath;
   request.skeleton = vtkSlicerReposeLogicInputs::SkeletonOf(seg);
   // What G's reader decided (a DICOM SEG's grid...), kept in the export's report.json as the
-  // command line keeps it.
-  if (!seg->GetLabelMapFileName().empty() && seg->GetLabelMapFileName() == this->VolumePath)
-    request.organsNotes = this->VolumeReadNotes;
+  // command line keeps it: the segmentation's own, from the file it was read from.
+  request.organsNotes = seg->GetLabelMapReadNotes();
   if (this->ParameterNode) {
     request.settings.cageVertices = this->ParameterNode->GetCageVertexCount();
     request.settings.dilateMm = this->ParameterNode->GetCageDilationMm();
@@ -558,6 +559,7 @@ bool vtkSlicerReposeLogic::OpenScene(const std::string& folder) {
   // The input box shows G: the voxels and label table the node read, not the file again.
   if (seg && !this->ShowVolume(inFolder(seg->GetLabelMapFileName()), seg->GetLabelMap()))
     return false;
+  if (seg) this->VolumeReadNotes = seg->GetLabelMapReadNotes();  // the box says them as a read does
   // A rigged pose goes live (a job: PollJob/WaitForJob commits it).
   if (pose && this->Scene->GetReferencedNode(pose, repose::scene_schema::kTransferMeshRole) &&
       !this->StartLivePose(pose))

@@ -129,8 +129,10 @@ vtkSmartPointer<vtkMRMLReposeScene> Load(const std::string& folder) {
   for (int n = 0; n < loaded->GetNumberOfNodes(); ++n) {
     vtkMRMLReposeNode* node = loaded->GetNthNode(n);
     if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
+      std::vector<std::string> readNotes;
       seg->SetLabelMap(Conversion::ToImageData(
-          vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg))));
+          vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg), &readNotes)));
+      seg->SetLabelMapReadNotes(readNotes);
       if (!seg->GetBodyPartMapFileName().empty()) {
         const std::string parts = (dir / seg->GetBodyPartMapFileName()).string();
         seg->SetBodyPartMap(Conversion::ToImageData(vtkSlicerReposeLogicRead::ReadVolume(parts)));

@@ -64,6 +64,7 @@ void vtkMRMLReposeSegmentationNode::CopyContent(vtkMRMLReposeNode* other) {
   this->SetBodyPartMapFileName(o->BodyPartMapFileName);
   this->SetImageFileName(o->ImageFileName);
   this->SetSkeletonJSON(o->SkeletonJSON);
+  this->SetLabelMapReadNotes(o->LabelMapReadNotes);
   this->SetLabelMap(copyOf(o->LabelMap));
   this->SetBodyPartMap(copyOf(o->BodyPartMap));
   this->SetImage(copyOf(o->Image));

@@ -10,6 +10,9 @@
 #include <vtkImageData.h>
 #include <vtkSmartPointer.h>
 
+#include <string>
+#include <vector>
+
 class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
     : public vtkMRMLReposeNode {
  public:
@@ -40,6 +43,15 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
   const std::string& GetSkeletonJSON() const { return this->SkeletonJSON; }
   void SetSkeletonJSON(const std::string& text) { this->SetField(this->SkeletonJSON, text); }
 
+  // What G's reader said about the file it read (a DICOM SEG placed on its own grid, a FRACTIONAL
+  // SEG thresholded: repose::ReadOptions::note), kept for the export's report ("input_notes",
+  // as `repose pose` keeps them). Not written to the scene: a saved scene holds G as NIfTI, on
+  // the grid the reader chose, and a scene opened has the notes of reading its own file.
+  const std::vector<std::string>& GetLabelMapReadNotes() const { return this->LabelMapReadNotes; }
+  void SetLabelMapReadNotes(const std::vector<std::string>& notes) {
+    this->SetField(this->LabelMapReadNotes, notes);
+  }
+
  protected:
   vtkMRMLReposeSegmentationNode() = default;
   void WriteFields(nlohmann::ordered_json& json) const override;
@@ -49,4 +61,5 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
  private:
   vtkSmartPointer<vtkImageData> LabelMap, BodyPartMap, Image;
   std::string LabelMapFileName, BodyPartMapFileName, ImageFileName, SkeletonJSON;
+  std::vector<std::string> LabelMapReadNotes;
 };

@@ -52,11 +52,33 @@ PoseJobRequest requestFrom(const std::string& tissuesPath, bool tissuesAuto,
   return request;
 }
 
+// The Volume a rig's `organs` argument holds. It is taken as an object (its read_notes are read
+// too), so the type is checked here: pybind's cast error would not say which argument it was.
+const Volume& organsVolume(const py::object& organs) {
+  if (!py::isinstance<Volume>(organs))
+    throw py::type_error("organs: expected a repose.Volume (read_volume, volume_from_array), got " +
+                         std::string(py::str(py::type::of(organs).attr("__name__"))));
+  return organs.cast<const Volume&>();
+}
+
 // What read_volume's reader said about G (Volume.read_notes; none for a Volume made otherwise),
-// for the job's reports ("input_notes", as `repose pose` keeps them).
+// for the job's reports ("input_notes", as `repose pose` keeps them). A user may set the
+// attribute, so its type is checked with a message that names it.
 std::vector<std::string> readNotesOf(const py::object& organs) {
   if (!py::hasattr(organs, "read_notes")) return {};
-  return organs.attr("read_notes").cast<std::vector<std::string>>();
+  const py::object notes = organs.attr("read_notes");
+  if (notes.is_none()) return {};
+  std::vector<std::string> lines;
+  if (py::isinstance<py::str>(notes) || !py::isinstance<py::sequence>(notes))
+    throw py::type_error("organs.read_notes: expected a list of str, got " +
+                         std::string(py::str(py::type::of(notes).attr("__name__"))));
+  for (const py::handle line : notes) {
+    if (!py::isinstance<py::str>(line))
+      throw py::type_error("organs.read_notes: expected a list of str, holds an item of type " +
+                           std::string(py::str(py::type::of(line).attr("__name__"))));
+    lines.push_back(line.cast<std::string>());
+  }
+  return lines;
 }
 
 // Each warning of a frame (PoseFrameOptions::warn) as a Python warning, once the GIL is back.
@@ -288,7 +310,7 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
                        const std::string& tissuesCsv, bool wholeOrgans, int jointRings, int threads,
                        const py::object& skeleton, bool autoSeparate, const py::object& progress,
                        const std::string& partsPath) {
-             const Volume& organs = organsObject.cast<const Volume&>();
+             const Volume& organs = organsVolume(organsObject);
              if (!isIntegerType(organs.scalarType()))
                throw Error("the organ map holds float voxels, not labels");
              PoseJobRequest request =
@@ -450,7 +472,7 @@ slabs), so label maps larger than memory can be posed.)doc")
       [](const std::string& folder, const py::object& organsObject, const py::object& partsObject,
          const py::object& pose, int jointRings, int threads, const std::string& tissuesPath,
          bool tissuesAuto) {
-        const Volume& organs = organsObject.cast<const Volume&>();
+        const Volume& organs = organsVolume(organsObject);
         const Volume& parts = partsObject.cast<const Volume&>();
         SceneContents scene = readSceneFolder(folder);
         PoseJobRequest request =

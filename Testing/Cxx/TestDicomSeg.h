@@ -124,4 +124,20 @@ inline void writeTinySeg(const TinySeg& t, const std::string& path) {
   file.saveFile(path.c_str(), EXS_LittleEndianExplicit);
 }
 
+// Gives the SEG at `path` (as Repose writes one) a SpacingBetweenSlices of `spacing` mm in its
+// shared Pixel Measures, saved over the file: a value its frames do not keep, as a SEG copied
+// from another series has, which the reader notes. False if a step fails.
+inline bool setSegSpacingBetweenSlices(const std::string& path, const char* spacing) {
+  DcmFileFormat seg;
+  // All of it: saved over the file it was read from, a PixelData left to be read later is lost.
+  if (!seg.loadFile(path.c_str()).good() || !seg.loadAllDataIntoMemory().good()) return false;
+  DcmItem *shared = nullptr, *measures = nullptr;
+  return seg.getDataset()
+             ->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0)
+             .good() &&
+         shared->findAndGetSequenceItem(DCM_PixelMeasuresSequence, measures, 0).good() &&
+         measures->putAndInsertString(DCM_SpacingBetweenSlices, spacing).good() &&
+         seg.saveFile(path.c_str(), EXS_LittleEndianExplicit).good();
+}
+
 }  // namespace repose::test

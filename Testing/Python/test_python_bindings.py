@@ -187,6 +187,26 @@ def test_what_the_reader_said_about_g_is_in_every_frames_report(tmp_path, phanto
     assert rig.pose_frame(g, phantom["parts"]).report["input_notes"] == [note]
 
 
+def test_a_rig_of_something_other_than_a_volume_is_refused_naming_the_argument(phantom):
+    """Rig takes organs as an object (to read its read_notes), so the type is checked by name:
+    an array, or a Volume whose read_notes a user set to something other than a list of str,
+    gets a TypeError saying which argument and what it got, before any work is done."""
+    pose = rp.Pose.read(str(POSES / "elbow90.pose.json"))
+    array = np.zeros((4, 4, 4), np.uint8)
+    with pytest.raises(TypeError) as wrong:
+        rp.build_rig(array, phantom["parts"], pose, skeleton=phantom["skeleton"])
+    message = str(wrong.value)
+    assert message.startswith("organs: expected a repose.Volume") and "\n" not in message, message
+    assert type(array).__name__ in message
+    for notes, said in (("one line", "got str"), ([1], "holds an item of type int")):
+        volume = phantom["organs"].copy()
+        volume.read_notes = notes
+        with pytest.raises(TypeError) as wrong:
+            rp.build_rig(volume, phantom["parts"], pose, skeleton=phantom["skeleton"])
+        assert str(wrong.value).startswith("organs.read_notes: expected a list of str")
+        assert said in str(wrong.value), str(wrong.value)
+
+
 def test_a_frame_write_refuses_a_folder_another_run_writes_into(tmp_path, phantom, elbow_rig):
     """PosedFrame.write takes the folder's lock as `repose pose --out` does: while another run
     holds it (here this test, with flock as FolderLock takes it), the write refuses with one line

@@ -5,6 +5,7 @@
 // --output-format chooses, and a re-run never leaves another run's files beside its report.
 #include "CliTestFiles.h"
 #include "CommandRunner.h"
+#include "TestDicomSeg.h"
 #include "TestPaths.h"
 #include "TestVolumes.h"
 
@@ -129,21 +130,9 @@ TEST(PoseSlicerOutputs, ASegmentationComesBackWithItsNamesColoursAndTerminology)
   WriteOptions asDicom;
   asDicom.sourceDicom = dataPath("dcmqi_ct3slice/liver.dcm");
   writeVolume(G, dir.file("G.dcm"), asDicom);
-  {
-    // With a SpacingBetweenSlices its frames do not keep (copied from another series): the reader
-    // places the frames by their own spacing and says so, and the report keeps what it said.
-    DcmFileFormat seg;
-    ASSERT_TRUE(seg.loadFile(dir.file("G.dcm").c_str()).good());
-    // All of it: saved over the file it was read from, a PixelData left to be read later is lost.
-    ASSERT_TRUE(seg.loadAllDataIntoMemory().good());
-    DcmItem *shared = nullptr, *measures = nullptr;
-    ASSERT_TRUE(seg.getDataset()
-                    ->findAndGetSequenceItem(DCM_SharedFunctionalGroupsSequence, shared, 0)
-                    .good());
-    ASSERT_TRUE(shared->findAndGetSequenceItem(DCM_PixelMeasuresSequence, measures, 0).good());
-    ASSERT_TRUE(measures->putAndInsertString(DCM_SpacingBetweenSlices, "7.5").good());
-    ASSERT_TRUE(seg.saveFile(dir.file("G.dcm").c_str(), EXS_LittleEndianExplicit).good());
-  }
+  // With a SpacingBetweenSlices its frames do not keep (copied from another series): the reader
+  // places the frames by their own spacing and says so, and the report keeps what it said.
+  ASSERT_TRUE(setSegSpacingBetweenSlices(dir.file("G.dcm"), "7.5"));
   std::string dicomCommon = common;
   dicomCommon.replace(dicomCommon.find(shellQuote(dir.file("G.seg.nrrd"))),
                       shellQuote(dir.file("G.seg.nrrd")).size(), shellQuote(dir.file("G.dcm")));

@@ -12,6 +12,7 @@
 #include "vtkSlicerReposeVolumeConversion.h"
 
 #include "CommandRunner.h"
+#include "TestDicomSeg.h"
 #include "TestPaths.h"
 
 #include <repose/io/AtomicOutput.h>
@@ -355,6 +356,77 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportAboveTheMemoryBudgetIsRefusedWithTheN
 // added next has the convention's organ names and the rig's part names. A folder that cannot be
 // made fails the job with one line naming it, and a G that is not a label map is refused before
 // any job starts.
+// What G's reader said about its file (here a DICOM SEG whose SpacingBetweenSlices its frames do
+// not keep) is in the export's report as "input_notes", as `repose pose` keeps it
+// (PoseSlicerOutputsTest), and in the input box: the segmentation node keeps the notes of the file
+// it was read from. A saved scene holds G as NIfTI on the grid the reader chose; opened, it has
+// nothing more to say, and its exports say nothing.
+TEST(vtkSlicerReposeLogicPipeline, AnExportsReportKeepsWhatTheReaderSaidAboutG) {
+  PhantomFiles files;
+  const std::string dcm = files.dir.file("G.dcm");
+  repose::writeVolume(repose::readVolume(files.G), dcm);
+  ASSERT_TRUE(setSegSpacingBetweenSlices(dcm, "7.5"));
+  const std::string said = dcm + ": its frames are not 7.5";
+  auto notesOf = [](const std::string& reportPath) {
+    std::ifstream in(reportPath);
+    const nlohmann::json report = nlohmann::json::parse(in);
+    return report.value("input_notes", std::vector<std::string>());
+  };
+
+  // As the module's panel does it: the file shown in the input box, then a segmentation of it.
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> parameters;
+  logic->SetParameterNode(parameters);
+  ASSERT_TRUE(logic->LoadVolume(dcm)) << logic->GetLastErrorMessage();
+  EXPECT_NE(logic->GetVolumeSummary().find("Note: its frames are not 7.5"), std::string::npos)
+      << logic->GetVolumeSummary();
+  auto* seg = logic->AddSegmentation(dcm, files.S);
+  ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
+  ASSERT_EQ(seg->GetLabelMapReadNotes().size(), 1u);
+  EXPECT_EQ(seg->GetLabelMapReadNotes()[0].rfind(said, 0), 0u) << seg->GetLabelMapReadNotes()[0];
+  auto* pose = logic->AddPose(suite("elbow90"));
+  ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
+  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  const std::string out = files.dir.file("posed");
+  ASSERT_TRUE(logic->StartApplyPose(pose, out));
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  EXPECT_EQ(notesOf(out + "/report.json"), seg->GetLabelMapReadNotes());
+
+  // A segmentation read from a file the reader had nothing to say about gets none, whatever the
+  // input box shows.
+  auto* quiet = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(quiet) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(quiet->GetLabelMapReadNotes().empty());
+
+  // Saved and opened again: G is the scene's NIfTI now, read without a note.
+  const std::string saved = files.dir.file("saved");
+  logic->GetScene()->RemoveNode(quiet);
+  ASSERT_TRUE(logic->SaveScene(saved)) << logic->GetLastErrorMessage();
+  vtkNew<vtkSlicerReposeLogic> opened;
+  vtkNew<vtkMRMLReposeParametersNode> openedParameters;
+  opened->SetParameterNode(openedParameters);
+  ASSERT_TRUE(opened->OpenScene(saved)) << opened->GetLastErrorMessage();
+  ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << opened->GetLastErrorMessage();
+  auto* openedSeg = vtkMRMLReposeSegmentationNode::SafeDownCast(
+      opened->GetScene()->GetNodesByClass("vtkMRMLReposeSegmentationNode").at(0));
+  EXPECT_EQ(std::filesystem::path(openedSeg->GetLabelMapFileName()).extension(), ".gz");
+  EXPECT_TRUE(openedSeg->GetLabelMapReadNotes().empty());
+  EXPECT_EQ(opened->GetVolumeSummary().find("Note: "), std::string::npos)
+      << opened->GetVolumeSummary();
+  const std::string reposed = files.dir.file("reposed");
+  ASSERT_TRUE(opened->StartApplyPose(
+      vtkMRMLReposePoseNode::SafeDownCast(
+          opened->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode").at(0)),
+      reposed));
+  ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << opened->GetLastErrorMessage();
+  EXPECT_TRUE(notesOf(reposed + "/report.json").empty());
+}
+
 TEST(vtkSlicerReposeLogicPipeline, RigFromOrganMapWritesTheRigAndNamesTheLabels) {
   ScratchDir dir("organrig");
   repose::PhantomOptions po;

@@ -62,10 +62,14 @@ std::vector<NodeCase> cases() {
          s->SetLabelMap(image(7));
          s->SetBodyPartMap(image(2));
          s->SetImage(image(100));
+         s->SetLabelMapReadNotes({"G.dcm: a note of its reader"});
        },
        [](vtkMRMLReposeNode* a, vtkMRMLReposeNode* b) {
          auto *x = vtkMRMLReposeSegmentationNode::SafeDownCast(a),
               *y = vtkMRMLReposeSegmentationNode::SafeDownCast(b);
+         // The reader's notes are copied, and not written (a scene's G is read again).
+         EXPECT_EQ(y->GetLabelMapReadNotes(), x->GetLabelMapReadNotes());
+         EXPECT_EQ(x->ToJSON().dump().find("a note of its reader"), std::string::npos);
          for (auto [p, q] : {std::pair{x->GetLabelMap(), y->GetLabelMap()},
                              std::pair{x->GetBodyPartMap(), y->GetBodyPartMap()},
                              std::pair{x->GetImage(), y->GetImage()}}) {
