@@ -9,6 +9,8 @@
 // not with the body's distance from the origin, and an undeformed cage is reproduced exactly.
 #pragma once
 
+#include "repose/util/HugePageAllocator.h"
+
 #include <Eigen/Core>
 #include <cstdint>
 #include <iosfwd>
@@ -52,7 +54,7 @@ class CompactGreenMatrix {
  private:
   Eigen::Index rows_ = 0, cols_ = 0, vertexCols_ = 0, stride_ = 0;  // stride_: cols_ padded to 16
   Eigen::VectorXd rowScale_;  // each row is stored times its scale to stay inside half range
-  std::vector<std::uint16_t> high_, low_;
+  HugePageVector<std::uint16_t> high_, low_;  // hundreds of MB at the seed's sizes
 };
 
 }  // namespace repose

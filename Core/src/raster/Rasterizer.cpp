@@ -481,7 +481,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
       std::min<std::int64_t>(slabs, threads), threads,
       [&](std::int64_t, std::int64_t) {
         std::int64_t localWrites = 0, localShell = 0;
-        std::vector<std::uint8_t> covered;
+        HugePageVector<std::uint8_t> covered;  // tens of MB a slab of a full grid
         auto sink = workerOf(write);
         for (std::int64_t slab; !stop && (slab = nextSlab++) < slabs;) {
           const std::int64_t s0 = split * slab / slabs, s1 = split * (slab + 1) / slabs;
@@ -833,50 +833,82 @@ static std::vector<std::int32_t> pieceOwnerTets(const TransferMesh& mesh,
 }
 
 std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh) {
-  using Key = std::array<int, 3>;
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      return (std::size_t(k[0]) * 73856093u) ^ (std::size_t(k[1]) * 19349663u) ^
-             (std::size_t(k[2]) * 83492791u);
-    }
-  };
+  // Each face (t, f) by its vertices sorted (a < b < c), bucketed by a with a counting sort: a
+  // face two tets share meets its twin among the few dozen faces of a's bucket. (A hash map of
+  // all 4 x #tets faces had cost half a second of a 0.85 mm warp.)
   const Eigen::Index nt = mesh.tets.rows();
-  std::unordered_map<Key, int, KeyHash> uses;
-  uses.reserve(static_cast<std::size_t>(2 * nt + 16));
-  auto faceKey = [&](Eigen::Index t, int f) {
-    Key k;
+  struct Face {
+    int b, c;
+    std::int32_t t;
+    std::int32_t f;
+    bool operator<(const Face& o) const { return b != o.b ? b < o.b : c < o.c; }
+  };
+  auto sortedFace = [&](Eigen::Index t, int f) {
+    std::array<int, 3> k;
     for (int c = 0, n = 0; c < 4; ++c)
-      if (c != f) k[n++] = mesh.tets(t, c);
+      if (c != f) k[std::size_t(n++)] = mesh.tets(t, c);
     std::sort(k.begin(), k.end());
     return k;
   };
+  int largest = -1;
   for (Eigen::Index t = 0; t < nt; ++t)
-    for (int f = 0; f < 4; ++f) ++uses[faceKey(t, f)];
-  // Boundary faces, then drop those whose rest place another boundary face also occupies (cuts).
-  std::vector<std::uint8_t> outer(static_cast<std::size_t>(nt), 0);
-  std::map<std::array<double, 9>, int> places;
-  auto place = [&](const Key& k) {
-    std::array<std::array<double, 3>, 3> p;
-    for (int c = 0; c < 3; ++c)
-      for (int a = 0; a < 3; ++a) p[c][a] = mesh.vertices(k[c], a);
-    std::sort(p.begin(), p.end());
-    std::array<double, 9> flat;
-    for (int c = 0; c < 3; ++c)
-      for (int a = 0; a < 3; ++a) flat[3 * c + a] = p[c][a];
-    return flat;
-  };
-  for (Eigen::Index t = 0; t < nt; ++t)
-    for (int f = 0; f < 4; ++f) {
-      const Key k = faceKey(t, f);
-      if (uses[k] == 1) {
-        outer[t] |= std::uint8_t(1u << f);
-        ++places[place(k)];
-      }
+    for (int c = 0; c < 4; ++c) {
+      if (mesh.tets(t, c) < 0)
+        throw Error("outer faces: tet " + std::to_string(t) + " has a negative vertex index");
+      largest = std::max(largest, mesh.tets(t, c));
     }
+  std::vector<std::int64_t> first(std::size_t(largest) + 2, 0);
   for (Eigen::Index t = 0; t < nt; ++t)
-    for (int f = 0; f < 4; ++f)
-      if ((outer[t] & (1u << f)) && places[place(faceKey(t, f))] > 1)
-        outer[t] &= std::uint8_t(~(1u << f));
+    for (int f = 0; f < 4; ++f) ++first[std::size_t(sortedFace(t, f)[0]) + 1];
+  for (std::size_t a = 1; a < first.size(); ++a) first[a] += first[a - 1];
+  std::vector<Face> faces(std::size_t(4 * nt));
+  {
+    std::vector<std::int64_t> next(first.begin(), first.end() - 1);
+    for (Eigen::Index t = 0; t < nt; ++t)
+      for (int f = 0; f < 4; ++f) {
+        const std::array<int, 3> k = sortedFace(t, f);
+        faces[std::size_t(next[std::size_t(k[0])]++)] = Face{k[1], k[2], std::int32_t(t), f};
+      }
+  }
+  // Boundary faces (used once), with where they lie at rest: a face whose rest place another
+  // boundary face also occupies is a cut (two sides of a separation), not the body's surface.
+  std::vector<std::uint8_t> outer(static_cast<std::size_t>(nt), 0);
+  struct Place {
+    std::array<double, 9> corners;  // the three vertices' rest positions, sorted
+    std::int32_t t, f;
+    bool operator<(const Place& o) const { return corners < o.corners; }
+  };
+  std::vector<Place> places;
+  for (std::size_t a = 0; a + 1 < first.size(); ++a) {
+    const auto begin = faces.begin() + first[a], end = faces.begin() + first[a + 1];
+    std::sort(begin, end);
+    for (auto run = begin; run != end;) {
+      auto last = run + 1;
+      while (last != end && last->b == run->b && last->c == run->c) ++last;
+      if (last - run == 1) {
+        outer[std::size_t(run->t)] |= std::uint8_t(1u << run->f);
+        std::array<std::array<double, 3>, 3> p;
+        const int v[3] = {int(a), run->b, run->c};
+        for (int c = 0; c < 3; ++c)
+          for (int x = 0; x < 3; ++x) p[std::size_t(c)][std::size_t(x)] = mesh.vertices(v[c], x);
+        std::sort(p.begin(), p.end());
+        Place place{{}, run->t, run->f};
+        for (int c = 0; c < 3; ++c)
+          for (int x = 0; x < 3; ++x) place.corners[std::size_t(3 * c + x)] = p[c][x];
+        places.push_back(place);
+      }
+      run = last;
+    }
+  }
+  std::sort(places.begin(), places.end());
+  for (std::size_t i = 0; i < places.size();) {
+    std::size_t j = i + 1;
+    while (j < places.size() && places[j].corners == places[i].corners) ++j;
+    if (j - i > 1)
+      for (std::size_t m = i; m < j; ++m)
+        outer[std::size_t(places[m].t)] &= std::uint8_t(~(1u << places[m].f));
+    i = j;
+  }
   return outer;
 }
 

@@ -1,6 +1,8 @@
 // Per-label voxel counts: one pass per layer with a dense histogram for small integer types.
 #include "repose/volume/LabelStatistics.h"
 
+#include "repose/util/Parallel.h"
+
 #include <map>
 #include <vector>
 
@@ -18,12 +20,33 @@ std::vector<LabelCount> countLabels(const Volume& volume) {
       const T* v = volume.data<T>(layer);
       const std::int64_t n = volume.numVoxels();
       if constexpr (sizeof(T) <= 2) {
-        // Dense histogram: labels of 8/16-bit maps index directly.
-        std::vector<std::int64_t> hist(1 << (8 * sizeof(T)), 0);
-        for (std::int64_t i = 0; i < n; ++i)
-          ++hist[static_cast<std::size_t>(static_cast<std::make_unsigned_t<T>>(v[i]))];
-        for (std::size_t b = 0; b < hist.size(); ++b)
-          if (hist[b]) counts[static_cast<int>(static_cast<T>(b))] += hist[b];
+        // Dense histograms: labels of 8/16-bit maps index directly. Over all cores for a large
+        // map (a posing job counts its input and output, 600M voxels at 0.85 mm), and for 8-bit
+        // maps four histograms a thread, one per voxel of each group of four, since a run of one
+        // label (most of a map) otherwise makes each increment wait for the one before.
+        using U = std::make_unsigned_t<T>;
+        constexpr std::size_t kBins = std::size_t(1) << (8 * sizeof(T));
+        constexpr std::int64_t kWays = sizeof(T) == 1 ? 4 : 1;
+        const int parts = n >= (std::int64_t(1) << 22) ? resolveThreads(0) : 1;
+        std::vector<std::vector<std::int64_t>> hists(static_cast<std::size_t>(parts));
+        parallelFor(
+            parts, parts,
+            [&](std::int64_t pb, std::int64_t pe) {
+              for (std::int64_t part = pb; part < pe; ++part) {
+                std::vector<std::int64_t>& h = hists[static_cast<std::size_t>(part)];
+                h.assign(kBins * kWays, 0);
+                const std::int64_t begin = n * part / parts, end = n * (part + 1) / parts;
+                std::int64_t i = begin;
+                for (; i + kWays <= end; i += kWays)
+                  for (std::int64_t w = 0; w < kWays; ++w)
+                    ++h[std::size_t(w) * kBins + static_cast<U>(v[i + w])];
+                for (; i < end; ++i) ++h[static_cast<U>(v[i])];
+              }
+            },
+            1);
+        for (const std::vector<std::int64_t>& h : hists)
+          for (std::size_t b = 0; b < h.size(); ++b)
+            if (h[b]) counts[static_cast<int>(static_cast<T>(b % kBins))] += h[b];
       } else {
         for (std::int64_t i = 0; i < n; ++i) ++counts[static_cast<int>(v[i])];
       }

@@ -17,6 +17,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <map>
+#include <numeric>
 #include <random>
 
 using namespace repose;
@@ -437,6 +439,62 @@ TEST(Rasterizer, ShellCoversVoxelsJustOutsideTheOuterFacesOnly) {
   int cutCount = 0;
   for (std::uint8_t m : cutOuter) cutCount += __builtin_popcount(m);
   EXPECT_EQ(cutCount, 2 * 2 * (7 * 5 + 7 * 4 + 5 * 4));
+}
+
+// outerFaces against the definition, written plainly (a map of every face's sorted vertices, a
+// map of every boundary face's rest place): a face is outer when one tet has it and no other
+// boundary face lies where it does. On the phantom's transfer mesh, on a box whose tets and
+// vertex numbers are shuffled, and on two boxes separated by a cut.
+TEST(Rasterizer, OuterFacesAreTheFacesOfOneTetAwayFromCuts) {
+  auto reference = [](const TransferMesh& m) {
+    std::map<std::array<int, 3>, int> uses;
+    auto key = [&](Eigen::Index t, int f) {
+      std::array<int, 3> k;
+      for (int c = 0, n = 0; c < 4; ++c)
+        if (c != f) k[std::size_t(n++)] = m.tets(t, c);
+      std::sort(k.begin(), k.end());
+      return k;
+    };
+    auto place = [&](const std::array<int, 3>& k) {
+      std::vector<std::array<double, 3>> p;
+      for (const int v : k) p.push_back({m.vertices(v, 0), m.vertices(v, 1), m.vertices(v, 2)});
+      std::sort(p.begin(), p.end());
+      return p;
+    };
+    for (Eigen::Index t = 0; t < m.tets.rows(); ++t)
+      for (int f = 0; f < 4; ++f) ++uses[key(t, f)];
+    std::map<std::vector<std::array<double, 3>>, int> places;
+    for (const auto& [k, n] : uses)
+      if (n == 1) ++places[place(k)];
+    std::vector<std::uint8_t> out(std::size_t(m.tets.rows()), 0);
+    for (Eigen::Index t = 0; t < m.tets.rows(); ++t)
+      for (int f = 0; f < 4; ++f)
+        if (uses[key(t, f)] == 1 && places[place(key(t, f))] == 1)
+          out[std::size_t(t)] |= std::uint8_t(1u << f);
+    return out;
+  };
+  const TransferMesh& phantomMesh = phantomScene().mesh;
+  EXPECT_EQ(outerFaces(phantomMesh), reference(phantomMesh));
+  TransferMesh shuffled = tetBox({0, 0, 0}, {5, 4, 3}, {5, 4, 3});
+  std::mt19937 random(7);
+  std::vector<int> renumber(std::size_t(shuffled.vertices.rows()));
+  std::iota(renumber.begin(), renumber.end(), 0);
+  std::shuffle(renumber.begin(), renumber.end(), random);
+  Eigen::MatrixX3d vertices(shuffled.vertices.rows(), 3);
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v)
+    vertices.row(renumber[std::size_t(v)]) = shuffled.vertices.row(v);
+  shuffled.vertices = vertices;
+  std::vector<Eigen::Index> order(std::size_t(shuffled.tets.rows()));
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), random);
+  Eigen::MatrixX4i tets(shuffled.tets.rows(), 4);
+  for (Eigen::Index t = 0; t < tets.rows(); ++t)
+    for (int c = 0; c < 4; ++c)
+      tets(t, c) = renumber[std::size_t(shuffled.tets(order[std::size_t(t)], c))];
+  shuffled.tets = tets;
+  EXPECT_EQ(outerFaces(shuffled), reference(shuffled));
+  const TransferMesh cut = concatenate(alignedBox(), tetBox({14, 2, 2}, {16, 12, 10}, {1, 5, 4}));
+  EXPECT_EQ(outerFaces(cut), reference(cut));
 }
 
 // A live slice is the rasterizer on a one-voxel-thick grid: on the full output's own voxel

@@ -2,6 +2,7 @@
 // (IJK -> RAS), scalar type, optional layers (overlapping Slicer segmentations) and label table.
 #pragma once
 
+#include "repose/util/HugePageAllocator.h"
 #include "repose/volume/LabelTable.h"
 #include "repose/volume/ScalarType.h"
 #include "repose/volume/VolumeGeometry.h"
@@ -48,7 +49,7 @@ class Volume {
   }
   double valueAsDouble(std::int64_t index, int layer = 0) const;
   std::size_t byteSize() const { return bytes_.size(); }
-  const std::vector<std::uint8_t>& bytes() const { return bytes_; }
+  const HugePageVector<std::uint8_t>& bytes() const { return bytes_; }
 
  private:
   template <class T>
@@ -58,7 +59,9 @@ class Volume {
   int layers_ = 1;
   bool labelMap_ = false;
   LabelTable labels_;
-  std::vector<std::uint8_t> bytes_;  // layers stored one after the other
+  // Layers stored one after the other; in huge pages (HugePageAllocator.h: a volume is written
+  // whole soon after it is made, and 4 KiB pages cost a fault each).
+  HugePageVector<std::uint8_t> bytes_;
 };
 
 }  // namespace repose
