@@ -86,6 +86,11 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   vtkMRMLReposeSegmentationNode* AddSegmentation(const std::string& labelsPath,
                                                  const std::string& partsPath = "",
                                                  const std::string& imagePath = "");
+  // Whether `seg` holds what these paths hold now: it was read from them (AddSegmentation, or a
+  // scene opened from its folder) and none has changed since. The panel then builds on it again
+  // instead of reading G, S and the image anew into one more node.
+  bool IsSegmentationOf(vtkMRMLReposeSegmentationNode* seg, const std::string& labelsPath,
+                        const std::string& partsPath, const std::string& imagePath) const;
   // Reads and validates a pose file into a new pose node (null and a message on failure).
   vtkMRMLReposePoseNode* AddPose(const std::string& path);
   // What a panel shows of a pose node, parsed once per change of the node: the groups a user can

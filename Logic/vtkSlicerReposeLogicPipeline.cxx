@@ -117,6 +117,8 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
                                                                      const std::string& image) {
   return this->Guarded<vtkMRMLReposeSegmentationNode*>(
       nullptr, [&]() -> vtkMRMLReposeSegmentationNode* {
+        // Stamped before reading: a file changed during the read is read again next time.
+        const std::string stamp = vtkSlicerReposeLogicRead::FilesStamp({labels, parts, image});
         std::vector<std::string> readNotes;
         repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels, &readNotes);
         if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
@@ -126,6 +128,7 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
         node->SetName(stemOf(labels));
         node->SetLabelMap(Conversion::ToImageData(G));
         node->SetLabelMapReadNotes(readNotes);
+        node->SetSourceStamp(stamp);
         for (const auto& [path, setter] :
              {std::pair{parts, &vtkMRMLReposeSegmentationNode::SetBodyPartMap},
               std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
@@ -145,6 +148,13 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
         this->Scene->AddNode(node);
         return node;
       });
+}
+
+bool vtkSlicerReposeLogic::IsSegmentationOf(vtkMRMLReposeSegmentationNode* seg,
+                                            const std::string& labels, const std::string& parts,
+                                            const std::string& image) const {
+  if (!seg || seg->GetSourceStamp().empty()) return false;
+  return seg->GetSourceStamp() == vtkSlicerReposeLogicRead::FilesStamp({labels, parts, image});
 }
 
 vtkMRMLReposePoseNode* vtkSlicerReposeLogic::AddPose(const std::string& path) {

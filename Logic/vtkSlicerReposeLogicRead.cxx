@@ -5,6 +5,8 @@
 #include <repose/util/Error.h>
 #include <repose/util/Memory.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -40,6 +42,39 @@ std::string ReadText(const std::string& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+std::string FilesStamp(const std::vector<std::string>& paths) {
+  namespace fs = std::filesystem;
+  std::string stamp;
+  for (const std::string& path : paths) {
+    stamp += path;
+    if (!path.empty()) {
+      std::error_code ec;
+      const fs::file_status status = fs::status(path, ec);
+      if (ec || !fs::exists(status)) return "";
+      // Size and time of a file; of a folder, the count, total size and latest time of its files,
+      // so a series re-exported into the same folder is a different stamp.
+      std::uintmax_t files = 0, bytes = 0;
+      fs::file_time_type latest = fs::file_time_type::min();
+      auto add = [&](const fs::path& file) {
+        const std::uintmax_t size = fs::file_size(file, ec);
+        const fs::file_time_type time = fs::last_write_time(file, ec);
+        if (ec) return;
+        ++files, bytes += size, latest = std::max(latest, time);
+      };
+      if (fs::is_directory(status)) {
+        for (fs::recursive_directory_iterator it(path, ec), end; !ec && it != end; it.increment(ec))
+          if (it->is_regular_file(ec)) add(it->path());
+      } else {
+        add(path);
+      }
+      stamp += "\t" + std::to_string(files) + "\t" + std::to_string(bytes) + "\t" +
+               std::to_string(latest.time_since_epoch().count());
+    }
+    stamp += "\n";
+  }
+  return stamp;
 }
 
 }  // namespace vtkSlicerReposeLogicRead

@@ -25,6 +25,10 @@ std::string NameLabels(repose::Volume& labels, const std::string& tissuesPath,
                        const std::vector<repose::LabelCount>* counts = nullptr);
 // A small text file (a pose, a skeleton, scene.json) whole; repose::Error "path: cannot open".
 std::string ReadText(const std::string& path);
+// Which files `paths` are now, to tell later whether a read of them is still current: each path
+// with its size and modification time (a folder, such as a DICOM series: of every file in it).
+// "" when a non-empty path does not exist; empty paths stand for themselves.
+std::string FilesStamp(const std::vector<std::string>& paths);
 
 }  // namespace vtkSlicerReposeLogicRead
 

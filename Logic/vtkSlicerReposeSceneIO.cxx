@@ -129,6 +129,13 @@ vtkSmartPointer<vtkMRMLReposeScene> Load(const std::string& folder) {
   for (int n = 0; n < loaded->GetNumberOfNodes(); ++n) {
     vtkMRMLReposeNode* node = loaded->GetNthNode(n);
     if (auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(node)) {
+      // The paths as OpenScene gives them to the panel, so building the rig reads nothing again.
+      auto inFolder = [&](const std::string& name) {
+        return name.empty() ? name : (dir / name).string();
+      };
+      seg->SetSourceStamp(vtkSlicerReposeLogicRead::FilesStamp(
+          {inFolder(seg->GetLabelMapFileName()), inFolder(seg->GetBodyPartMapFileName()),
+           inFolder(seg->GetImageFileName())}));
       std::vector<std::string> readNotes;
       seg->SetLabelMap(Conversion::ToImageData(
           vtkSlicerReposeLogicRead::ReadVolume(need(seg->GetLabelMapFileName(), seg), &readNotes)));

@@ -65,6 +65,7 @@ void vtkMRMLReposeSegmentationNode::CopyContent(vtkMRMLReposeNode* other) {
   this->SetImageFileName(o->ImageFileName);
   this->SetSkeletonJSON(o->SkeletonJSON);
   this->SetLabelMapReadNotes(o->LabelMapReadNotes);
+  this->SetSourceStamp(o->SourceStamp);
   this->SetLabelMap(copyOf(o->LabelMap));
   this->SetBodyPartMap(copyOf(o->BodyPartMap));
   this->SetImage(copyOf(o->Image));

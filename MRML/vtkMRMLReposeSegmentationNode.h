@@ -52,6 +52,13 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
     this->SetField(this->LabelMapReadNotes, notes);
   }
 
+  // Which files this node's images were read from, as they were then (the Logic's FilesStamp of
+  // G, S and the image): the panel builds the rig on this node again while its paths still
+  // stamp the same, instead of reading them anew. Not written to the scene: an opened scene's
+  // node is stamped with its own files.
+  const std::string& GetSourceStamp() const { return this->SourceStamp; }
+  void SetSourceStamp(const std::string& stamp) { this->SetField(this->SourceStamp, stamp); }
+
  protected:
   vtkMRMLReposeSegmentationNode() = default;
   void WriteFields(nlohmann::ordered_json& json) const override;
@@ -60,6 +67,6 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
 
  private:
   vtkSmartPointer<vtkImageData> LabelMap, BodyPartMap, Image;
-  std::string LabelMapFileName, BodyPartMapFileName, ImageFileName, SkeletonJSON;
+  std::string LabelMapFileName, BodyPartMapFileName, ImageFileName, SkeletonJSON, SourceStamp;
   std::vector<std::string> LabelMapReadNotes;
 };

@@ -365,12 +365,14 @@ bool qSlicerReposeModuleWidget::buildRig() {
     pose = this->activePose();
     if (!pose) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
   }
-  // The segmentation node of the current paths (made again when a path changed).
+  // The segmentation node of the current paths, read again only when a path or its file changed.
+  // (The node's file names are those of a saved scene's folder, so they could not tell this:
+  // every build had read G, S and the image into one more node.)
   auto* seg = vtkMRMLReposeSegmentationNode::SafeDownCast(
       d->Logic->GetScene()->GetNodeByID(d->ParameterNode->GetInputSegmentationNodeID()));
-  if (!seg || seg->GetLabelMapFileName() != d->ParameterNode->GetInputSegmentationPath() ||
-      seg->GetBodyPartMapFileName() != d->ParameterNode->GetBodyPartMapPath() ||
-      seg->GetImageFileName() != d->ParameterNode->GetImagePath()) {
+  if (!d->Logic->IsSegmentationOf(seg, d->ParameterNode->GetInputSegmentationPath(),
+                                  d->ParameterNode->GetBodyPartMapPath(),
+                                  d->ParameterNode->GetImagePath())) {
     seg = d->Logic->AddSegmentation(d->ParameterNode->GetInputSegmentationPath(),
                                     d->ParameterNode->GetBodyPartMapPath(),
                                     d->ParameterNode->GetImagePath());

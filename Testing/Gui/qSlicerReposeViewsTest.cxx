@@ -12,6 +12,7 @@
 #include "qSlicerReposeVolumeChangePlot.h"
 #include "vtkMRMLReposeParametersNode.h"
 #include "vtkMRMLReposePoseNode.h"
+#include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeLogic.h"
 #include "vtkSlicerReposeVolumeConversion.h"
@@ -636,6 +637,11 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
     QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    // Built again on the same files: the same segmentation node, G not read into another one.
+    int inputs = 0;
+    for (vtkMRMLReposeNode* n : logic->GetScene()->GetNodesByClass("vtkMRMLReposeSegmentationNode"))
+      inputs += logic->GetScene()->GetReferencedNode(n, "source") == nullptr;
+    QCOMPARE(inputs, 1);
     QVERIFY2((shownAt("wrist_left") - wristBefore).norm() < 1e-6,
              qPrintable(QString::number((shownAt("wrist_left") - wristBefore).norm())));
   }

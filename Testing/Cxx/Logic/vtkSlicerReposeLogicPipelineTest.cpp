@@ -9,6 +9,7 @@
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeLogicRead.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
 #include "CommandRunner.h"
@@ -425,6 +426,75 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportsReportKeepsWhatTheReaderSaidAboutG) 
   ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
       << opened->GetLastErrorMessage();
   EXPECT_TRUE(notesOf(reposed + "/report.json").empty());
+}
+
+// A segmentation node knows the files it was read from as they were then, so the panel builds
+// the rig on it again instead of reading G, S and the image anew into one more node; a path
+// changed, or a file rewritten, is read again; an opened scene's node is of its own files, with
+// the paths OpenScene gives the panel.
+TEST(vtkSlicerReposeLogicPipeline, ASegmentationIsOfTheFilesItWasReadFromUntilOneChanges) {
+  namespace fs = std::filesystem;
+  PhantomFiles files;
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> parameters;
+  logic->SetParameterNode(parameters);
+  auto* seg = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(logic->IsSegmentationOf(seg, files.G, files.S, ""));
+  EXPECT_FALSE(logic->IsSegmentationOf(seg, files.G, "", ""));
+  EXPECT_FALSE(logic->IsSegmentationOf(seg, files.S, files.S, ""));
+  EXPECT_FALSE(logic->IsSegmentationOf(seg, files.G, files.S, files.G));
+  EXPECT_FALSE(logic->IsSegmentationOf(nullptr, files.G, files.S, ""));
+  EXPECT_FALSE(logic->IsSegmentationOf(seg, files.G, files.dir.file("gone.nii.gz"), ""));
+  // A copy of the node is of the same files.
+  vtkNew<vtkMRMLReposeSegmentationNode> copy;
+  copy->Copy(seg);
+  EXPECT_TRUE(logic->IsSegmentationOf(copy, files.G, files.S, ""));
+
+  // G rewritten (re-exported from Slicer, say) with the same bytes but a later time: read again.
+  const fs::file_time_type before = fs::last_write_time(files.G);
+  fs::last_write_time(files.G, before + std::chrono::seconds(2));
+  EXPECT_FALSE(logic->IsSegmentationOf(seg, files.G, files.S, ""));
+  fs::last_write_time(files.G, before);
+  EXPECT_TRUE(logic->IsSegmentationOf(seg, files.G, files.S, ""));
+  // A file of another size at the same time: read again too.
+  {
+    std::ofstream grow(files.S, std::ios::app | std::ios::binary);
+    grow << '\0';
+  }
+  EXPECT_FALSE(logic->IsSegmentationOf(seg, files.G, files.S, ""));
+
+  // A folder (a DICOM series): a file added to it changes its stamp.
+  const std::string series = files.dir.file("series");
+  fs::create_directories(series);
+  std::ofstream(series + "/1.dcm") << "a";
+  const std::string one = vtkSlicerReposeLogicRead::FilesStamp({series});
+  EXPECT_FALSE(one.empty());
+  EXPECT_EQ(one, vtkSlicerReposeLogicRead::FilesStamp({series}));
+  std::ofstream(series + "/2.dcm") << "b";
+  EXPECT_NE(one, vtkSlicerReposeLogicRead::FilesStamp({series}));
+  EXPECT_EQ(vtkSlicerReposeLogicRead::FilesStamp({series + "/none"}), "");
+
+  // Saved and opened: the opened node is of the scene folder's own files, as OpenScene puts
+  // them in the parameter node, so a build there reads nothing again.
+  auto* fresh = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(fresh) << logic->GetLastErrorMessage();
+  logic->GetScene()->RemoveNode(seg);
+  const std::string saved = files.dir.file("saved");
+  ASSERT_TRUE(logic->SaveScene(saved)) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(logic->IsSegmentationOf(fresh, files.G, files.S, ""))
+      << "saving does not change what the node was read from";
+  vtkNew<vtkSlicerReposeLogic> opened;
+  vtkNew<vtkMRMLReposeParametersNode> openedParameters;
+  opened->SetParameterNode(openedParameters);
+  ASSERT_TRUE(opened->OpenScene(saved)) << opened->GetLastErrorMessage();
+  auto* openedSeg = vtkMRMLReposeSegmentationNode::SafeDownCast(
+      opened->GetScene()->GetNodeByID(openedParameters->GetInputSegmentationNodeID()));
+  ASSERT_TRUE(openedSeg);
+  EXPECT_TRUE(opened->IsSegmentationOf(openedSeg, openedParameters->GetInputSegmentationPath(),
+                                       openedParameters->GetBodyPartMapPath(),
+                                       openedParameters->GetImagePath()));
+  EXPECT_FALSE(opened->IsSegmentationOf(openedSeg, files.G, files.S, ""));
 }
 
 TEST(vtkSlicerReposeLogicPipeline, RigFromOrganMapWritesTheRigAndNamesTheLabels) {

@@ -63,6 +63,7 @@ std::vector<NodeCase> cases() {
          s->SetBodyPartMap(image(2));
          s->SetImage(image(100));
          s->SetLabelMapReadNotes({"G.dcm: a note of its reader"});
+         s->SetSourceStamp("/data/G.dcm\t1\t4096\t17\n\n\n");
        },
        [](vtkMRMLReposeNode* a, vtkMRMLReposeNode* b) {
          auto *x = vtkMRMLReposeSegmentationNode::SafeDownCast(a),
@@ -70,6 +71,9 @@ std::vector<NodeCase> cases() {
          // The reader's notes are copied, and not written (a scene's G is read again).
          EXPECT_EQ(y->GetLabelMapReadNotes(), x->GetLabelMapReadNotes());
          EXPECT_EQ(x->ToJSON().dump().find("a note of its reader"), std::string::npos);
+         // So is the stamp of the files it was read from (an opened scene's are its own).
+         EXPECT_EQ(y->GetSourceStamp(), x->GetSourceStamp());
+         EXPECT_EQ(x->ToJSON().dump().find("/data/G.dcm"), std::string::npos);
          for (auto [p, q] : {std::pair{x->GetLabelMap(), y->GetLabelMap()},
                              std::pair{x->GetBodyPartMap(), y->GetBodyPartMap()},
                              std::pair{x->GetImage(), y->GetImage()}}) {
