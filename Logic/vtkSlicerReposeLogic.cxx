@@ -78,12 +78,16 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
   this->VolumeLabelNames.clear();
   this->VolumeLabelNote.clear();
   this->VolumeReadNotes.clear();
+  this->VolumeStamp.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath = path;  // before the node is told, so its Modified does not reload
   this->LastErrorMessage.clear();
   try {
     if (path.empty()) throw repose::Error("no input file given");
     std::vector<std::string> readNotes;
+    // Before reading: a file changed during the read does not match it afterwards.
+    const std::string stamp =
+        held ? std::string() : vtkSlicerReposeLogicRead::FilesStamp({path, this->TissueTablePath});
     repose::Volume volume = held ? vtkSlicerReposeVolumeConversion::FromImageData(held)
                                  : vtkSlicerReposeLogicRead::ReadVolume(path, &readNotes);
     for (const repose::Label& l : volume.labels().labels())
@@ -108,6 +112,7 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
     }
     this->VolumeLookupTable =
         vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels(), 0, present);
+    if (volume.isLabelMap()) this->VolumeStamp = stamp;
   } catch (const repose::Error& e) {
     this->LastErrorMessage = oneLine(e.what());
   } catch (const std::bad_alloc&) {
@@ -115,7 +120,7 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
   } catch (const std::exception& e) {
     this->LastErrorMessage = oneLine(path + ": " + e.what());
   }
-  if (!this->LastErrorMessage.empty()) this->VolumeImageData = nullptr;
+  if (!this->LastErrorMessage.empty()) this->VolumeImageData = nullptr, this->VolumeStamp.clear();
   if (this->ParameterNode) this->ParameterNode->SetInputSegmentationPath(path);
   this->Modified();
   return this->LastErrorMessage.empty();
@@ -128,6 +133,7 @@ void vtkSlicerReposeLogic::ClearVolume() {
   this->VolumeLabelNames.clear();
   this->VolumeLabelNote.clear();
   this->VolumeReadNotes.clear();
+  this->VolumeStamp.clear();
   this->VolumeLabelsPresent = -1;
   this->VolumePath.clear();
   this->LastErrorMessage.clear();

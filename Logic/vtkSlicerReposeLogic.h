@@ -402,6 +402,10 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLogic : public vtkObj
   std::string LastRigSummary;
   std::string VolumeLabelNote;  // where the labels' names came from, when not from the file
   std::vector<std::string> VolumeReadNotes;  // what the reader decided (ReadOptions::note)
+  // FilesStamp of VolumePath and the tissue table when VolumeImageData is a label map read from
+  // that file ("" otherwise): AddSegmentation of the same, unchanged file shares the image
+  // instead of reading it again.
+  std::string VolumeStamp;
   std::string LastRefinementSummary;
   std::vector<int> RefinementVertices;
   std::vector<double> RefinementErrors;

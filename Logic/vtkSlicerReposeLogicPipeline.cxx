@@ -31,7 +31,9 @@
 #include <repose/util/Error.h>
 
 #include <nlohmann/json.hpp>
+#include <vtkMatrix4x4.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -120,13 +122,34 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
         // Stamped before reading: a file changed during the read is read again next time.
         const std::string stamp = vtkSlicerReposeLogicRead::FilesStamp({labels, parts, image});
         std::vector<std::string> readNotes;
-        repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels, &readNotes);
-        if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
-        // Names and colours the file left out, so the views and the probe tell labels apart.
-        vtkSlicerReposeLogicRead::NameLabels(G, this->TissueTablePath, labels);
+        vtkSmartPointer<vtkImageData> labelMap;
+        std::array<int, 3> dims{0, 0, 0};
+        Eigen::Matrix4d ijkToRas = Eigen::Matrix4d::Identity();
+        if (!labels.empty() && labels == this->VolumePath && this->VolumeImageData &&
+            !this->VolumeStamp.empty() &&
+            this->VolumeStamp ==
+                vtkSlicerReposeLogicRead::FilesStamp({labels, this->TissueTablePath})) {
+          // The file the input box shows, unchanged since, its labels named from the same table:
+          // that image is G as the read below would make it, so the node shares it (as the box
+          // shares an opened scene's) instead of reading and holding G a second time.
+          labelMap = this->VolumeImageData;
+          readNotes = this->VolumeReadNotes;
+          labelMap->GetDimensions(dims.data());
+          for (int r = 0; r < 4; ++r)
+            for (int c = 0; c < 4; ++c)
+              ijkToRas(r, c) = this->VolumeIJKToRASMatrix->GetElement(r, c);
+        } else {
+          repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels, &readNotes);
+          if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
+          // Names and colours the file left out, so the views and the probe tell labels apart.
+          vtkSlicerReposeLogicRead::NameLabels(G, this->TissueTablePath, labels);
+          labelMap = Conversion::ToImageData(G);
+          for (int a = 0; a < 3; ++a) dims[std::size_t(a)] = int(G.dims()[std::size_t(a)]);
+          ijkToRas = G.geometry().ijkToRas;
+        }
         auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
         node->SetName(stemOf(labels));
-        node->SetLabelMap(Conversion::ToImageData(G));
+        node->SetLabelMap(labelMap);
         node->SetLabelMapReadNotes(readNotes);
         node->SetSourceStamp(stamp);
         for (const auto& [path, setter] :
@@ -134,7 +157,8 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
               std::pair{image, &vtkMRMLReposeSegmentationNode::SetImage}}) {
           if (path.empty()) continue;
           repose::Volume v = vtkSlicerReposeLogicRead::ReadVolume(path);
-          if (v.dims() != G.dims() || !v.geometry().ijkToRas.isApprox(G.geometry().ijkToRas, 1e-6))
+          if (v.dims()[0] != dims[0] || v.dims()[1] != dims[1] || v.dims()[2] != dims[2] ||
+              !v.geometry().ijkToRas.isApprox(ijkToRas, 1e-6))
             throw repose::Error(path + ": not on the grid of " + labels);
           // An S without part names (a NIfTI `repose rig` wrote, then converted) gets the rig's
           // names, so the panel's part list is not empty.

@@ -497,6 +497,67 @@ TEST(vtkSlicerReposeLogicPipeline, ASegmentationIsOfTheFilesItWasReadFromUntilOn
   EXPECT_FALSE(opened->IsSegmentationOf(openedSeg, files.G, files.S, ""));
 }
 
+// The panel shows G in its input box, then builds on a segmentation of the same file: the node
+// shares the box's image instead of reading G again, with the same voxels and names a read gives;
+// once the file is rewritten, or the tissue table that names the labels changes, it is read.
+TEST(vtkSlicerReposeLogicPipeline, ASegmentationOfTheFileTheInputBoxShowsSharesItsImage) {
+  namespace fs = std::filesystem;
+  PhantomFiles files;
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> parameters;
+  logic->SetParameterNode(parameters);
+  ASSERT_TRUE(logic->LoadVolume(files.G)) << logic->GetLastErrorMessage();
+  auto* shared = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(shared) << logic->GetLastErrorMessage();
+  EXPECT_EQ(shared->GetLabelMap(), logic->GetVolumeImageData());
+  EXPECT_TRUE(logic->IsSegmentationOf(shared, files.G, files.S, ""));
+
+  // What a read gives: another logic that never showed the file.
+  vtkNew<vtkSlicerReposeLogic> reader;
+  vtkNew<vtkMRMLReposeParametersNode> readerParameters;
+  reader->SetParameterNode(readerParameters);
+  auto* read = reader->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(read);
+  EXPECT_TRUE(sameVoxels(shared->GetLabelMap(), read->GetLabelMap()));
+  const repose::Volume a = vtkSlicerReposeVolumeConversion::FromImageData(shared->GetLabelMap());
+  const repose::Volume b = vtkSlicerReposeVolumeConversion::FromImageData(read->GetLabelMap());
+  EXPECT_TRUE(a.geometry().ijkToRas.isApprox(b.geometry().ijkToRas, 1e-12));
+  ASSERT_EQ(a.labels().labels().size(), b.labels().labels().size());
+  for (std::size_t i = 0; i < a.labels().labels().size(); ++i)
+    EXPECT_EQ(a.labels().labels()[i].name, b.labels().labels()[i].name);
+  // S on another grid is still refused against the shared G's grid.
+  const std::string coarse = files.dir.file("S_coarse.nii.gz");
+  {
+    repose::Volume S = repose::readVolume(files.S);
+    repose::VolumeGeometry g = S.geometry();
+    g.ijkToRas(0, 3) += 1.0;
+    repose::Volume moved(g, S.scalarType());
+    repose::writeVolume(moved, coarse);
+  }
+  EXPECT_FALSE(logic->AddSegmentation(files.G, coarse));
+  EXPECT_NE(logic->GetLastErrorMessage().find("not on the grid of"), std::string::npos)
+      << logic->GetLastErrorMessage();
+
+  // G rewritten since the box read it: read again, not shared.
+  fs::last_write_time(files.G, fs::last_write_time(files.G) + std::chrono::seconds(2));
+  auto* reread = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(reread) << logic->GetLastErrorMessage();
+  EXPECT_NE(reread->GetLabelMap(), logic->GetVolumeImageData());
+  EXPECT_TRUE(sameVoxels(reread->GetLabelMap(), read->GetLabelMap()));
+
+  // Shown again, then a tissue table set (it names the labels): read again too.
+  ASSERT_TRUE(logic->LoadVolume(files.G)) << logic->GetLastErrorMessage();
+  auto* again = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->GetLabelMap(), logic->GetVolumeImageData());
+  const std::string tissues = files.dir.file("tissues.csv");
+  repose::writeTextFileAtomically(tissues, "label,name,density,rigid,bone\n1,skin,1100,0,0\n");
+  logic->SetTissueTablePath(tissues);
+  auto* named = logic->AddSegmentation(files.G, files.S);
+  ASSERT_TRUE(named) << logic->GetLastErrorMessage();
+  EXPECT_NE(named->GetLabelMap(), logic->GetVolumeImageData());
+}
+
 TEST(vtkSlicerReposeLogicPipeline, RigFromOrganMapWritesTheRigAndNamesTheLabels) {
   ScratchDir dir("organrig");
   repose::PhantomOptions po;
