@@ -457,7 +457,7 @@ TEST(vtkSlicerReposeLogicPipeline, ASegmentationIsOfTheFilesItWasReadFromUntilOn
   EXPECT_FALSE(logic->IsSegmentationOf(seg, files.G, files.S, ""));
   fs::last_write_time(files.G, before);
   EXPECT_TRUE(logic->IsSegmentationOf(seg, files.G, files.S, ""));
-  // A file of another size at the same time: read again too.
+  // A file that grew (another size): read again too.
   {
     std::ofstream grow(files.S, std::ios::app | std::ios::binary);
     grow << '\0';
