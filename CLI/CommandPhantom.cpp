@@ -72,6 +72,10 @@ int runPhantom(const Args& args) {
             "real anatomy's contacts and scales: arms against the trunk along their length, hands "
             "on the thighs, thighs touching; long bones as cortical shells around marrow, blood "
             "vessels of a few mm")
+      .option("gap-mm", "HAND[,FOREARM]",
+              "with --arms-resting, the near contacts of real reference phantoms: each hand HAND "
+              "mm off its thigh (a voxel or three) and each forearm FOREARM mm off the trunk and "
+              "hip (default 15); the gaps stay air")
       .option("labels", "NAME",
               "phantom (its own labels, named in the file) or icrp110 (ICRP 110 organ IDs on "
               "ICRP's array order, no label table: a converted reference phantom)",
@@ -95,6 +99,19 @@ int runPhantom(const Args& args) {
   options.armsResting = parser.has("arms-resting");
   if (options.armsTouching && options.armsResting)
     throw UsageError{"--arms-touching and --arms-resting exclude each other"};
+  if (parser.has("gap-mm")) {
+    const std::string text = parser.get("gap-mm");
+    double hand = 0, forearm = 15;
+    char tail = 0;
+    const int n = std::sscanf(text.c_str(), "%lf,%lf%c", &hand, &forearm, &tail);
+    if (n < 1 || n > 2 || !std::isfinite(hand) || !std::isfinite(forearm) || hand <= 0 ||
+        forearm <= 0 || hand > 100 || forearm > 100)
+      throw UsageError{"--gap-mm expects HAND[,FOREARM] in mm (each above 0, at most 100), not " +
+                       text};
+    if (!options.armsResting) throw UsageError{"--gap-mm needs --arms-resting"};
+    options.handGapMm = hand;
+    options.forearmGapMm = forearm;
+  }
   if (parser.has("spacing")) {
     const std::string text = parser.get("spacing");
     double v[3];
@@ -170,6 +187,8 @@ int runPhantom(const Args& args) {
         {"voxelMm", options.spacing().maxCoeff()},
         {"spacingMm", {options.spacing().x(), options.spacing().y(), options.spacing().z()}},
         {"armsResting", options.armsResting},
+        {"handGapMm", options.handGapMm},
+        {"forearmGapMm", options.forearmGapMm},
         {"labels", labels},
         {"originRas", {o.x(), o.y(), o.z()}},
         {"numVoxels", g.numVoxels()},

@@ -31,6 +31,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -56,6 +57,12 @@ struct FrameOutputs {
   }
 };
 
+std::string formatFixed(double value, int decimals) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
 void writeFrameOutputs(const FrameOutputs& o, const PosedFrame& posed) {
   if (!o.labels.empty()) writeVolume(posed.organs, o.labels);
   if (!o.parts.empty()) writeVolume(posed.parts, o.parts);
@@ -75,6 +82,10 @@ void writeReturnParameters(const std::string& path, const json& report) {
       << "\nlabelsLost = " << report["labels_lost"].get<std::int64_t>() << "\n";
   if (q.contains("bones_rigid"))
     out << "bonesMinDice = " << q["bones_rigid"]["min_dice"].get<double>() << "\n";
+  std::string missed;
+  for (const auto& line : report["targets"]["missed"])
+    missed += (missed.empty() ? "" : "; ") + line.get<std::string>();
+  out << "targetsMissed = " << missed << "\n";
   writeTextFileAtomically(path, out.str());
 }
 
@@ -102,7 +113,10 @@ int runPose(const Args& args) {
               "The whole job: pose a label map G (with its body-part map S, and an image) by a\n"
               "pose file. Writes, per frame (one, or one per keyframe, in DIR/<frame>/):\n"
               "posed_G and posed_S (--output-format), posed_image.nii.gz (with --image),\n"
-              "transform.nrrd (displacement field, LPS, output->input) and report.json.");
+              "transform.nrrd (displacement field, LPS, output->input) and report.json.\n"
+              "Exit status 0 when every frame met its quality targets, 4 when every frame was\n"
+              "written but some missed (one line each on stderr; report.json's \"targets\"),\n"
+              "1 on an error (nothing written), 2 on a usage error.");
   p.option("input", "FILE", "label map G (NIfTI, NRRD, .seg.nrrd)")
       .option("parts", "FILE", "body-part map S on G's grid (the cage and mesh follow it)")
       .option("image", "FILE", "optional intensity image on G's grid, posed alongside")
@@ -150,6 +164,10 @@ int runPose(const Args& args) {
       .flag("no-auto-separate",
             "do not cut apart the body parts that move with different groups where they touch "
             "(by default they are, except across their own joint: docs/POSES.md)")
+      .flag("no-volume-restoration",
+            "leave each frame's mesh as the solve and the joint bends place it (by default the "
+            "soft tissue's vertices at the joints are relaxed so every body part keeps its "
+            "volume: docs/ARCHITECTURE.md)")
       .option("label-volumes", "MODE",
               "preserve: round each soft label of G to the volume the deformation gives it "
               "(label borders relabelled; docs/QUALITY.md); nearest: plain nearest-neighbour "
@@ -207,6 +225,7 @@ int runPose(const Args& args) {
   request.skeleton = skeletonFor(p.get("parts"), p.get("skeleton"));
   request.jointRings = static_cast<int>(p.getInt("joint-rings"));
   request.autoSeparate = !p.has("no-auto-separate");
+  request.volumeRestoration = !p.has("no-volume-restoration");
   const double spacingMm = p.getDouble("spacing-mm");
   if (!(spacingMm >= 0)) throw UsageError{"--spacing-mm must be >= 0"};
   const std::optional<double> background = p.getDoubleUnless("background", "min");
@@ -273,8 +292,12 @@ int runPose(const Args& args) {
   for (const std::string& line : job.warnings())
     std::cerr << "repose pose: warning: " << line << "\n";
   for (const ContactSeparation& c : job.separations().automatic.made)
-    say("separating " + c.names[0] + " from " + c.names[1] + " where they touch (" +
-        std::to_string(c.contactVoxels) + " contact voxels" +
+    say("separating " + c.names[0] + " from " + c.names[1] +
+        (c.touchingVoxels > 0 ? " where they touch (" + std::to_string(c.touchingVoxels) +
+                                    " touching, "
+                              : " across a gap of " + formatFixed(c.gapMm, 1) + " mm (") +
+        std::to_string(c.contactVoxels) + " voxels within " +
+        formatFixed(job.separations().automatic.reachMm, 0) + " mm" +
         (c.joint.empty() ? std::string() : ", outside the " + c.joint + " joint") + ")");
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
   const std::string key = job.sceneKey();
@@ -325,6 +348,7 @@ int runPose(const Args& args) {
   fo.preserveLabelVolumes = p.get("label-volumes") == "preserve";
   fo.labelMapFiles = labelMapFiles;
   json summary = json::array();
+  int missedFrames = 0;
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {
     const std::string frameName = rig.frameName(index);
     // Memory: the posed G and S, the image and the field beside the inputs, refused above the
@@ -367,6 +391,16 @@ int runPose(const Args& args) {
              : std::string()) +
         "; quality targets " + (q["all_met"].get<bool>() ? "met" : "NOT all met") + " -> " +
         (dir / "report.json").string());
+    // A frame that missed a target is written all the same (users may want it), and said so in
+    // one line naming what missed; the exit status says it too.
+    if (!report["targets"]["met"].get<bool>()) {
+      std::string what;
+      for (const auto& line : report["targets"]["missed"])
+        what += (what.empty() ? "" : "; ") + line.get<std::string>();
+      std::cerr << "repose pose: frame " << frameName << " written, but it missed its targets: "
+                << what << std::endl;
+      ++missedFrames;
+    }
     summary.push_back(report);
   }
   const double seconds =
@@ -377,7 +411,9 @@ int runPose(const Args& args) {
   else
     say("done in " + std::to_string(int(seconds)) + " s: " + (scratch ? "" : outDir));
   endSlicerProgress("repose pose");
-  return 0;
+  // In 3D Slicer a non-zero exit loads nothing: there the miss is the stderr line and the
+  // targetsMissed return parameter (the module completes "with errors" and loads the frame).
+  return missedFrames > 0 && !p.has("slicer-progress") ? kExitTargetsMissed : 0;
 }
 
 }  // namespace repose::cli

@@ -274,8 +274,9 @@ int runSweep(const Args& args) {
               "what `repose pose --scene` writes, in DIR/<subject>/<pose>[/<frame>]; then\n"
               "DIR/sweep.json, sweep.csv and sweep.svg. Run it under mpirun -np N to spread the\n"
               "jobs over N ranks (docs/PERFORMANCE.md); without MPI it runs them in turn.\n"
-              "Exit status 3 when some jobs failed (each recorded with its error), 1 when the\n"
-              "sweep itself could not run.");
+              "Exit status 3 when some jobs failed (each recorded with its error), 4 when every\n"
+              "job was written but some missed their quality targets (report.json's \"targets\"),\n"
+              "1 when the sweep itself could not run.");
   p.option("subjects", "LIST",
            "a file of subject folders, one per line: each with S.nii.gz, skeleton.json and "
            "tissues.csv as `repose rig --out` (or `repose phantom --out`) writes them, and G "
@@ -394,16 +395,20 @@ int runSweep(const Args& args) {
   summary.mpi = comm->mpi();
   summary.seconds = secondsSince(start);
   const std::string summaryJson = writeSweepSummary(settings.outDir, records, summary);
-  std::size_t failed = 0;
-  for (const SweepRecord& r : records) failed += r.status == "failed";
+  std::size_t failed = 0, missed = 0;
+  for (const SweepRecord& r : records) {
+    failed += r.status == "failed";
+    missed += r.status != "failed" && r.targetsMet && !*r.targetsMet;
+  }
   if (settings.quiet) {
     std::cout << summaryJson;
   } else {
     std::cout << records.size() << " jobs on " << comm->size() << " rank(s) in "
-              << int(summary.seconds) << " s, " << failed << " failed -> " << settings.outDir
+              << int(summary.seconds) << " s, " << failed << " failed, " << missed
+              << " written but missed their targets -> " << settings.outDir
               << "/sweep.json, sweep.csv, sweep.svg" << std::endl;
   }
-  return failed == 0 ? 0 : 3;
+  return failed > 0 ? 3 : missed > 0 ? kExitTargetsMissed : 0;
 }
 
 }  // namespace repose::cli

@@ -123,7 +123,11 @@ Group resultsGroup() {
            {"double", "", "worstLabelChangePercent", "Worst label change (%)", "output", "",
             "The largest volume change of a label of at least 1000 voxels.", true},
            {"integer", "", "labelsLost", "Labels lost", "output", "",
-            "Labels of the input that vanished from the output (target: 0).", true}}};
+            "Labels of the input that vanished from the output (target: 0).", true},
+           {"string", "", "targetsMissed", "Targets missed", "output", "",
+            "The quality targets the frame missed, one after the other (empty: every target "
+            "met). The frame is written and loaded either way.",
+            true}}};
 }
 
 std::string poseXml() {

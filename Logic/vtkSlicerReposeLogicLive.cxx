@@ -45,6 +45,7 @@ struct vtkSlicerReposeLogic::LiveSession {
   repose::LabelTable PartLabels;  // S's, for groups selecting parts
   std::vector<std::uint8_t> OuterFaces;
   Eigen::MatrixX3d Deformed;  // the live frame's TM vertices
+  std::vector<repose::RigidHandle> Handles;  // and its groups' motions
   Eigen::Vector3d Lo{0, 0, 0}, Hi{0, 0, 0};
   vtkSmartPointer<vtkPolyData> Cage, Body;
   double FrameMilliseconds = 0;
@@ -238,6 +239,7 @@ bool vtkSlicerReposeLogic::SolveLiveFrame(const repose::Pose& pose) {
     // iterations per edit (the export solves its frame from rest).
     const repose::PoseRig::Frame frame = live.Rig->liveFrame(pose, index);
     live.Deformed = frame.deformed;
+    live.Handles = frame.handles;
     live.Prediction.reset();
     setPoints(live.Cage, frame.cage);
     setPoints(live.Body, frame.deformed);
@@ -321,7 +323,9 @@ vtkSlicerReposeLogic::LivePrediction vtkSlicerReposeLogic::GetLivePrediction() {
   if (!this->Live || this->Live->Deformed.rows() == 0) return {};
   LiveSession& live = *this->Live;
   if (!live.Prediction) {
-    const repose::VolumePrediction p = repose::predictVolumeChange(live.Rig->mesh(), live.Deformed);
+    Eigen::MatrixX3d restored = live.Deformed;
+    live.Rig->restoreFrameVolumes(restored, live.Handles);
+    const repose::VolumePrediction p = repose::predictVolumeChange(live.Rig->mesh(), restored);
     LivePrediction out;
     out.valid = true;
     out.bodyChangePercent = p.changePercent();
@@ -334,6 +338,26 @@ vtkSlicerReposeLogic::LivePrediction vtkSlicerReposeLogic::GetLivePrediction() {
     out.draggedBy = name(p.draggedBy);
     for (const repose::PartVolumeChange& c : p.parts)
       if (c.part == p.worstPart) out.worstPartChangePercent = c.changePercent();
+    // The part furthest from its volume in percent, against the per-part target.
+    const repose::PartVolumeChange* furthest = nullptr;
+    for (const repose::PartVolumeChange& c : p.parts)
+      if (c.restMm3 > 0 &&
+          (!furthest || std::fabs(c.changePercent()) > std::fabs(furthest->changePercent())))
+        furthest = &c;
+    char text[160];
+    if (std::fabs(out.bodyChangePercent) > repose::kBodyTargetPercent) {
+      std::snprintf(text, sizeof text, "body %+.2f %% (target within 0.5 %%)",
+                    out.bodyChangePercent);
+      out.missed = text;
+    }
+    if (furthest && std::fabs(furthest->changePercent()) > repose::kLabelTargetPercent) {
+      std::snprintf(text, sizeof text, "%s %+.2f %% (target within 1 %%)",
+                    name(furthest->part).c_str(), furthest->changePercent());
+      out.missed += (out.missed.empty() ? "" : "; ") + std::string(text);
+      out.worstPart = name(furthest->part);
+      out.worstPartChangePercent = furthest->changePercent();
+    }
+    out.met = out.missed.empty();
     live.Prediction = out;
   }
   return *live.Prediction;

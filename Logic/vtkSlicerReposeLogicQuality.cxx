@@ -55,6 +55,16 @@ std::vector<vtkSlicerReposeLogic::QualityCheck> vtkSlicerReposeLogic::GetLastPos
   if (q.contains("no_label_lost"))
     rows.push_back({"Labels lost", std::to_string(q["no_label_lost"].value("labels_lost", 0)),
                     "none", met("no_label_lost")});
+  if (q.contains("prediction_within_targets")) {
+    const nlohmann::json& p = q["prediction_within_targets"];
+    const std::string part = p.value("worst_part", std::string());
+    rows.push_back({"Mesh prediction",
+                    "body " + percent(p.value("body_change_percent", 0.0)) +
+                        (part.empty() ? std::string()
+                                      : ", " + part + " " +
+                                            percent(p.value("worst_part_change_percent", 0.0))),
+                    "body ±0.5 %, each part ±1 %", met("prediction_within_targets")});
+  }
   return rows;
 }
 

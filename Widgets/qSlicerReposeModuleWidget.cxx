@@ -950,15 +950,14 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
       liveText += QString("; body volume %1%2 % (predicted)")
                       .arg(p.bodyChangePercent >= 0 ? "+" : "")
                       .arg(p.bodyChangePercent, 0, 'f', 2);
-      // A part stretched by another it is tied to: tissue dragged along a contact.
-      if (!p.worstPart.empty() && std::fabs(p.worstPartChangePercent) > 1)
-        liveText +=
-            QString("; %1 %2%3 %%4")
-                .arg(QString::fromStdString(p.worstPart))
-                .arg(p.worstPartChangePercent >= 0 ? "+" : "")
-                .arg(p.worstPartChangePercent, 0, 'f', 1)
-                .arg(p.draggedBy.empty() ? QString()
-                                         : ", dragged by " + QString::fromStdString(p.draggedBy));
+      // A part stretched by another it is tied to (tissue dragged along a contact), or folded:
+      // the export will be written, but it will miss its targets, said before it is made.
+      if (!p.met)
+        liveText += QString("; the export will MISS its targets: %1%2")
+                        .arg(QString::fromStdString(p.missed))
+                        .arg(p.draggedBy.empty()
+                                 ? QString()
+                                 : ", dragged by " + QString::fromStdString(p.draggedBy));
     }
   }
   d->LiveStatusLabel->setText(liveText);

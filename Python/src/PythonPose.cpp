@@ -15,6 +15,7 @@
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 
+#include <nlohmann/json.hpp>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
@@ -340,6 +341,11 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
            py::arg("_parts_path") = "",
            // The job holds G and S: they live as long as the rig.
            py::keep_alive<1, 2>(), py::keep_alive<1, 3>())
+      .def_property(
+          "volume_restoration", [](const Rig& r) { return r.rig->volumeRestoration(); },
+          [](Rig& r, bool on) { r.rig->setVolumeRestoration(on); },
+          "Whether each frame relaxes the soft tissue of the joints' bends so every body part "
+          "keeps its volume (on by default; `repose pose --no-volume-restoration` turns it off).")
       .def_property_readonly("frame_count", [](const Rig& r) { return r.rig->frameCount(); })
       .def_property_readonly("frame_names",
                              [](const Rig& r) {
@@ -413,6 +419,15 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
               posed.reportJson = r.job->completeReport(posed.reportJson, r.sceneReused, *r.rig);
               return posed;
             });
+            // A frame that missed a target is returned all the same, and said so in one line,
+            // as `repose pose` says it.
+            const nlohmann::json targets = nlohmann::json::parse(f.reportJson)["targets"];
+            if (!targets["met"].get<bool>()) {
+              std::string missed;
+              for (const auto& line : targets["missed"])
+                missed += (missed.empty() ? "" : "; ") + line.get<std::string>();
+              warnings.push_back("it missed its targets: " + missed);
+            }
             issueWarnings(f.name, warnings);
             return f;
           },

@@ -261,11 +261,13 @@ that needs more is refused with the numbers before anything is allocated.)doc");
   m.def(
       "make_phantom",
       [](double voxelMm, bool armsTouching, bool image, bool armsResting,
-         const py::object& spacing) {
+         const py::object& spacing, double handGapMm, double forearmGapMm) {
         PhantomOptions o;
         o.voxelMm = voxelMm;
         o.armsTouching = armsTouching;
         o.armsResting = armsResting;
+        o.handGapMm = handGapMm;
+        o.forearmGapMm = forearmGapMm;
         if (!spacing.is_none()) o.spacingMm = spacing.cast<Eigen::Vector3d>();
         std::pair<Volume, Volume> maps;
         std::optional<Volume> ct;
@@ -286,10 +288,12 @@ that needs more is refused with the numbers before anything is allocated.)doc");
       },
       py::arg("voxel_mm") = 2.0, py::arg("arms_touching") = false, py::arg("image") = false,
       py::arg("arms_resting") = false, py::arg("spacing_mm") = py::none(),
+      py::arg("hand_gap_mm") = 0.0, py::arg("forearm_gap_mm") = 0.0,
       R"doc(The synthetic mannequin in memory: {'organs': G, 'parts': S, 'skeleton': Skeleton[,
 'image': CT]} (`repose phantom` writes the same to files). arms_resting: the arms against the
 trunk, hands on the thighs, thighs touching, with vessels and bone marrow; spacing_mm: (x, y, z)
-voxel sizes instead of voxel_mm.)doc");
+voxel sizes instead of voxel_mm; hand_gap_mm, forearm_gap_mm (with arms_resting): the hands and
+forearms held that far off the thighs and the trunk, as in real reference phantoms.)doc");
 }
 
 }  // namespace repose::python

@@ -258,7 +258,8 @@ class qSlicerReposeViewsTest : public QObject {
                                               {"Worst label", "labels_within_1_percent"},
                                               {"Bones rigid", "bones_rigid"},
                                               {"Holes", "no_new_holes"},
-                                              {"Labels lost", "no_label_lost"}};
+                                              {"Labels lost", "no_label_lost"},
+                                              {"Mesh prediction", "prediction_within_targets"}};
     QCOMPARE(quality->rowCount(), int(checks.size()) - 1);  // all_met is the sum of the rows
     for (int r = 0; r < quality->rowCount(); ++r) {
       const QString check = quality->item(r, 0)->text();

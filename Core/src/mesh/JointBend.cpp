@@ -100,18 +100,50 @@ JointBends::JointBends(const TransferMesh& mesh, const std::vector<RigidHandle>&
   }
 }
 
+bool JointBends::turns(const Joint& j, const std::vector<RigidHandle>& frame) const {
+  const Eigen::Isometry3d relative = frame[std::size_t(j.proximalGroup)].motion.inverse() *
+                                     frame[std::size_t(j.distalGroup)].motion;
+  if (std::fabs(Eigen::AngleAxisd(relative.rotation()).angle()) < 1e-6)
+    return false;  // the blend is one rigid motion already
+  // A turn about an axis through the centre: the centre stays put.
+  const Eigen::Vector3d& c = j.joint.centre;
+  return (relative * c - c).norm() <= 0.02 * j.joint.radiusMm;
+}
+
+std::vector<char> JointBends::zone(const std::vector<RigidHandle>& frame,
+                                   Eigen::Index vertexCount) const {
+  std::vector<char> out(std::size_t(vertexCount), 0);
+  for (const Joint& j : joints_)
+    if (turns(j, frame))
+      for (const int v : j.vertices) out[std::size_t(v)] = 1;
+  return out;
+}
+
+std::vector<char> JointBends::reachTets(const TransferMesh& mesh,
+                                        const std::vector<RigidHandle>& frame) const {
+  std::vector<char> out(std::size_t(mesh.tets.rows()), 0);
+  for (const Joint& j : joints_) {
+    if (!turns(j, frame)) continue;
+    const double reach = j.joint.radiusMm * std::max(j.joint.proximalReach, j.joint.distalReach);
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) centre += mesh.vertices.row(mesh.tets(t, k)).transpose() / 4;
+      if ((centre - j.joint.centre).norm() <= reach) out[std::size_t(t)] = 1;
+    }
+  }
+  return out;
+}
+
 JointBendReport JointBends::apply(const TransferMesh& mesh, const std::vector<RigidHandle>& frame,
                                   Eigen::MatrixX3d& deformed) const {
   JointBendReport report;
   for (const Joint& j : joints_) {
+    if (!turns(j, frame)) continue;
     const Eigen::Isometry3d& proximal = frame[std::size_t(j.proximalGroup)].motion;
     const Eigen::Isometry3d relative =
         proximal.inverse() * frame[std::size_t(j.distalGroup)].motion;
     const Eigen::AngleAxisd turn(relative.rotation());
-    if (std::fabs(turn.angle()) < 1e-6) continue;  // the blend is one rigid motion already
-    // A turn about an axis through the centre: the centre stays put.
     const Eigen::Vector3d& c = j.joint.centre;
-    if ((relative * c - c).norm() > 0.02 * j.joint.radiusMm) continue;
     for (const int v : j.vertices) {
       const Eigen::Vector3d rest = mesh.vertices.row(v);
       double s = 0;

@@ -47,12 +47,12 @@ struct Phantom::Impl {
 };
 
 double Phantom::Impl::bodyDistance(const Eigen::Vector3d& p, const std::vector<int>& segs) const {
-  double body = 1e300;
+  phantom::BlendedDistance body;
   for (int i : segs) {
     const Segment& s = model.segments[i];
-    if (s.box.containsX(p.x())) body = phantom::smoothMin(body, s.shape.distance(p), model.blendMm);
+    if (s.box.containsX(p.x())) body.add(s, s.shape.distance(p), model.blendMm);
   }
-  return body;
+  return body.value();
 }
 
 double Phantom::Impl::skinAt(const Eigen::Vector3d& p, const std::vector<int>& segs) const {
@@ -72,13 +72,14 @@ void Phantom::Impl::evaluate(const Eigen::Vector3d& p, const std::vector<int>& s
                              const std::vector<int>& structs, std::uint8_t& organ,
                              std::uint8_t& part) const {
   organ = part = 0;
-  double body = 1e300, best = 1e300;
+  phantom::BlendedDistance blended;
+  double best = 1e300;
   std::uint8_t owner = 0;
   for (int i : segs) {
     const Segment& s = model.segments[i];
     if (!s.box.containsX(p.x())) continue;
     const double d = s.shape.distance(p);
-    body = phantom::smoothMin(body, d, model.blendMm);
+    blended.add(s, d, model.blendMm);
     if (d < best) {
       best = d;
       owner = s.cut && (p - s.cutPoint).dot(s.cutNormal) < 0 ? s.cutOwner : s.part;
@@ -86,6 +87,7 @@ void Phantom::Impl::evaluate(const Eigen::Vector3d& p, const std::vector<int>& s
         owner = (p - model.neckCentre).dot(model.neckNormal) > 0 ? kPartHead : kPartTorso;
     }
   }
+  const double body = blended.value();
   if (!(body < 0)) return;
   part = owner;
   const double depth = -body;
@@ -153,6 +155,11 @@ Phantom::Phantom(const PhantomOptions& options) : impl_(std::make_unique<Impl>()
     throw Error("phantom: every voxel spacing must be a positive number of mm");
   if (options.armsTouching && options.armsResting)
     throw Error("phantom: the arms either touch the hips or rest along the body, not both");
+  for (const double gap : {options.handGapMm, options.forearmGapMm})
+    if (!std::isfinite(gap) || gap < 0 || gap > 100)
+      throw Error("phantom: a gap must be 0 to 100 mm, not " + std::to_string(gap));
+  if ((options.handGapMm > 0 || options.forearmGapMm > 0) && !options.armsResting)
+    throw Error("phantom: the hands' and forearms' gaps are those of the arms-resting posture");
   if (!std::isfinite(options.marginMm) || options.marginMm < 0)
     throw Error("phantom: the margin must be zero or more mm");
   if (options.threads < 0) throw Error("phantom: the thread count cannot be negative");
@@ -302,6 +309,8 @@ std::string Phantom::skeletonJson() const {
   nlohmann::json made = {{"made_by", "repose phantom"},
                          {"armsTouching", o.armsTouching},
                          {"armsResting", o.armsResting},
+                         {"handGapMm", o.handGapMm},
+                         {"forearmGapMm", o.forearmGapMm},
                          {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
                          {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
   return skeletonToJson(skeleton(), made.dump());

@@ -41,6 +41,11 @@ bool Structure::contains(const V& p, double depth) const {
   return false;
 }
 
+void BlendedDistance::add(const Segment& s, double d, double blendMm) {
+  for (int c = 0; c < 3; ++c)
+    if (s.blends & (1 << c)) acc[c] = smoothMin(acc[c], d, blendMm);
+}
+
 namespace {
 
 V mirror(const V& p) {
@@ -241,13 +246,56 @@ void restLegs(SideJoints& j) {
   j.ankle.x() = 50;
   j.toe.x() = 50;
 }
-void restArms(SideJoints& j, const Builder& b, double press) {
-  restOn(j.shoulder, j.elbow, kUpperArmR[0], kUpperArmR[1], b.trunk, 0.2, press);
+// The air between a primitive and a set of others (hard union), measured from the primitive's
+// inside on a 1 mm lattice: exact to the lattice's step.
+double clearance(const RoundCone& shape, const std::vector<RoundCone>& body) {
+  const Box box = shape.bounds();
+  double best = 1e300;
+  for (double x = box.lo.x(); x <= box.hi.x(); x += 1)
+    for (double y = box.lo.y(); y <= box.hi.y(); y += 1)
+      for (double z = box.lo.z(); z <= box.hi.z(); z += 1) {
+        const V p(x, y, z);
+        if (shape.distance(p) > 0) continue;
+        for (const RoundCone& c : body) best = std::min(best, c.distance(p));
+      }
+  return best;
+}
+
+// Turns the hand about the wrist (its tip along x) until its surface, as the body draws it,
+// stands `gap` mm off the thighs: the near contact of a reference phantom's hand.
+void holdHandOff(SideJoints& j, const std::vector<RoundCone>& thighs, double gap) {
+  double lo = j.wrist.x() - 250, hi = j.wrist.x() + 120;  // too far in, too far out
+  for (int it = 0; it < 30; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    V tip = j.handTip;
+    tip.x() = mid;
+    (clearance(hand(j.wrist, tip, V::UnitX(), 1.0), thighs) < gap ? lo : hi) = mid;
+  }
+  j.handTip.x() = hi;
+}
+
+// With gaps (PhantomOptions::handGapMm), the forearm and the hand stand off the body by them
+// instead of pressing into it: a negative press.
+void restArms(SideJoints& j, const Builder& b, double press, double forearmGap, double handGap) {
+  // Held off, the arm hangs a little away from the body: the upper arm leaves the chest wall
+  // towards the elbow (its distal 40 % the forearm's gap off), and the forearm keeps its gap
+  // from the elbow down, as in a reference phantom whose forearm is that far from the trunk.
+  if (forearmGap > 0)
+    restOn(j.shoulder, j.elbow, kUpperArmR[0], kUpperArmR[1], b.trunk, 0.6, -forearmGap);
+  else
+    restOn(j.shoulder, j.elbow, kUpperArmR[0], kUpperArmR[1], b.trunk, 0.2, press);
   std::vector<RoundCone> hip = b.trunk;
   hip.insert(hip.end(), b.thighs.begin(), b.thighs.end());
-  restOn(j.elbow, j.wrist, kForearmR[0], kForearmR[1], hip, 0.15, press);
+  if (forearmGap > 0)
+    restOn(j.elbow, j.wrist, kForearmR[0], kForearmR[1], hip, 0.0, -forearmGap);
+  else
+    restOn(j.elbow, j.wrist, kForearmR[0], kForearmR[1], hip, 0.15, press);
   // The hand's thin side faces the thigh; it starts 8 mm past the wrist.
-  restOn(j.wrist, j.handTip, kHandR[0] * kHandThin, kHandR[1] * kHandThin, b.thighs, 0.1, press);
+  if (handGap > 0)
+    holdHandOff(j, b.thighs, handGap);
+  else
+    restOn(j.wrist, j.handTip, kHandR[0] * kHandThin, kHandR[1] * kHandThin, b.thighs, 0.1,
+           press);
 }
 
 void addTorsoAndHead(Builder& b) {
@@ -270,7 +318,7 @@ void addTorsoAndHead(Builder& b) {
   b.m.neckNormal = V(0, std::sin(tilt), std::cos(tilt));
 }
 
-void addArm(Builder& b, const SideJoints& j, const V& across, bool left) {
+void addArm(Builder& b, const SideJoints& j, const V& across, bool left, bool detached) {
   auto P = [&](const V& p) { return left ? mirror(p) : p; };
   const V ac = left ? mirror(across) : across;
   const std::uint8_t upper = left ? kPartUpperArmLeft : kPartUpperArmRight;
@@ -279,8 +327,14 @@ void addArm(Builder& b, const SideJoints& j, const V& across, bool left) {
   const V s = P(j.shoulder), e = P(j.elbow), w = P(j.wrist), t = P(j.handTip);
   const V uu = (e - s).normalized(), uf = (w - e).normalized(), uh = (t - w).normalized();
   b.cutSegment(upper, RoundCone::make(s, e, kUpperArmR[0], kUpperArmR[1]), s, uu, kPartTorso);
+  const std::uint8_t arm = left ? kBlendArmLeft : kBlendArmRight;
+  // Held off the body, the forearm and hand blend with their own upper arm only (the elbow),
+  // and the upper arm with both the body (the shoulder) and them.
+  if (detached) b.m.segments.back().blends = kBlendMain | arm;
   b.segment(fore, RoundCone::make(e, w, kForearmR[0], kForearmR[1]));
+  if (detached) b.m.segments.back().blends = arm;
   b.segment(handPart, hand(w, t, ac, 1.0));
+  if (detached) b.m.segments.back().blends = arm;
   // Humerus: the head (a ball on the shoulder joint), the shaft, and the condyles across the
   // elbow's flexion axis; the forearm bones start a cartilage gap beyond the condyles and end
   // one before the carpals, whose rounded end is centred on the wrist joint.
@@ -501,9 +555,10 @@ BodyModel buildBody(const PhantomOptions& options) {
   addLeg(b, j, false);
   addLeg(b, j, true);
   if (options.armsTouching) pressArmToHip(j, across, b, 3.0);
-  if (options.armsResting) restArms(j, b, 3.0);
-  addArm(b, j, across, false);
-  addArm(b, j, across, true);
+  const bool detached = options.armsResting && (options.handGapMm > 0 || options.forearmGapMm > 0);
+  if (options.armsResting) restArms(j, b, 3.0, options.forearmGapMm, options.handGapMm);
+  addArm(b, j, across, false, detached);
+  addArm(b, j, across, true, detached);
   addTorsoStructures(b, j);
   addJoints(b, j, across);
 

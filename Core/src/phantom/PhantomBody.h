@@ -25,7 +25,21 @@ struct Segment {
   Eigen::Vector3d cutPoint = Eigen::Vector3d::Zero(), cutNormal = Eigen::Vector3d::UnitZ();
   // The head and the neck are divided by the neck plane (BodyModel::neck*), not by distance.
   bool neckSplit = false;
+  // The smooth unions the segment takes part in (bits: kBlendMain, kBlendArmLeft,
+  // kBlendArmRight); the body is the plain minimum of them. A forearm and hand held off the body
+  // (PhantomOptions::handGapMm) blend only with their own arm, so a gap of a few millimetres
+  // stays open instead of being bridged by the blend.
+  std::uint8_t blends = 1;
   Box box;  // bounds grown by the blend radius: beyond it the segment cannot change a voxel
+};
+
+constexpr std::uint8_t kBlendMain = 1, kBlendArmLeft = 2, kBlendArmRight = 4;
+
+// Distances to the body as the smooth unions of Segment::blends combine them.
+struct BlendedDistance {
+  double acc[3] = {1e300, 1e300, 1e300};
+  void add(const Segment& s, double d, double blendMm);
+  double value() const { return std::min({acc[0], acc[1], acc[2]}); }
 };
 
 enum class StructureKind { Cone, Ellipsoid, Shell, Ribs };

@@ -90,12 +90,17 @@ void resolveJointsWith(Pose& pose, const Skeleton* skeleton, const std::string& 
 }
 
 PoseSeparations poseSeparations(const Pose& pose, const Volume& parts, const Skeleton* skeleton,
-                                bool automatic) {
+                                bool automatic, const RigSettings& settings) {
   PoseSeparations out;
   out.all = resolveSeparations(pose, parts.labels());
   out.automaticOn = automatic;
   if (automatic) {
-    out.automatic = findContactSeparations(parts, pose, skeleton);
+    CageOptions cage;
+    cage.dilateMm = settings.dilateMm;
+    ContactOptions co;
+    co.reachMm = contactReachMm(cage, parts);
+    co.threads = settings.threads;
+    out.automatic = findContactSeparations(parts, pose, skeleton, co);
     for (const LimbSeparation& s : out.automatic.separations()) out.all.push_back(s);
   }
   return out;
@@ -118,7 +123,10 @@ std::vector<JointRefinement> jointRefinements(const Pose& pose, const Volume& pa
     JointRefinement r;
     r.centre = j.centre;
     r.radiusMm = 1.5 * j.radiusMm;
-    r.sizeMm = std::max(2 * voxel, j.radiusMm / 3);
+    // A sixth of the radius (at least two voxels): the bend's inner side is compressed several
+    // times over its angle, and the volume restoration needs free vertices there; with a third
+    // the thick slices' arm vessels lost 1.25 % at the 90-degree elbow (docs/QUALITY.md).
+    r.sizeMm = std::max(2 * voxel, j.radiusMm / 6);
     out.push_back(r);
   }
   return out;
@@ -199,7 +207,7 @@ PoseJob::PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRe
   }
   jointRings_ = request_.jointRings >= 0 ? request_.jointRings : pose_.jointRings;
   const Skeleton* skeleton = skeleton_ ? &*skeleton_ : nullptr;
-  separations_ = poseSeparations(pose_, parts, skeleton, request_.autoSeparate);
+  separations_ = poseSeparations(pose_, parts, skeleton, request_.autoSeparate, settings_);
   for (const std::string& why : separations_.automatic.skipped)
     warnings_.push_back("not separated: " + why);
   settings_.refineJoints = jointRefinements(pose_, parts, skeleton);
@@ -220,9 +228,11 @@ std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, int threads) con
 
 std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, const Pose& pose,
                                           int threads) const {
-  return std::make_unique<PoseRig>(std::move(geometry), pose, parts_->labels(), threads,
-                                   jointRings_,
-                                   bendJoints(skeleton_ ? &*skeleton_ : nullptr, parts_->labels()));
+  auto rig = std::make_unique<PoseRig>(
+      std::move(geometry), pose, parts_->labels(), threads, jointRings_,
+      bendJoints(skeleton_ ? &*skeleton_ : nullptr, parts_->labels()));
+  rig->setVolumeRestoration(request_.volumeRestoration);
+  return rig;
 }
 
 PoseFrameOptions PoseJob::frameOptions() const {

@@ -2,6 +2,7 @@
 
 #include "repose/cage/ArapDeformer.h"
 #include "repose/mesh/RigidHandles.h"
+#include "repose/mesh/VolumeRestoration.h"
 #include "repose/util/Error.h"
 
 #include <Eigen/LU>
@@ -265,9 +266,38 @@ PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partL
                                       jointRings >= 0 ? jointRings : pose_.jointRings);
   bends_ = JointBends(geometry_.mesh, handles_, bends);
   frames_ = pose_.frames();
+  // Whole pieces stay exactly rigid: the restoration moves only the soft tissue's vertices.
+  const TransferMesh& m = geometry_.mesh;
+  movable_.assign(std::size_t(m.vertices.rows()), 1);
+  if (!m.rigid.empty())
+    for (Eigen::Index t = 0; t < m.tets.rows(); ++t)
+      if (m.rigid[std::size_t(t)])
+        for (int k = 0; k < 4; ++k) movable_[std::size_t(m.tets(t, k))] = 0;
 }
 
 PoseRig::~PoseRig() = default;
+
+VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
+                                                     const std::vector<RigidHandle>& handles) const {
+  if (!restoreVolumes_ || bends_.empty()) return {};
+  const TransferMesh& m = geometry_.mesh;
+  std::vector<char> zone = bends_.zone(handles, m.vertices.rows());
+  // One ring of tets around the bends: the tets that span the bend's reach.
+  std::vector<char> grown = zone;
+  for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
+    bool any = false;
+    for (int k = 0; k < 4; ++k) any = any || zone[std::size_t(m.tets(t, k))];
+    if (any)
+      for (int k = 0; k < 4; ++k) grown[std::size_t(m.tets(t, k))] = 1;
+  }
+  bool anything = false;
+  for (std::size_t v = 0; v < grown.size(); ++v) {
+    grown[v] = grown[v] && movable_[v];
+    anything = anything || grown[v];
+  }
+  if (!anything) return {};
+  return restoreVolumes(m, grown, deformed, {}, bends_.reachTets(m, handles));
+}
 
 PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision,
                               FrameMaps tetMaps) const {
@@ -355,8 +385,12 @@ PoseRig::Frame PoseRig::solveFrame(const std::string& name,
     }
   }
   const JointBendReport bent = bends_.apply(geometry_.mesh, f.handles, f.deformed);
-  // The bends and the carried vertices moved vertices after the solver: their tets' maps follow.
-  if (tetMaps == FrameMaps::With && (bent.vertices > 0 || carriedOutside > 0)) {
+  // Soft tissue keeps its volume (VolumeRestoration.h): every frame but the live preview's.
+  if (start == CageStart::Rest) f.restoration = restoreFrameVolumes(f.deformed, f.handles);
+  // The bends, the carried vertices and the restoration moved vertices after the solver: their
+  // tets' maps follow.
+  if (tetMaps == FrameMaps::With &&
+      (bent.vertices > 0 || carriedOutside > 0 || f.restoration.freeVertices > 0)) {
     const TransferMesh& m = geometry_.mesh;
     for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
       Eigen::Matrix3d D, E;

@@ -153,6 +153,7 @@ inline constexpr IcrpOrgan kIcrp110Organs[] = {
     {138, "Urinary bladder contents", 1040, 1040},
     {139, "Uterus", 1030, 1030},
     {140, "Air inside body", 1, 1},
+    {141, "Skin at top and bottom", 1090, 1090},
 };
 
 }  // namespace repose::rig

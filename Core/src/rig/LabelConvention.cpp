@@ -204,6 +204,32 @@ const char* icrpBoneName(int id) {
   return name ? name : "";
 }
 
+const rig::IcrpOrgan* icrpOrgan(int id) {
+  for (const rig::IcrpOrgan& o : rig::kIcrp110Organs)
+    if (o.id == id) return &o;
+  return nullptr;
+}
+
+// The role of a label no convention knows: soft, not rigid, of no one body region (the rig's
+// flood gives each of its voxels the part around it), with the density its name suggests, else
+// soft tissue's. Never a reason to refuse G.
+LabelRole unknownRole(const Volume& organs, int value) {
+  LabelRole r;
+  r.name = nameOf(organs, value);
+  bool known = false;
+  r.densityKgM3 = r.name.empty() ? kSoftTissueKgM3 : typicalDensity(lower(r.name), &known);
+  return r;
+}
+
+// One warning line listing the labels a convention did not know (at most 8 by number and name).
+std::string unknownLabelsNote(const std::vector<std::string>& unknown, const std::string& name) {
+  std::string list;
+  for (std::size_t i = 0; i < unknown.size() && i < 8; ++i) list += (i ? ", " : "") + unknown[i];
+  return std::to_string(unknown.size()) + " label(s) not in the " + name +
+         " convention, taken as soft tissue (not rigid, no body region): " + list +
+         (unknown.size() > 8 ? ", ..." : "");
+}
+
 LabelConvention icrp110(const Volume& organs, const std::vector<int>& labels) {
   // The female phantom has ovaries and a uterus, the male a prostate and testes.
   const std::set<int> has(labels.begin(), labels.end());
@@ -212,13 +238,17 @@ LabelConvention icrp110(const Volume& organs, const std::vector<int>& labels) {
   LabelConvention c;
   c.name = std::string("icrp110 (") + (male && !female ? "AM" : "AF") + ")";
   if (!male && !female) c.notes.push_back("no sex-specific organ found: the AF densities are used");
+  std::vector<std::string> unknown;
   for (const int v : labels) {
-    const rig::IcrpOrgan* organ = nullptr;
-    for (const rig::IcrpOrgan& o : rig::kIcrp110Organs)
-      if (o.id == v) organ = &o;
-    if (!organ)
-      throw Error("label " + std::to_string(v) +
-                  " is not an ICRP 110 organ ID (1 to 140): G is not an ICRP 110 phantom");
+    const rig::IcrpOrgan* organ = icrpOrgan(v);
+    if (!organ) {
+      // A label the ICRP 110 list does not have (a user's addition, a later release's ID).
+      c.roles[v] = unknownRole(organs, v);
+      c.unknown.push_back(v);
+      const std::string n = nameOf(organs, v);
+      unknown.push_back(std::to_string(v) + (n.empty() ? "" : " " + n));
+      continue;
+    }
     LabelRole r;
     r.name = organ->name;
     r.densityKgM3 = male && !female ? organ->densityAm : organ->densityAf;
@@ -233,8 +263,26 @@ LabelConvention icrp110(const Volume& organs, const std::vector<int>& labels) {
     if (endsWith(n, ", legs")) r.region = BodyRegion::Legs;
     c.roles[v] = r;
   }
-  (void)organs;
+  if (!unknown.empty()) c.notes.push_back(unknownLabelsNote(unknown, "icrp110"));
   return c;
+}
+
+// Whether G's labels are ICRP 110 organ IDs: at least 20 labels, unnamed or named as ICRP names
+// them, nearly all of them IDs of the list (a real file holds 1-141; a few may be missing, a few
+// added), among them the humeri's and femora's.
+bool looksLikeIcrp110(const Volume& organs, const std::vector<int>& labels) {
+  if (labels.size() < 20) return false;
+  std::size_t ids = 0, foreignNames = 0;
+  for (const int v : labels) {
+    const rig::IcrpOrgan* organ = icrpOrgan(v);
+    ids += organ != nullptr;
+    const std::string n = nameOf(organs, v);
+    if (!n.empty() && !(organ && lower(n) == lower(organ->name))) ++foreignNames;
+  }
+  const std::size_t extra = labels.size() - ids;
+  const std::set<int> has(labels.begin(), labels.end());
+  const bool bones = has.count(13) + has.count(16) + has.count(28) + has.count(31) >= 2;
+  return bones && foreignNames == 0 && extra <= std::max<std::size_t>(3, labels.size() / 10);
 }
 
 // ---- TotalSegmentator v2 (class names of its label table) ----
@@ -355,11 +403,8 @@ LabelConvention fromCsv(const Volume& organs, const std::string& path,
     if (given.count(v)) {
       c.roles[v] = given[v];
     } else {
-      LabelRole r;
-      r.name = nameOf(organs, v);
-      bool known = false;
-      r.densityKgM3 = typicalDensity(lower(r.name), &known);
-      c.roles[v] = r;
+      // The CSV lists the bones (and what else its author chose): the rest is soft tissue.
+      c.roles[v] = unknownRole(organs, v);
     }
   }
   return c;
@@ -386,18 +431,12 @@ LabelConvention byNames(const Volume& organs, const std::vector<int>& labels,
     r.name = nameOf(organs, v);
     if (!role(r.name, r)) {
       unknown.push_back(std::to_string(v) + (r.name.empty() ? "" : " " + r.name));
-      r.densityKgM3 = kSoftTissueKgM3;
+      r = unknownRole(organs, v);
+      c.unknown.push_back(v);
     }
     c.roles[v] = r;
   }
-  if (!unknown.empty()) {
-    std::string list;
-    for (std::size_t i = 0; i < unknown.size() && i < 8; ++i) list += (i ? ", " : "") + unknown[i];
-    c.notes.push_back(std::to_string(unknown.size()) + " label(s) not in the " + name +
-                      " convention, taken as soft tissue of density " +
-                      std::to_string(int(kSoftTissueKgM3)) + " kg/m^3: " + list +
-                      (unknown.size() > 8 ? ", ..." : ""));
-  }
+  if (!unknown.empty()) c.notes.push_back(unknownLabelsNote(unknown, name));
   return c;
 }
 
@@ -427,12 +466,7 @@ LabelConvention conventionOf(const Volume& organs, const std::vector<int>& label
     int phantomBones = 0, tsBones = 0;
     const int phantomNames = countMatches(organs, labels, phantomRole, &phantomBones);
     const int tsNames = countMatches(organs, labels, totalSegmentatorRole, &tsBones);
-    const bool icrpValues = labels.back() <= 140 && labels.size() >= 20 &&
-                            std::count_if(labels.begin(), labels.end(), [&](int v) {
-                              return nameOf(organs, v).empty();
-                            }) == std::ptrdiff_t(labels.size());
-    const std::set<int> has(labels.begin(), labels.end());
-    const bool icrpBones = has.count(13) + has.count(16) + has.count(28) + has.count(31) >= 2;
+    const bool icrpValues = looksLikeIcrp110(organs, labels);
     if (phantomBones >= 3 && phantomNames * 2 >= int(labels.size())) {
       c = byNames(organs, labels, "phantom", phantomRole);
       c.detection = "auto: G's label names are the phantom's";
@@ -441,12 +475,12 @@ LabelConvention conventionOf(const Volume& organs, const std::vector<int>& label
       // the vertebrae): whether its bones make a rig is said next, by name.
       c = byNames(organs, labels, "totalsegmentator", totalSegmentatorRole);
       c.detection = "auto: G's label names are TotalSegmentator's";
-    } else if (icrpValues && icrpBones) {
+    } else if (icrpValues) {
       c = icrp110(organs, labels);
-      c.detection = "auto: unnamed labels 1-140 with the ICRP 110 humerus and femur IDs";
+      c.detection = "auto: labels that are ICRP 110 organ IDs (1-141), with its humerus and femur IDs";
     } else {
       throw Error(source + ": cannot tell the label convention (" + std::to_string(labels.size()) +
-                  " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs): "
+                  " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs 1-141): "
                   "give --labels phantom|icrp110|totalsegmentator|FILE.csv");
     }
   } else {

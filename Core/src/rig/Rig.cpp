@@ -153,11 +153,22 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
                              {"voxels", count[std::size_t(v)]},
                              {"volume_ml", double(count[std::size_t(v)]) * ml}});
   }
+  nlohmann::json unknownJson = nlohmann::json::array();
+  for (const int v : out.convention.unknown) {
+    const auto r = out.convention.roles.find(v);
+    unknownJson.push_back({{"label", v},
+                           {"name", r != out.convention.roles.end() ? r->second.name : ""},
+                           {"taken_as", "soft tissue"},
+                           {"density_kg_m3", r != out.convention.roles.end()
+                                                 ? r->second.densityKgM3
+                                                 : 0.0}});
+  }
   nlohmann::json jointsJson = nlohmann::json::parse(skeletonToJson(out.skeleton))["joints"];
   nlohmann::json report = {
       {"input", source},
       {"convention", out.convention.name},
       {"detection", out.convention.detection},
+      {"unknown_labels", unknownJson},
       {"body_frame",
        {{"superior", {up.x(), up.y(), up.z()}},
         {"anterior", {ant.x(), ant.y(), ant.z()}},

@@ -5,6 +5,7 @@
 
 #include "repose/io/VolumeIO.h"
 #include "repose/phantom/Phantom.h"
+#include "repose/volume/DistanceTransform.h"
 #include "repose/util/Error.h"
 
 #include <gtest/gtest.h>
@@ -323,6 +324,69 @@ TEST(Phantom, HandsClearOfTheHipsByDefaultAndPressedAgainstThemWhenTouching) {
     EXPECT_GE(contacts[1], 4) << voxel << " mm";
     EXPECT_NEAR(contacts[0], contacts[1], 0.1 * contacts[0] + 2);
   }
+}
+
+// The gap variant (`repose phantom --arms-resting --gap-mm HAND,FOREARM`): the near contacts of
+// real reference phantoms. Measured on the voxels, on an isotropic grid and on thick slices: no
+// hand voxel touches a thigh or the trunk, the nearest hand and thigh voxel centres lie the hand's
+// gap apart (within two voxels beyond it), and the forearm beyond its elbow end keeps its gap from
+// the trunk and hips; the upper arm still rests on the chest wall.
+TEST(Phantom, TheGapVariantHoldsHandsAndForearmsOffTheBodyByTheirGaps) {
+  for (const Eigen::Vector3d spacing : {Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(1.8, 1.8, 4.8)}) {
+    PhantomOptions o;
+    o.spacingMm = spacing;
+    o.armsResting = true;
+    o.handGapMm = 4;
+    o.forearmGapMm = 15;
+    const Phantom phantom(o);
+    const auto [G, S] = phantom.makeVolumes();
+    const auto& d = S.dims();
+    const auto* s = S.data<std::uint8_t>();
+    const std::size_t n = std::size_t(S.numVoxels());
+    auto distanceTo = [&](auto pick) {
+      std::vector<std::uint8_t> mask(n);
+      for (std::size_t i = 0; i < n; ++i) mask[i] = pick(int(s[i]));
+      return squaredDistanceToMask(mask, d, spacing);
+    };
+    const std::vector<float> toThigh = distanceTo([](int p) {
+      return p == kPartThighLeft || p == kPartThighRight;
+    });
+    const std::vector<float> toTrunkOrThigh = distanceTo(isTorsoOrThigh);
+    const std::vector<float> toTorso = distanceTo([](int p) { return p == kPartTorso; });
+    for (const bool left : {true, false}) {
+      const std::string side = left ? "_left" : "_right";
+      const int hand = left ? kPartHandLeft : kPartHandRight;
+      const int forearm = left ? kPartForearmLeft : kPartForearmRight;
+      const int upper = left ? kPartUpperArmLeft : kPartUpperArmRight;
+      const Eigen::Vector3d elbow = phantom.joint("elbow" + side).ras;
+      const Eigen::Vector3d wrist = phantom.joint("wrist" + side).ras;
+      double handThigh = 1e300, handBody = 1e300, forearmBody = 1e300, upperTorso = 1e300;
+      for (std::size_t i = 0; i < n; ++i) {
+        if (s[i] == hand) {
+          handThigh = std::min(handThigh, std::sqrt(double(toThigh[i])));
+          handBody = std::min(handBody, std::sqrt(double(toTrunkOrThigh[i])));
+        } else if (s[i] == forearm) {
+          const Eigen::Vector3d p = S.geometry().voxelToRas(
+              double(std::int64_t(i) % d[0]), double((std::int64_t(i) / d[0]) % d[1]),
+              double(std::int64_t(i) / (d[0] * d[1])));
+          if ((p - elbow).dot(wrist - elbow) > 0.15 * (wrist - elbow).squaredNorm())
+            forearmBody = std::min(forearmBody, std::sqrt(double(toTrunkOrThigh[i])));
+        } else if (s[i] == upper) {
+          upperTorso = std::min(upperTorso, std::sqrt(double(toTorso[i])));
+        }
+      }
+      const double voxel = spacing.maxCoeff();
+      EXPECT_GE(handThigh, 4.0) << side << " " << spacing.transpose();
+      EXPECT_LE(handThigh, 4.0 + 2 * voxel) << side << " " << spacing.transpose();
+      EXPECT_GE(handBody, 4.0) << side;
+      EXPECT_GE(forearmBody, 15.0 - 1e-9) << side << " " << spacing.transpose();
+      EXPECT_LE(forearmBody, 15.0 + 2 * voxel + 6) << side << " " << spacing.transpose();
+      EXPECT_LE(upperTorso, 1.05 * spacing.minCoeff()) << side;  // touching
+    }
+  }
+  PhantomOptions bad;
+  bad.handGapMm = 3;
+  EXPECT_THROW(Phantom{bad}, Error);  // gaps belong to the arms-resting posture
 }
 
 TEST(Phantom, SlabsAndPointsAgreeWithTheWholeVolume) {

@@ -277,3 +277,83 @@ TEST(Rig, AnUnnamedBodyPartMapIsNamedByTheRigsConventionOnlyWhenItFits) {
   EXPECT_EQ(nameBodyPartsByRigConvention(named, "S.nrrd"), "");
   EXPECT_EQ(named.labels().find(4)->name, "lower arm");
 }
+
+// A real ICRP 110 file holds organ ID 141 (the skin of its first and last slices) beside 1-140,
+// and a user's copy may carry a label of its own. Neither may cost the user the rig: auto-detection
+// takes the file for ICRP 110, 141 is ICRP's skin, and the unknown label is soft tissue, listed in
+// rig.json and named in one warning line.
+TEST(Rig, ARealIcrp110LabelSetWith141AndAnUnknownLabelRigsWithoutAnOption) {
+  PhantomOptions o;
+  o.spacingMm = Eigen::Vector3d(2.137, 2.137, 8.0);
+  o.armsResting = true;
+  o.labels = PhantomLabelling::Icrp110;
+  const Phantom phantom(o);
+  const auto [G, S] = phantom.makeVolumes();
+  const RigResult plain = rigBody(G);
+  Volume real = G;
+  std::uint8_t* g = real.data<std::uint8_t>();
+  const auto& d = real.dims();
+  // The body's first and last slices: their skin (IDs 122-125) becomes 141, as in ICRP's files.
+  std::int64_t kLo = d[2], kHi = -1;
+  for (std::int64_t i = 0; i < real.numVoxels(); ++i)
+    if (g[i]) kLo = std::min(kLo, i / (d[0] * d[1])), kHi = std::max(kHi, i / (d[0] * d[1]));
+  ASSERT_LT(kLo, kHi);
+  std::int64_t skin141 = 0, unknown = 0;
+  for (std::int64_t i = 0; i < real.numVoxels(); ++i) {
+    const std::int64_t k = i / (d[0] * d[1]);
+    if ((k == kLo || k == kHi) && g[i] >= 122 && g[i] <= 125) g[i] = 141, ++skin141;
+  }
+  // An ID ICRP does not have: a block of the trunk's muscle (ID 107) in the belly.
+  const Eigen::Vector3d belly = phantom.joint("spine").ras + Eigen::Vector3d(0, 40, -60);
+  for (std::int64_t i = 0; i < real.numVoxels(); ++i) {
+    const Eigen::Vector3d p = real.geometry().voxelToRas(
+        double(i % d[0]), double((i / d[0]) % d[1]), double(i / (d[0] * d[1])));
+    if (g[i] == 107 && (p - belly).norm() < 40) g[i] = 201, ++unknown;
+  }
+  ASSERT_GT(skin141, 0);
+  ASSERT_GT(unknown, 50);
+
+  for (const char* labels : {"auto", "icrp110"}) {
+    RigOptions ro;
+    ro.labels = labels;
+    ro.source = "icrp_am.nii.gz";
+    const RigResult rig = rigBody(real, ro);
+    EXPECT_EQ(rig.convention.name.rfind("icrp110", 0), 0u) << rig.convention.name;
+    EXPECT_EQ(rig.convention.unknown, std::vector<int>{201});
+    ASSERT_TRUE(rig.convention.roles.count(141));
+    EXPECT_EQ(rig.convention.roles.at(141).name, "Skin at top and bottom");
+    EXPECT_FALSE(rig.convention.roles.at(141).rigid);
+    ASSERT_TRUE(rig.convention.roles.count(201));
+    EXPECT_FALSE(rig.convention.roles.at(201).rigid);
+    EXPECT_EQ(rig.convention.roles.at(201).bone, BoneKind::None);
+    EXPECT_EQ(rig.convention.roles.at(201).region, BodyRegion::Unknown);
+    // One warning line names it, and only it.
+    int lines = 0;
+    for (const std::string& w : rig.warnings)
+      if (w.find("201") != std::string::npos) {
+        ++lines;
+        EXPECT_EQ(w.find('\n'), std::string::npos);
+        EXPECT_EQ(w.find("141"), std::string::npos) << w;
+      }
+    EXPECT_EQ(lines, 1);
+    const nlohmann::json report = nlohmann::json::parse(rig.reportJson);
+    ASSERT_EQ(report["unknown_labels"].size(), 1u);
+    EXPECT_EQ(report["unknown_labels"][0]["label"], 201);
+    EXPECT_EQ(report["unknown_labels"][0]["taken_as"], "soft tissue");
+    // The tissue table has every label, soft where unknown; the rig is the plain file's.
+    ASSERT_TRUE(rig.tissues.count(201) && rig.tissues.count(141));
+    EXPECT_FALSE(rig.tissues.at(201).rigid);
+    EXPECT_GE(agreement(plain.parts, rig.parts), 0.99);
+    for (const SkeletonJoint& j : plain.skeleton.joints) {
+      const SkeletonJoint* found = rig.skeleton.find(j.name);
+      ASSERT_NE(found, nullptr) << j.name;
+      EXPECT_LT((found->centre - j.centre).norm(), 1.0) << j.name;
+    }
+  }
+  // Labels that are mostly not ICRP IDs are still not taken for ICRP 110.
+  Volume foreign = real;
+  std::uint8_t* f = foreign.data<std::uint8_t>();
+  for (std::int64_t i = 0; i < foreign.numVoxels(); ++i)
+    if (f[i] >= 100 && f[i] <= 141) f[i] = std::uint8_t(f[i] + 100);
+  EXPECT_THROW(rigBody(foreign), Error);
+}

@@ -60,6 +60,12 @@ class JointBends {
   // screw with neither slide nor offset beyond 2% of its radius); other joints keep the blend.
   JointBendReport apply(const TransferMesh& mesh, const std::vector<RigidHandle>& frame,
                         Eigen::MatrixX3d& deformed) const;
+  // The vertices `apply` bends in this frame (of the joints that turn), marked 1 among
+  // `vertexCount`.
+  std::vector<char> zone(const std::vector<RigidHandle>& frame, Eigen::Index vertexCount) const;
+  // The tets whose centre lies within the reach of a joint that turns in this frame, whatever
+  // their vertices (the soft tissue between two bone ends, every vertex on a bone, among them).
+  std::vector<char> reachTets(const TransferMesh& mesh, const std::vector<RigidHandle>& frame) const;
 
  private:
   struct Joint {
@@ -67,6 +73,8 @@ class JointBends {
     int proximalGroup = -1, distalGroup = -1;
     std::vector<int> vertices;
   };
+  // Whether the joint turns about its centre in this frame (what apply bends), and the turn.
+  bool turns(const Joint& j, const std::vector<RigidHandle>& frame) const;
   std::vector<Joint> joints_;
 };
 

@@ -30,6 +30,11 @@ struct PhantomOptions {
   // hands on the thighs, the thighs touch; the long bones are cortical shells around marrow and
   // blood vessels of a few millimetres run through the limbs (labels 28-34).
   bool armsResting = false;
+  // With armsResting, the near contacts of real reference phantoms instead of contacts: each hand
+  // stands handGapMm off its thigh and each forearm forearmGapMm off the trunk and hip (the upper
+  // arm still rests on the chest wall). Across these gaps the body's surfaces do not blend, so
+  // the air between stays air however thin. Zero: the hands and forearms press on the body.
+  double handGapMm = 0, forearmGapMm = 0;
   PhantomLabelling labels = PhantomLabelling::Phantom;
   double marginMm = 10.0;  // empty border around the body
   int threads = 0;         // 0: all cores

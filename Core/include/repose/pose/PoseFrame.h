@@ -29,6 +29,16 @@ LabelMapFiles labelMapFilesFor(const std::string& choice, const std::string& inp
 // colour tables beside NIfTI): what a report of that format lists among its outputs.
 std::vector<std::string> labelMapFileNames(LabelMapFiles files);
 
+// docs/QUALITY.md's targets the report holds a frame to: the whole body within 0.5 %, every label
+// of >= 1000 voxels and every body part the posed mesh predicts within 1 %.
+constexpr double kBodyTargetPercent = 0.5;
+constexpr double kLabelTargetPercent = 1.0;
+
+// The exit status of `repose pose` and `repose sweep` when every frame was written but some
+// missed a target (report.json's "targets"): scripts tell it from success (0), an error (1), a
+// usage error (2), a sweep whose jobs failed (3) and a cancel (130).
+constexpr int kExitTargetsMissed = 4;
+
 struct PoseFrameOptions {
   const Volume* image = nullptr;  // on G's grid, posed alongside (trilinear)
   // The image's value where no tissue is; unset: imageBackground(*image).

@@ -50,11 +50,12 @@ struct PoseSeparations {
   bool automaticOn = false;
   std::string reportJson() const;  // report.json's "separations"
 };
+// The automatic ones are found within contactReachMm of the rig's cage (settings' dilation).
 PoseSeparations poseSeparations(const Pose& pose, const Volume& parts, const Skeleton* skeleton,
-                                bool automatic);
+                                bool automatic, const RigSettings& settings = {});
 
 // The joints whose two body parts the pose moves with different groups (not both fixed): the
-// balls where the rig's transfer mesh is made finer (RigSettings::refineJoints), tets of a third
+// balls where the rig's transfer mesh is made finer (RigSettings::refineJoints), tets of a sixth
 // of the joint's radius_mm (at least two voxels) within 1.5 radii of its centre.
 std::vector<JointRefinement> jointRefinements(const Pose& pose, const Volume& parts,
                                               const Skeleton* skeleton);
@@ -78,6 +79,8 @@ struct PoseJobRequest {
                          // the rigid labels and the joints' refinement
   int jointRings = -1;   // -1: the pose file's
   bool autoSeparate = true;
+  // Restore the soft tissue's volume after each frame's solve (VolumeRestoration.h).
+  bool volumeRestoration = true;
   // What G's reader decided (ReadOptions::note: a DICOM SEG's grid, a fractional SEG
   // thresholded), kept in every report of the job as "input_notes".
   std::vector<std::string> organsNotes;

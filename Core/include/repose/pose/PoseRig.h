@@ -6,6 +6,7 @@
 
 #include "repose/cage/CageBuilder.h"
 #include "repose/mesh/JointBend.h"
+#include "repose/mesh/VolumeRestoration.h"
 #include "repose/mesh/Refinement.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
@@ -123,6 +124,8 @@ class PoseRig {
     Eigen::MatrixX3d cage;                 // posed cage vertices
     Eigen::MatrixX3d deformed;             // posed TM vertices
     std::vector<Eigen::Matrix3d> tetMaps;  // B_t of every tet (empty with FrameMaps::Without)
+    // What the volume restoration did (nothing in a live frame, or when it is off).
+    VolumeRestorationReport restoration;
   };
   std::size_t frameCount() const { return frames_.size(); }
   const std::string& frameName(std::size_t index) const { return frames_.at(index).first; }
@@ -157,6 +160,17 @@ class PoseRig {
   const std::vector<RigidHandle>& handles() const { return handles_; }
   const HandleInfluence& influence() const { return influence_; }
   const Pose& pose() const { return pose_; }
+  // Whether frame() restores the soft tissue's volumes after the solve and the bends
+  // (VolumeRestoration.h; on by default). Live frames never do: they are previews.
+  void setVolumeRestoration(bool on) { restoreVolumes_ = on; }
+  bool volumeRestoration() const { return restoreVolumes_; }
+  // The restoration frame() applies, on posed vertices of this rig's mesh solved elsewhere (a
+  // live frame, to predict what its export will measure) with the frame's handles (their
+  // motions say which joints bend). It acts in the joints' bends only, the soft tissue the bends
+  // place and one ring of tets around them: tissue dragged along elsewhere (two parts tied along
+  // a contact no cut freed) keeps the volume change that says so. Nothing when it is off.
+  VolumeRestorationReport restoreFrameVolumes(Eigen::MatrixX3d& deformed,
+                                              const std::vector<RigidHandle>& handles) const;
 
  private:
   enum class CageStart { Rest, LastLiveFrame };
@@ -176,6 +190,8 @@ class PoseRig {
   std::vector<RigidHandle> handles_;
   HandleInfluence influence_;
   JointBends bends_;
+  std::vector<char> movable_;  // per TM vertex: not a whole piece's
+  bool restoreVolumes_ = true;
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames_;
 };
 

@@ -54,13 +54,18 @@ struct LabelConvention {
   std::string name;                // "phantom", "icrp110 (AF)", "totalsegmentator", "FILE.csv"
   std::string detection;           // how it was chosen (for the report)
   std::map<int, LabelRole> roles;  // per label value present in G
+  // Labels present in G that the convention does not know: soft tissue, not rigid, of no body
+  // region (a label is never a reason to refuse G); rig.json lists them and notes says so.
+  std::vector<int> unknown;
   std::vector<std::string> notes;  // labels it did not know, density sources
 };
 
 // `requested`: "auto", "phantom", "icrp110", "totalsegmentator" or a CSV path
 // (`label,bone[,side][,name][,density_kg_m3]` with a header; bone one of boneKindName's names,
-// side left/right). Throws repose::Error with a one-line message when the convention cannot be
-// told ("auto") or does not fit G.
+// side left/right). "auto" takes G for ICRP 110 when nearly all its labels are organ IDs 1-141
+// (unnamed, or named as ICRP names them) with the humeri's and femora's among them. Labels a
+// convention does not know become soft tissue (LabelConvention::unknown), never an error.
+// Throws repose::Error with a one-line message when the convention cannot be told ("auto").
 LabelConvention labelConvention(const Volume& organs, const std::string& requested,
                                 const std::string& source);
 

@@ -1,0 +1,63 @@
+// Soft tissue keeps its volume: a posed transfer mesh relaxed so that every body part has its rest
+// volume again, and every tet as nearly as the mesh allows.
+//
+// A joint's transition is made of blended rigid motions and analytic bends (RigidHandles.h,
+// JointBend.h). The bend keeps volume in the continuum, but the mesh samples it coarsely, the bend
+// fades into the blend at its reach, and the soft tets between two bone ends follow two rigid
+// pieces that disagree: at a 90-degree elbow the forearm's mesh lost 1.7 % of its volume, which no
+// rounding of the voxels can give back to the tissue it belongs to. Flesh is nearly
+// incompressible (Poisson's ratio about 0.49), so the restoration moves the soft vertices of the
+// transitions (never a whole piece's: bones stay exactly rigid) by the smallest smooth correction
+// that gives each body part of S its rest volume exactly and each tet its own as nearly as the
+// mesh allows: the inner side of a bend bulges, as flesh does. Only the tets the correction can
+// reach count: a part's volume changed elsewhere (tissue dragged along a contact no cut freed)
+// is left for the report to show.
+//
+// Gauss-Newton on the tets' volumes: each round linearises every tet's volume in its free
+// vertices and minimises sum_t (dV_t)^2 / V0_t + lambda * sum_edges |corr_a - corr_b|^2 (the
+// correction kept smooth along the mesh's edges) subject to every touched part's linearised
+// volume, over the tets with a free vertex, equal to its rest volume (Lagrange multipliers: one sparse Cholesky factorisation and a
+// small dense system per round).
+#pragma once
+
+#include "repose/mesh/TransferMesh.h"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace repose {
+
+struct VolumeRestorationOptions {
+  int iterations = 5;
+  // Tets whose posed volume differs from their rest volume by more than this fraction free their
+  // vertices, and `rings` rings of neighbours around them, for the correction.
+  double tolerance = 1e-3;
+  int rings = 2;
+  // Weight of the correction's smoothness against the tets' volumes (scaled by the mean rest
+  // volume over the mean squared edge length of the free region, so it does not depend on the
+  // mesh's size).
+  double smoothness = 0.01;
+};
+
+struct VolumeRestorationReport {
+  int freeVertices = 0;
+  int parts = 0;                 // body parts whose volume was held
+  double maxCorrectionMm = 0;    // the largest distance a vertex was moved
+  double worstPartBefore = 0;    // the largest |volume change| of a part, percent
+  double worstPartAfter = 0;
+  int invertedBefore = 0, invertedAfter = 0;
+};
+
+// `movable[v]`: whether vertex v may be moved at all (the soft tissue of the joints' bends; never
+// a vertex of a whole piece, which must stay rigid). Modifies `deformed` (the posed vertices, RAS mm) in place. Parts whose tets all
+// keep their volume within the tolerance are left as they are.
+// `held[t]` (optional, one per tet): the tets whose volumes each part's constraint sums besides
+// those the correction reaches (the soft tets between two bone ends, which no free vertex can
+// reach: the tissue around them makes up for them). Empty: only the reached tets.
+VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vector<char>& movable,
+                                       Eigen::MatrixX3d& deformed,
+                                       const VolumeRestorationOptions& options = {},
+                                       const std::vector<char>& held = {});
+
+}  // namespace repose

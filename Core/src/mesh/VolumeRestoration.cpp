@@ -1,0 +1,220 @@
+// restoreVolumes: Gauss-Newton on the tets' volumes with every touched body part's volume held
+// exactly (VolumeRestoration.h).
+#include "repose/mesh/VolumeRestoration.h"
+
+#include "numerics/SparseCholesky.h"
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+
+namespace repose {
+namespace {
+
+// d(volume)/d(vertex k) of the tet with corners x[0..3]: the gradient of det[b-a, c-a, d-a] / 6.
+std::array<Eigen::Vector3d, 4> volumeGradients(const std::array<Eigen::Vector3d, 4>& x) {
+  const Eigen::Vector3d b = x[1] - x[0], c = x[2] - x[0], d = x[3] - x[0];
+  std::array<Eigen::Vector3d, 4> g;
+  g[1] = c.cross(d) / 6;
+  g[2] = d.cross(b) / 6;
+  g[3] = b.cross(c) / 6;
+  g[0] = -(g[1] + g[2] + g[3]);
+  return g;
+}
+
+double volumeOf(const std::array<Eigen::Vector3d, 4>& x) {
+  return (x[1] - x[0]).cross(x[2] - x[0]).dot(x[3] - x[0]) / 6;
+}
+
+}  // namespace
+
+VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vector<char>& movable,
+                                       Eigen::MatrixX3d& deformed,
+                                       const VolumeRestorationOptions& options,
+                                       const std::vector<char>& held) {
+  VolumeRestorationReport report;
+  const Eigen::Index nv = mesh.vertices.rows(), nt = mesh.tets.rows();
+  auto corners = [&](const Eigen::MatrixX3d& x, Eigen::Index t) {
+    std::array<Eigen::Vector3d, 4> c;
+    for (int k = 0; k < 4; ++k) c[std::size_t(k)] = x.row(mesh.tets(t, k)).transpose();
+    return c;
+  };
+  std::vector<double> rest(static_cast<std::size_t>(nt)), posed(static_cast<std::size_t>(nt));
+  std::map<int, std::pair<double, double>> partVolume;  // label -> (rest, posed)
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    rest[std::size_t(t)] = volumeOf(corners(mesh.vertices, t));
+    posed[std::size_t(t)] = volumeOf(corners(deformed, t));
+    auto& p = partVolume[mesh.labels[t]];
+    p.first += rest[std::size_t(t)], p.second += posed[std::size_t(t)];
+    report.invertedBefore += posed[std::size_t(t)] < 0;
+  }
+  for (const auto& [label, v] : partVolume)
+    if (v.first > 0)
+      report.worstPartBefore =
+          std::max(report.worstPartBefore, std::fabs(100 * (v.second / v.first - 1)));
+  report.worstPartAfter = report.worstPartBefore;
+  report.invertedAfter = report.invertedBefore;
+
+  // Free vertices: those of tets off their volume, grown by `rings`, that may move.
+  std::vector<char> free(std::size_t(nv), 0);
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (std::fabs(posed[std::size_t(t)] / rest[std::size_t(t)] - 1) > options.tolerance)
+      for (int k = 0; k < 4; ++k) free[std::size_t(mesh.tets(t, k))] = 1;
+  for (int ring = 0; ring < options.rings; ++ring) {
+    std::vector<char> grown = free;
+    for (Eigen::Index t = 0; t < nt; ++t) {
+      bool any = false;
+      for (int k = 0; k < 4; ++k) any = any || free[std::size_t(mesh.tets(t, k))];
+      if (any)
+        for (int k = 0; k < 4; ++k) grown[std::size_t(mesh.tets(t, k))] = 1;
+    }
+    free.swap(grown);
+  }
+  std::vector<int> index(std::size_t(nv), -1);
+  int n = 0;
+  for (Eigen::Index v = 0; v < nv; ++v)
+    if (free[std::size_t(v)] && movable[std::size_t(v)]) index[std::size_t(v)] = n++;
+  report.freeVertices = n;
+  if (n == 0) return report;
+
+  // The tets a free vertex touches, and the parts they belong to (each held at its rest volume).
+  std::vector<Eigen::Index> active;
+  std::map<int, int> partRow;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    bool any = false;
+    for (int k = 0; k < 4; ++k) any = any || index[std::size_t(mesh.tets(t, k))] >= 0;
+    if (!any) continue;
+    active.push_back(t);
+    partRow.try_emplace(mesh.labels[t], int(partRow.size()));
+  }
+  report.parts = int(partRow.size());
+  // The tets each part's constraint sums: the reached ones, and those held besides (of the parts
+  // reached).
+  std::vector<Eigen::Index> summed = active;
+  if (!held.empty()) {
+    std::vector<char> isActive(std::size_t(nt), 0);
+    for (const Eigen::Index t : active) isActive[std::size_t(t)] = 1;
+    for (Eigen::Index t = 0; t < nt; ++t)
+      if (held[std::size_t(t)] && !isActive[std::size_t(t)] && partRow.count(mesh.labels[t]))
+        summed.push_back(t);
+  }
+  // Edges with a free end: the correction's smoothness.
+  std::vector<std::pair<int, int>> edges;
+  {
+    std::vector<std::pair<int, int>> all;
+    for (const Eigen::Index t : active)
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          int u = mesh.tets(t, a), w = mesh.tets(t, b);
+          if (u > w) std::swap(u, w);
+          all.emplace_back(u, w);
+        }
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+    edges = std::move(all);
+  }
+  double meanRest = 0, meanEdge2 = 0;
+  for (const Eigen::Index t : active) meanRest += rest[std::size_t(t)];
+  meanRest /= double(active.size());
+  for (const auto& [a, b] : edges) meanEdge2 += (mesh.vertices.row(a) - mesh.vertices.row(b)).squaredNorm();
+  meanEdge2 /= double(std::max<std::size_t>(1, edges.size()));
+  const double lambda = options.smoothness * meanRest / std::max(1e-12, meanEdge2);
+
+  const Eigen::MatrixX3d start = deformed;
+  const int unknowns = 3 * n, constraints = int(partRow.size());
+  for (int round = 0; round < options.iterations; ++round) {
+    std::vector<Eigen::Triplet<double>> triplets;
+    triplets.reserve(active.size() * 78 + edges.size() * 12 + std::size_t(unknowns));
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns);
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(unknowns, constraints);  // columns: parts' gradients
+    Eigen::VectorXd partResidual = Eigen::VectorXd::Zero(constraints);
+    // Each part's volume over the tets the correction reaches: a change elsewhere in the part
+    // (tissue dragged along a contact) is not made up for here.
+    for (const Eigen::Index t : summed)
+      partResidual[partRow.at(mesh.labels[t])] +=
+          volumeOf(corners(deformed, t)) - rest[std::size_t(t)];
+    for (const Eigen::Index t : active) {
+      const auto x = corners(deformed, t);
+      const auto g = volumeGradients(x);
+      const double r = volumeOf(x) - rest[std::size_t(t)];
+      const double w = 1 / rest[std::size_t(t)];
+      const int column = partRow.at(mesh.labels[t]);
+      for (int a = 0; a < 4; ++a) {
+        const int ia = index[std::size_t(mesh.tets(t, a))];
+        if (ia < 0) continue;
+        for (int c = 0; c < 3; ++c) {
+          rhs[3 * ia + c] -= w * r * g[std::size_t(a)][c];
+          C(3 * ia + c, column) += g[std::size_t(a)][c];
+        }
+        for (int b = 0; b < 4; ++b) {
+          const int ib = index[std::size_t(mesh.tets(t, b))];
+          if (ib < 0) continue;
+          for (int c = 0; c < 3; ++c)
+            for (int e = 0; e < 3; ++e)
+              triplets.emplace_back(3 * ia + c, 3 * ib + e,
+                                    w * g[std::size_t(a)][c] * g[std::size_t(b)][e]);
+        }
+      }
+    }
+    // Smoothness of the whole correction so far (deformed - start), edge by edge.
+    for (const auto& [u, w] : edges) {
+      const int iu = index[std::size_t(u)], iw = index[std::size_t(w)];
+      const Eigen::Vector3d du = deformed.row(u) - start.row(u), dw = deformed.row(w) - start.row(w);
+      const Eigen::Vector3d diff = du - dw;
+      for (int c = 0; c < 3; ++c) {
+        if (iu >= 0) {
+          triplets.emplace_back(3 * iu + c, 3 * iu + c, lambda);
+          rhs[3 * iu + c] -= lambda * diff[c];
+        }
+        if (iw >= 0) {
+          triplets.emplace_back(3 * iw + c, 3 * iw + c, lambda);
+          rhs[3 * iw + c] += lambda * diff[c];
+        }
+        if (iu >= 0 && iw >= 0) {
+          triplets.emplace_back(3 * iu + c, 3 * iw + c, -lambda);
+          triplets.emplace_back(3 * iw + c, 3 * iu + c, -lambda);
+        }
+      }
+    }
+    for (int i = 0; i < unknowns; ++i) triplets.emplace_back(i, i, 1e-9 * lambda + 1e-12);
+    Eigen::SparseMatrix<double> A(unknowns, unknowns);
+    A.setFromTriplets(triplets.begin(), triplets.end());
+    SparseCholesky llt;
+    llt.factorize(A, "the volume restoration");
+    // min 1/2 d'Ad - rhs'd  subject to  C'd = -partResidual.
+    Eigen::MatrixXd B(unknowns, constraints + 1);
+    B.col(0) = rhs;
+    B.rightCols(constraints) = C;
+    const Eigen::MatrixXd S = llt.solve(B);  // A^-1 rhs, A^-1 C
+    const Eigen::MatrixXd schur = C.transpose() * S.rightCols(constraints);
+    const Eigen::VectorXd mu =
+        schur.ldlt().solve(C.transpose() * S.col(0) + partResidual);
+    const Eigen::VectorXd delta = S.col(0) - S.rightCols(constraints) * mu;
+    for (Eigen::Index v = 0; v < nv; ++v) {
+      const int i = index[std::size_t(v)];
+      if (i >= 0) deformed.row(v) += Eigen::RowVector3d(delta[3 * i], delta[3 * i + 1], delta[3 * i + 2]);
+    }
+  }
+
+  std::map<int, std::pair<double, double>> after;
+  report.invertedAfter = 0;
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    const double v = volumeOf(corners(deformed, t));
+    auto& p = after[mesh.labels[t]];
+    p.first += rest[std::size_t(t)], p.second += v;
+    report.invertedAfter += v < 0;
+  }
+  report.worstPartAfter = 0;
+  for (const auto& [label, v] : after)
+    if (v.first > 0)
+      report.worstPartAfter = std::max(report.worstPartAfter, std::fabs(100 * (v.second / v.first - 1)));
+  for (Eigen::Index v = 0; v < nv; ++v)
+    report.maxCorrectionMm = std::max(report.maxCorrectionMm, (deformed.row(v) - start.row(v)).norm());
+  return report;
+}
+
+}  // namespace repose
