@@ -193,7 +193,7 @@ void vtkSlicerReposeLogic::OnLivePoseModified() {
     this->Modified();
     return;
   }
-  if (!repose::sameHandleGroups(*pose, this->Live->Rig->pose())) {
+  if (!repose::sameHandleGroups(*pose, this->Live->Rig->userPose())) {
     if (!this->StartLivePose(this->Live->Pose)) this->Modified();
     return;
   }

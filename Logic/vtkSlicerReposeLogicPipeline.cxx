@@ -225,7 +225,9 @@ bool vtkSlicerReposeLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
     // The job decides what `repose pose` decides: joints, separations (the pose's and the
     // automatic ones), whole pieces, the joints' finer tets.
     const std::shared_ptr<const repose::PoseJob> job = this->PoseJobFor(seg, named, *G, *parts);
-    const repose::Pose pose = job->pose();
+    // The user's pose (without the groups the girdles' and pelvis's rhythms add when the rig
+    // solves: those follow the user's turns, they are not edited).
+    const repose::Pose pose = job->userPose();
     if (repose::poseNamesJoints(named))
       poseNode->SetPoseJSON(repose::poseToJson(pose));  // the rig's pose, in numbers
     const repose::RigSettings settings = job->settings();

@@ -354,7 +354,7 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
                                  names.push_back(r.rig->frameName(i));
                                return names;
                              })
-      .def_property_readonly("pose", [](const Rig& r) { return r.rig->pose(); })
+      .def_property_readonly("pose", [](const Rig& r) { return r.rig->userPose(); })
       .def_property_readonly(
           "cage_vertices", [](const Rig& r) { return verticesOf(r.rig->cage().vertices); },
           "Rest cage vertices (n x 3, RAS mm).")

@@ -6,7 +6,9 @@ from each frame's report.json:
   body volume within +-0.5 %; every label of >= 1000 voxels within +-1 % beyond its resampling
   floor; each bone (all its labels) Dice >= 0.95; no new holes; no label lost; and no two bones
   run into each other (issue 21: with the rig's joint centres the standard poses must not
-  collide).
+  collide). With `--gap-mm` (hands and forearms held off the body) a moving hand must be cut from
+  its thigh across the gap; `arms_up160` must turn both shoulder girdles and `sitting` tilt the
+  pelvis (the rhythms of docs/POSES.md).
 
 usage: pose_suite_quality.py BIN_DIR POSES_DIR WORK_DIR [phantom options...]
        [--label-bound PERCENT]  the per-label bound beyond the floor (default 1, the target)
@@ -49,6 +51,7 @@ def main():
         del argv[i:i + 2]
     bin_dir, poses, work = argv[:3]
     phantom_args = argv[3:]
+    gap_variant = "--gap-mm" in phantom_args
     repose = os.path.join(bin_dir, "repose")
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
@@ -104,6 +107,17 @@ def main():
             seps = f["separations"]
             if not seps.get("automatic") or not seps.get("made"):
                 failures.append(f"{where}: no automatic contact separation was made")
+            # The gap variant: a hand that moves is cut from the thigh it hangs beside, across
+            # the air between them, and both arms up and sitting turn the girdles and the pelvis.
+            made = [set(m["parts"]) for m in seps.get("made", [])]
+            if gap_variant and name in ("elbow90", "arm_raise90", "arms_up160"):
+                if {"hand_left", "thigh_left"} not in made:
+                    failures.append(f"{where}: the left hand was not cut from its thigh")
+            applied = " ".join(f.get("rhythms", {}).get("applied", []))
+            if name == "arms_up160" and applied.count("scapulohumeral rhythm") != 2:
+                failures.append(f"{where}: the shoulder girdles did not turn with the arms")
+            if name == "sitting" and "lumbopelvic rhythm" not in applied:
+                failures.append(f"{where}: the pelvis did not tilt with the thighs")
             # The posed mesh's own prediction: the body and every body part keep their volume.
             pred = q["prediction_within_targets"]
             if not pred["met"]:

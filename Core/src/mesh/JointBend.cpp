@@ -86,9 +86,13 @@ JointBends::JointBends(const TransferMesh& mesh, const std::vector<RigidHandle>&
       continue;
     // A vertex where the two parts meet belongs to both: its tets' parts are then mixed (-1), so
     // it is recognised by having only these two parts around it.
+    std::vector<int> proximal{j.proximalPart};
+    for (const int p : j.proximalAlso)
+      if (groupOf(p) == out.proximalGroup) proximal.push_back(p);
     std::vector<char> mixedOk(std::size_t(nv), 1);
     for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
-      if (mesh.labels[t] != j.proximalPart && mesh.labels[t] != j.distalPart)
+      if (mesh.labels[t] != j.distalPart &&
+          std::find(proximal.begin(), proximal.end(), mesh.labels[t]) == proximal.end())
         for (int k = 0; k < 4; ++k) mixedOk[std::size_t(mesh.tets(t, k))] = 0;
     const double reach = j.radiusMm * std::max(j.proximalReach, j.distalReach);
     for (Eigen::Index v = 0; v < nv; ++v) {

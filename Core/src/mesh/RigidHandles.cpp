@@ -34,12 +34,14 @@ std::vector<int> cageOwners(Eigen::Index cageVertices, const std::vector<RigidHa
 }
 
 // Bones move as whole pieces. Each piece of rigid tissue (tets of one bone label connected
-// through faces: a humerus, not the humerus and the scapula it touches) is given to the
+// through faces: a humerus, not the humerus and the scapula it touches) is given to the group
+// that selects its body part, else (a piece across parts, or groups of cage vertices) to the
 // group that carries most of it (tet volume times the mean membership of the tet's vertices), and
 // every vertex of the piece takes that group alone. A vertex shared by pieces given to different
 // groups (where two bones touch across a joint) splits evenly between them. The bend of a joint
 // then happens in the soft tissue around the bones, never through a bone end.
-void lockRigidTissue(const TransferMesh& mesh, Eigen::MatrixXd& membership) {
+void lockRigidTissue(const TransferMesh& mesh, const std::vector<RigidHandle>& handles,
+                     Eigen::MatrixXd& membership) {
   const Eigen::Index nt = mesh.tets.rows(), groups = membership.cols();
   const TetAdjacency adjacency = TetAdjacency::build(mesh);
   std::vector<int> piece(std::size_t(nt), -1);
@@ -64,10 +66,23 @@ void lockRigidTissue(const TransferMesh& mesh, Eigen::MatrixXd& membership) {
     for (int k = 0; k < 4; ++k) mean += membership.row(mesh.tets(t, k));
     vote.row(piece[t]) += std::fabs(tetVolume(mesh.vertices, mesh.tets.row(t))) * mean / 4;
   }
+  // A piece lying in one body part goes with the group that selects that part: a thin bone
+  // in a small part (a clavicle in its girdle) is mostly surrounded by its neighbours' tissue,
+  // and with widened joints their memberships would outvote its own part's group.
+  std::vector<int> onlyPart(std::size_t(pieces), 0);  // its one part, -1 for several
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    if (piece[t] < 0) continue;
+    int& p = onlyPart[std::size_t(piece[t])];
+    p = p == 0 ? mesh.labels[t] : (p == mesh.labels[t] ? p : -1);
+  }
   std::vector<int> carrier(std::size_t(pieces), -1);
   for (int b = 0; b < pieces; ++b) {
+    for (std::size_t g = 0; g < handles.size() && onlyPart[std::size_t(b)] > 0; ++g)
+      if (std::find(handles[g].parts.begin(), handles[g].parts.end(), onlyPart[std::size_t(b)]) !=
+          handles[g].parts.end())
+        carrier[std::size_t(b)] = int(g);
     Eigen::Index g = 0;
-    if (vote.row(b).maxCoeff(&g) > 0) carrier[b] = int(g);
+    if (carrier[std::size_t(b)] < 0 && vote.row(b).maxCoeff(&g) > 0) carrier[std::size_t(b)] = int(g);
   }
   Eigen::MatrixXd locked = Eigen::MatrixXd::Zero(membership.rows(), groups);
   for (Eigen::Index t = 0; t < nt; ++t)
@@ -246,7 +261,32 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
       membership = count.cwiseInverse().asDiagonal() * sum;
     }
   }
-  if (!mesh.rigid.empty()) lockRigidTissue(mesh, membership);
+  // A group's own widening: its transitions only, averaged over more rings, where the group or
+  // a neighbour carries a vertex.
+  int widest = 0;
+  for (const RigidHandle& h : handles) widest = std::max(widest, h.widen);
+  if (widest > 0) {
+    const TetAdjacency adjacency = TetAdjacency::build(mesh);
+    for (int ring = 0; ring < widest; ++ring) {
+      std::vector<char> near(std::size_t(n), 0);
+      for (std::size_t g = 0; g < handles.size(); ++g) {
+        if (handles[g].widen <= ring) continue;
+        for (Eigen::Index v = 0; v < n; ++v) near[std::size_t(v)] |= membership(v, Eigen::Index(g)) > 0;
+      }
+      std::vector<char> grown = near;
+      for (const auto& [i, j] : adjacency.edges)
+        if (near[std::size_t(i)] || near[std::size_t(j)]) grown[std::size_t(i)] = grown[std::size_t(j)] = 1;
+      Eigen::MatrixXd sum = membership;
+      Eigen::VectorXd count = Eigen::VectorXd::Ones(n);
+      for (const auto& [i, j] : adjacency.edges) {
+        sum.row(i) += membership.row(j), sum.row(j) += membership.row(i);
+        count[i] += 1, count[j] += 1;
+      }
+      for (Eigen::Index v = 0; v < n; ++v)
+        if (grown[std::size_t(v)]) membership.row(v) = sum.row(v) / count[v];
+    }
+  }
+  if (!mesh.rigid.empty()) lockRigidTissue(mesh, handles, membership);
   // Memberships in [0, 1] summing to at most 1 (a part named by two groups counts once).
   for (Eigen::Index v = 0; v < n; ++v) {
     auto row = membership.row(v);

@@ -35,7 +35,8 @@ double volumeOf(const std::array<Eigen::Vector3d, 4>& x) {
 VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vector<char>& movable,
                                        Eigen::MatrixX3d& deformed,
                                        const VolumeRestorationOptions& options,
-                                       const std::vector<char>& held) {
+                                       const std::vector<char>& held,
+                                       const TetTissues* tissues) {
   VolumeRestorationReport report;
   const Eigen::Index nv = mesh.vertices.rows(), nt = mesh.tets.rows();
   auto corners = [&](const Eigen::MatrixX3d& x, Eigen::Index t) {
@@ -123,32 +124,97 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
   for (const auto& [a, b] : edges) meanEdge2 += (mesh.vertices.row(a) - mesh.vertices.row(b)).squaredNorm();
   meanEdge2 /= double(std::max<std::size_t>(1, edges.size()));
   const double lambda = options.smoothness * meanRest / std::max(1e-12, meanEdge2);
+  // Each free vertex's shortest rest edge: how far one round may move it.
+  std::vector<double> shortest(std::size_t(n), 1e300);
+  for (const auto& [a, b] : edges) {
+    const double length = (mesh.vertices.row(a) - mesh.vertices.row(b)).norm();
+    for (const int v : {a, b})
+      if (index[std::size_t(v)] >= 0)
+        shortest[std::size_t(index[std::size_t(v)])] =
+            std::min(shortest[std::size_t(index[std::size_t(v)])], length);
+  }
+
+  // The tissues held besides the parts: each label of G in the summed tets with enough voxels
+  // there to be counted (64: a handful of voxels would only add noise). Each constraint is scaled by
+  // its rest amount, so all say a fraction.
+  std::map<int, int> tissueRow;
+  std::vector<double> amount;  // per constraint: the part's rest volume or the tissue's voxels
+  amount.assign(partRow.size(), 0.0);
+  for (const Eigen::Index t : summed) amount[std::size_t(partRow.at(mesh.labels[t]))] += rest[std::size_t(t)];
+  if (tissues && !tissues->empty()) {
+    std::map<int, double> voxels;
+    for (const Eigen::Index t : summed)
+      for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1]; ++e)
+        voxels[tissues->entries[std::size_t(e)].first] += tissues->entries[std::size_t(e)].second;
+    for (const auto& [label, count] : voxels)
+      if (count >= 64) {
+        tissueRow[label] = int(amount.size());
+        amount.push_back(count);
+      }
+  }
+  report.tissues = int(tissueRow.size());
 
   const Eigen::MatrixX3d start = deformed;
-  const int unknowns = 3 * n, constraints = int(partRow.size());
+  const int unknowns = 3 * n, constraints = int(amount.size());
+  // The worst part's misfit (a fraction) of the positions at hand: the rounds keep the
+  // best positions they saw, so a round that goes astray (a constraint no step can meet, a tet
+  // far inside out) never leaves the mesh worse than it found it.
+  // Each constraint's volume change (mm^3) at positions x, over the tets the correction reaches:
+  // a change elsewhere in the part (tissue dragged along a contact) is not made up for here.
+  auto residual = [&](const Eigen::MatrixX3d& x) {
+    Eigen::VectorXd r = Eigen::VectorXd::Zero(constraints);
+    for (const Eigen::Index t : summed) {
+      const double change = volumeOf(corners(x, t)) - rest[std::size_t(t)];
+      r[partRow.at(mesh.labels[t])] += change;
+      if (!tissueRow.empty())
+        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1]; ++e) {
+          const auto it = tissueRow.find(tissues->entries[std::size_t(e)].first);
+          if (it != tissueRow.end())
+            r[it->second] += change / rest[std::size_t(t)] * tissues->entries[std::size_t(e)].second;
+        }
+    }
+    return r;
+  };
+  auto misfit = [&](const Eigen::MatrixX3d& x) {
+    const Eigen::VectorXd r = residual(x);
+    // The parts' rows: the tissues' follow them (a tissue whose few voxels lie in tets turned
+    // inside out may stay far off whatever a round does).
+    double worst = 0;
+    for (std::size_t c = 0; c < partRow.size(); ++c)
+      worst = std::max(worst, std::fabs(r[Eigen::Index(c)]) / amount[c]);
+    return worst;
+  };
+  Eigen::MatrixX3d best = deformed;
+  double bestMisfit = misfit(deformed);
   for (int round = 0; round < options.iterations; ++round) {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(active.size() * 78 + edges.size() * 12 + std::size_t(unknowns));
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns);
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(unknowns, constraints);  // columns: parts' gradients
-    Eigen::VectorXd partResidual = Eigen::VectorXd::Zero(constraints);
-    // Each part's volume over the tets the correction reaches: a change elsewhere in the part
-    // (tissue dragged along a contact) is not made up for here.
-    for (const Eigen::Index t : summed)
-      partResidual[partRow.at(mesh.labels[t])] +=
-          volumeOf(corners(deformed, t)) - rest[std::size_t(t)];
+    Eigen::VectorXd partResidual = residual(deformed);
+    for (int c = 0; c < constraints; ++c) partResidual[c] /= amount[std::size_t(c)];
     for (const Eigen::Index t : active) {
       const auto x = corners(deformed, t);
       const auto g = volumeGradients(x);
       const double r = volumeOf(x) - rest[std::size_t(t)];
       const double w = 1 / rest[std::size_t(t)];
       const int column = partRow.at(mesh.labels[t]);
+      // The tissues this tet holds: their constraints' gradients, voxels over the rest volume.
+      std::vector<std::pair<int, double>> carried;
+      if (!tissueRow.empty())
+        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1]; ++e) {
+          const auto it = tissueRow.find(tissues->entries[std::size_t(e)].first);
+          if (it != tissueRow.end())
+            carried.emplace_back(it->second, tissues->entries[std::size_t(e)].second /
+                                              rest[std::size_t(t)] / amount[std::size_t(it->second)]);
+        }
       for (int a = 0; a < 4; ++a) {
         const int ia = index[std::size_t(mesh.tets(t, a))];
         if (ia < 0) continue;
         for (int c = 0; c < 3; ++c) {
           rhs[3 * ia + c] -= w * r * g[std::size_t(a)][c];
-          C(3 * ia + c, column) += g[std::size_t(a)][c];
+          C(3 * ia + c, column) += g[std::size_t(a)][c] / amount[std::size_t(column)];
+          for (const auto& [row, scale] : carried) C(3 * ia + c, row) += scale * g[std::size_t(a)][c];
         }
         for (int b = 0; b < 4; ++b) {
           const int ib = index[std::size_t(mesh.tets(t, b))];
@@ -190,15 +256,32 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     B.col(0) = rhs;
     B.rightCols(constraints) = C;
     const Eigen::MatrixXd S = llt.solve(B);  // A^-1 rhs, A^-1 C
-    const Eigen::MatrixXd schur = C.transpose() * S.rightCols(constraints);
-    const Eigen::VectorXd mu =
-        schur.ldlt().solve(C.transpose() * S.col(0) + partResidual);
+    // Constraints that cannot all be met (two nearly alike, or a tissue no free vertex reaches)
+    // are met as nearly as they can: a ridge on the Schur complement.
+    Eigen::MatrixXd schur = C.transpose() * S.rightCols(constraints);
+    const double ridge = 1e-9 * std::max(1e-300, schur.diagonal().cwiseAbs().maxCoeff());
+    schur.diagonal().array() += ridge;
+    const Eigen::VectorXd mu = schur.ldlt().solve(C.transpose() * S.col(0) + partResidual);
     const Eigen::VectorXd delta = S.col(0) - S.rightCols(constraints) * mu;
+    // A linearised step is trusted only so far: no vertex moves more than its shortest rest edge
+    // in one round (a tet turned far inside out, or constraints at odds, would otherwise
+    // send a vertex across the body); the next round starts from where the vertices are.
+    double moved = 0;
     for (Eigen::Index v = 0; v < nv; ++v) {
       const int i = index[std::size_t(v)];
-      if (i >= 0) deformed.row(v) += Eigen::RowVector3d(delta[3 * i], delta[3 * i + 1], delta[3 * i + 2]);
+      if (i < 0) continue;
+      Eigen::RowVector3d d(delta[3 * i], delta[3 * i + 1], delta[3 * i + 2]);
+      const double limit = shortest[std::size_t(i)];
+      if (d.norm() > limit) d *= limit / d.norm();
+      deformed.row(v) += d;
+      moved = std::max(moved, d.norm());
     }
+    report.iterations = round + 1;
+    const double now = misfit(deformed);
+    if (now < bestMisfit) bestMisfit = now, best = deformed;
+    if (moved < 1e-4) break;  // settled
   }
+  deformed = best;
 
   std::map<int, std::pair<double, double>> after;
   report.invertedAfter = 0;

@@ -451,20 +451,78 @@ void addVessels(Builder& b, const SideJoints& j) {
   }
 }
 
+// The point `depth` mm under the back's surface above (x, z) (the trunk's primitives without
+// their blend, which adds at most a quarter of its radius), found along -y.
+V underBack(const Builder& b, double x, double z, double depth) {
+  double inside = 0, outside = -250;
+  for (int it = 0; it < 50; ++it) {
+    const double mid = 0.5 * (inside + outside);
+    (b.distanceTo(V(x, mid, z), {kPartTorso}) < -depth ? inside : outside) = mid;
+  }
+  return V(x, inside, z);
+}
+
+// The shoulder girdle (detailed anatomy): each clavicle from beside the sternum's top, under the
+// skin of the upper chest, to the acromion over the humeral head; each scapula a plate on the back
+// of the ribs with its spine running up to the acromion and its neck out to the glenoid, a
+// cartilage gap off the humeral head. They belong to the torso's part in the phantom's own S; a
+// rig that knows the girdle makes them parts of their own. Before the ribs: where a scapula lies
+// on them, it is the scapula.
+void addShoulderGirdle(Builder& b, const SideJoints& j) {
+  for (const double side : {1.0, -1.0}) {
+    auto P = [&](const V& p) { return V(side * p.x(), p.y(), p.z()); };
+    auto bone = [&](std::uint8_t label, const RoundCone& c) {
+      Structure& s = b.cone(label, kPartTorso, c);
+      s.claimsPart = true;  // the glenoid and acromion reach past the shoulder's plane
+    };
+    const V s = P(j.shoulder);
+    // The clavicle: medial end a few millimetres of joint beside the manubrium, lateral end at the
+    // acromion.
+    const V c0 = P({26, 36, 1022}), c1 = P({75, 32, 1038}), c2 = P({126, 6, 1050});
+    bone(kClavicle, RoundCone::make(c0, c1, 7, 6.5));
+    bone(kClavicle, RoundCone::make(c1, c2, 6.5, 6));
+    // The acromion over the humeral head (its underside 13 + 3 + 3 mm above the joint).
+    const V acromion = P({148, -14, 1055});
+    bone(kScapula, RoundCone::make(c2 + 6 * (acromion - c2).normalized(), acromion, 6, 6));
+    // The scapula's body, flat against the back, its spine and its neck to the glenoid.
+    const V top = underBack(b, 70, 995, 12), bottom = underBack(b, 84, 935, 12);
+    const V mid = underBack(b, 77, 965, 12), surface = underBack(b, 77, 965, 0);
+    const V normal = (surface - mid).normalized();
+    bone(kScapula, RoundCone::make(P(top), P(bottom), 30, 15, P(normal), 0.12, 1));
+    bone(kScapula, RoundCone::make(P(underBack(b, 76, 1002, 11)), acromion, 6, 5));
+    const V lateralAngle = P(underBack(b, 104, 1016, 18));
+    const V glenoid = s + 27 * (lateralAngle - s).normalized();
+    bone(kScapula, RoundCone::make(lateralAngle, glenoid, 9, 10));
+  }
+}
+
 void addTorsoStructures(Builder& b, const SideJoints& j) {
   const V Y = V::UnitY();
+  if (b.detailed) addShoulderGirdle(b, j);
   // Spine: lumbar-thoracic column, then the cervical part curving forward into the neck and
   // stopping below the skull base (the neck joint is the gap between them).
   const V l0(0, -50, 700), t1(0, -48, 1000), c1(0, -10, 1138);
   b.cone(kSpinalCord, kPartTorso, RoundCone::make(l0, t1, 5, 5));
   b.cone(kSpinalCord, kPartTorso, RoundCone::make(t1, c1, 5, 4));
-  b.cone(kVertebrae, kPartTorso, RoundCone::make(l0, t1, 16, 14));
+  if (b.detailed) {
+    // The lumbosacral disc (detailed anatomy): soft tissue between the sacrum and L5, where the
+    // rig puts the lumbosacral joint (a quarter of the pelvis's height below the iliac crests),
+    // so the pelvis can tilt back under the spine without bone running into bone.
+    // The cones' round ends reach their radius past their end points: the disc is 747-758 mm.
+    const V s1(0, -50, 747 - 16), l5(0, -50, 758 + 16);
+    b.cone(kVertebrae, kPartTorso, RoundCone::make(l0, s1, 16, 16));
+    b.cone(kVertebrae, kPartTorso, RoundCone::make(l5, t1, 16, 14));
+  } else {
+    b.cone(kVertebrae, kPartTorso, RoundCone::make(l0, t1, 16, 14));
+  }
   b.cone(kVertebrae, kPartTorso, RoundCone::make(t1, c1, 14, 8));
   b.cone(kSternum, kPartTorso, RoundCone::make({0, 64, 905}, {0, 40, 1020}, 11, 10, Y, 0.5, 1));
   Structure& ribs = b.structure(StructureKind::Ribs, kRibs, kPartTorso);
   ribs.zmin = 905;
   ribs.zmax = 1000;  // the first rib leaves T1 (t1 above), below the shoulder joints
-  ribs.depthMin = b.m.skinMm + b.m.fatMm[kPartTorso] + 3;
+  // With the shoulder girdle (detailed anatomy) the ribs lie deeper, under the scapulae and the
+  // muscles between (a scapula glides on them, it does not touch them).
+  ribs.depthMin = b.m.skinMm + b.m.fatMm[kPartTorso] + (b.detailed ? 12 : 3);
   ribs.depthMax = ribs.depthMin + 8;
   ribs.period = 22;
   ribs.thickness = 9;
@@ -475,17 +533,33 @@ void addTorsoStructures(Builder& b, const SideJoints& j) {
   pelvis.inner = {{0, -5, 735}, {85, 57, 80}};
   pelvis.zmin = 700;
   pelvis.zmax = 770;
-  for (const V& hip : {j.hip, mirror(j.hip)})  // the sockets of the femoral heads
+  for (const double side : {1.0, -1.0}) {  // the sockets of the femoral heads
+    const V hip = side > 0 ? j.hip : mirror(j.hip);
     pelvis.holes.emplace_back(hip, 15 + kCartilageMm);
+    // The socket opens forwards and outwards, as an acetabulum does, so a thigh flexed up to a
+    // right angle turns its shaft clear of the rim.
+    if (b.detailed) pelvis.holes.emplace_back(hip + V(side * 10, 18, -12), 25);
+  }
   if (b.detailed) addVessels(b, j);
   b.ellipsoid(kHeart, kPartTorso, {-18, 26, 948}, {40, 32, 45});
-  b.ellipsoid(kLiver, kPartTorso, {26, 8, 850}, {66, 50, 48});
+  // The liver clear of the iliac crests a tilted pelvis lifts (detailed anatomy).
+  if (b.detailed)
+    b.ellipsoid(kLiver, kPartTorso, {26, 8, 858}, {66, 50, 42});
+  else
+    b.ellipsoid(kLiver, kPartTorso, {26, 8, 850}, {66, 50, 48});
   b.ellipsoid(kStomach, kPartTorso, {-42, 22, 875}, {34, 28, 40});
   b.ellipsoid(kSpleen, kPartTorso, {-72, -30, 885}, {18, 26, 35});
   b.ellipsoid(kKidneyLeft, kPartTorso, {-48, -38, 815}, {22, 18, 40});
   b.ellipsoid(kKidneyRight, kPartTorso, {48, -38, 805}, {22, 18, 40});
-  b.ellipsoid(kLungLeft, kPartTorso, {-50, -8, 965}, {42, 50, 75});
-  b.ellipsoid(kLungRight, kPartTorso, {50, -8, 965}, {42, 50, 75});
+  // Inside the ribs, which lie deeper with the shoulder girdle (detailed anatomy): the scapulae
+  // lie on the ribs, never on a lung.
+  if (b.detailed) {
+    b.ellipsoid(kLungLeft, kPartTorso, {-46, 8, 965}, {30, 30, 65});
+    b.ellipsoid(kLungRight, kPartTorso, {46, 8, 965}, {30, 30, 65});
+  } else {
+    b.ellipsoid(kLungLeft, kPartTorso, {-50, -8, 965}, {42, 50, 75});
+    b.ellipsoid(kLungRight, kPartTorso, {50, -8, 965}, {42, 50, 75});
+  }
   b.ellipsoid(kBladder, kPartTorso, {0, 25, 705}, {26, 22, 22});
   b.ellipsoid(kSmallBowel, kPartTorso, {0, 18, 760}, {85, 50, 58});
 }

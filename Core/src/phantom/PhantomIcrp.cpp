@@ -19,6 +19,7 @@ constexpr std::uint8_t kForearm[3] = {19, 20, 21};
 constexpr std::uint8_t kFemurUpper[3] = {28, 29, 30}, kFemurLower[3] = {31, 32, 33};
 constexpr std::uint8_t kTibia[3] = {34, 35, 36};
 constexpr std::uint8_t kHand = 22, kFoot = 37, kCranium = 26, kPelvis = 41, kRibs = 43;
+constexpr std::uint8_t kClavicles = 24, kScapulae = 45;  // cortical (the phantom's are solid)
 constexpr std::uint8_t kCervical = 47, kThoracic = 49, kLumbar = 51, kSacrum = 53, kSternum = 55;
 constexpr std::uint8_t kBrain = 61, kEyeBulbLeft = 67, kEyeBulbRight = 69;
 constexpr std::uint8_t kStomachWall = 72, kSmallIntestineWall = 74, kHeartWall = 87;
@@ -109,6 +110,10 @@ std::uint8_t IcrpLabeller::label(std::uint8_t organ, std::uint8_t part,
       return id::kPelvis;
     case kRibs:
       return id::kRibs;
+    case kClavicle:
+      return id::kClavicles;
+    case kScapula:
+      return id::kScapulae;
     case kSternum:
       return id::kSternum;
     case kVertebrae:  // levels by height on the phantom's spine (T1 at z = 1000 mm)

@@ -89,6 +89,8 @@ LabelTable makeOrganLabels(bool detailed) {
   add(t, kVesselsTrunk, "blood_vessels_trunk", 200, 40, 40);
   add(t, kVesselsArms, "blood_vessels_arms", 216, 60, 60);
   add(t, kVesselsLegs, "blood_vessels_legs", 180, 30, 50);
+  add(t, kClavicle, "clavicle", 232, 220, 184);
+  add(t, kScapula, "scapula", 224, 210, 170);
   return t;
 }
 

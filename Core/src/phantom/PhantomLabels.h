@@ -47,7 +47,10 @@ enum Organ : std::uint8_t {
   kVesselsTrunk = 32,
   kVesselsArms = 33,
   kVesselsLegs = 34,
-  kOrganCount = 35  // one past the last value
+  // The shoulder girdle's bones (detailed anatomy): both clavicles, both scapulae.
+  kClavicle = 35,
+  kScapula = 36,
+  kOrganCount = 37  // one past the last value
 };
 constexpr int kBasicOrganCount = 28;  // the labels of the basic anatomy
 
@@ -57,7 +60,7 @@ Region regionOf(std::uint8_t part);
 // The vessel label of a body part's region.
 std::uint8_t vesselLabel(std::uint8_t part);
 
-// The labels of G: the basic anatomy's 27, or with `detailed` all 34.
+// The labels of G: the basic anatomy's 27, or with `detailed` all 36.
 LabelTable makeOrganLabels(bool detailed = false);
 LabelTable makePartLabels();
 

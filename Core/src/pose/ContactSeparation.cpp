@@ -18,16 +18,20 @@ namespace {
 // they connect touches across a joint, so it is never cut whole.
 bool standardJointPair(const std::string& a, const std::string& b) {
   static const std::set<std::pair<std::string, std::string>> pairs = [] {
-    std::set<std::pair<std::string, std::string>> out{{"head", "torso"}};
+    std::set<std::pair<std::string, std::string>> out{{"head", "torso"}, {"pelvis", "torso"}};
     for (const char* side : {"_left", "_right"}) {
       const std::string s = side;
       for (const auto& [p, q] : {std::pair{"torso", "upper_arm"},
+                                 {"torso", "shoulder_girdle"},
+                                 {"shoulder_girdle", "upper_arm"},
                                  {"upper_arm", "forearm"},
                                  {"forearm", "hand"},
                                  {"torso", "thigh"},
+                                 {"pelvis", "thigh"},
                                  {"thigh", "shank"},
                                  {"shank", "foot"}}) {
-        const std::string x = std::string(p) == "torso" ? "torso" : p + s, y = q + s;
+        const std::string x = std::string(p) == "torso" || std::string(p) == "pelvis" ? p : p + s,
+                          y = q + s;
         out.insert({std::min(x, y), std::max(x, y)});
       }
     }
@@ -267,11 +271,25 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
     c.separation.labelB = pair.second;
     c.names = {nameOf(table, pair.first), nameOf(table, pair.second)};
     const SkeletonJoint* joint = nullptr;
-    if (skeleton)
+    if (skeleton) {
       for (const SkeletonJoint& j : skeleton->joints)
         if ((j.parts[0] == c.names[0] && j.parts[1] == c.names[1]) ||
             (j.parts[0] == c.names[1] && j.parts[1] == c.names[0]))
           joint = &j;
+      // Two parts that meet across a joint through a part between them (the torso and the upper
+      // arm across the shoulder, where the girdle is a part of its own; the torso and a thigh
+      // across the hip, below the pelvis) are spared that joint's sphere: the armpit and the groin
+      // are the joint's crease, not a contact.
+      for (const SkeletonJoint& j : skeleton->joints) {
+        if (joint) break;
+        for (int end = 0; end < 2 && !joint; ++end) {
+          if (j.parts[1] != c.names[std::size_t(end)]) continue;
+          const std::string& other = c.names[std::size_t(1 - end)];
+          for (const SkeletonJoint& k : skeleton->joints)
+            if (k.parts[0] == other && k.parts[1] == j.parts[0] && !other.empty()) joint = &j;
+        }
+      }
+    }
     if (joint && joint->radiusMm <= 0) {
       out.skipped.push_back(c.names[0] + " and " + c.names[1] + ": the skeleton's joint " +
                             joint->name + " has no radius_mm, so the contact cannot be told " +

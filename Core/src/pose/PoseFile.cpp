@@ -328,8 +328,8 @@ Pose parsePose(const std::string& text, const std::string& source) {
   }
   r.object(j, "(top level)");
   r.onlyKeys(j, "",
-             {"format", "version", "name", "description", "joint_rings", "separations", "groups",
-              "keyframes"});
+             {"format", "version", "name", "description", "joint_rings", "rhythms", "separations",
+              "groups", "keyframes"});
   if (!j.contains("format") || j["format"] != "repose-pose")
     r.fail("format", "expected \"repose-pose\"");
   if (!j.contains("version") || r.integer(j["version"], "version") != 1)
@@ -340,6 +340,18 @@ Pose parsePose(const std::string& text, const std::string& source) {
   if (j.contains("joint_rings")) {
     pose.jointRings = r.integer(j["joint_rings"], "joint_rings");
     if (pose.jointRings < 0 || pose.jointRings > 8) r.fail("joint_rings", "expected 0 to 8");
+  }
+  if (j.contains("rhythms")) {
+    const json& rh = j["rhythms"];
+    r.object(rh, "rhythms");
+    r.onlyKeys(rh, "rhythms", {"scapulohumeral", "lumbopelvic"});
+    for (const auto& [key, flag] :
+         {std::pair<const char*, bool*>{"scapulohumeral", &pose.scapulohumeralRhythm},
+          {"lumbopelvic", &pose.lumbopelvicRhythm}})
+      if (rh.contains(key)) {
+        if (!rh[key].is_boolean()) r.fail(std::string("rhythms.") + key, "expected true or false");
+        *flag = rh[key].get<bool>();
+      }
   }
   if (j.contains("separations")) {
     const json& s = j["separations"];
@@ -454,6 +466,9 @@ std::string poseToJson(const Pose& pose) {
   json j = {{"format", "repose-pose"}, {"version", 1}, {"name", pose.name}};
   if (!pose.description.empty()) j["description"] = pose.description;
   if (pose.jointRings != 0) j["joint_rings"] = pose.jointRings;
+  if (!pose.scapulohumeralRhythm || !pose.lumbopelvicRhythm)
+    j["rhythms"] = {{"scapulohumeral", pose.scapulohumeralRhythm},
+                    {"lumbopelvic", pose.lumbopelvicRhythm}};
   if (!pose.separations.empty()) {
     j["separations"] = json::array();
     for (const PoseSeparation& s : pose.separations) {

@@ -366,6 +366,8 @@ PosedFrame poseFrame(const PoseRig& rig, std::size_t index, const Volume& organs
   report["volume_restoration"] = {{"on", rig.volumeRestoration()},
                                   {"free_vertices", vr.freeVertices},
                                   {"parts_held", vr.parts},
+                                  {"tissues_held", vr.tissues},
+                                  {"rounds", vr.iterations},
                                   {"max_correction_mm", vr.maxCorrectionMm},
                                   {"worst_part_before_percent", vr.worstPartBefore},
                                   {"worst_part_after_percent", vr.worstPartAfter},

@@ -120,6 +120,7 @@ std::vector<RigidHandle> resolveHandles(const Pose& pose, const TriangleMesh& ca
         if (std::find(parts.begin(), parts.end(), vertexPart[v]) != parts.end()) claim(g, int(v));
     }
     handles[g].parts = parts;
+    handles[g].widen = pose.groups[g].widen;
   }
   if (restGroup >= 0) {
     for (Eigen::Index v = 0; v < nc; ++v)

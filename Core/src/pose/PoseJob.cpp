@@ -140,7 +140,11 @@ std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& pa
       if (l.name == name) return l.value;
     return 0;
   };
+  auto kind = [](const std::string& name) { return name.substr(0, name.find('_')); };
   for (const SkeletonJoint& j : skeleton->joints) {
+    // The girdle and the pelvis meet the trunk all around, not across a joint plane a hinge bend
+    // could follow: their transitions are the blend's, relaxed by the volume restoration.
+    if (kind(j.name) == "sternoclavicular" || kind(j.name) == "lumbosacral") continue;
     const Eigen::Vector3d* distal = j.axis("rotation");
     BendJoint b;
     b.name = j.name;
@@ -150,12 +154,17 @@ std::vector<BendJoint> bendJoints(const Skeleton* skeleton, const LabelTable& pa
     b.radiusMm = j.radiusMm;
     if (!distal || b.proximalPart == 0 || b.distalPart == 0 || !(b.radiusMm > 0)) continue;
     b.distal = *distal;
+    // The part above a girdle or a pelvis (the torso) bends with it where they move together:
+    // the armpit beside a shoulder, the groin beside a hip.
+    for (const SkeletonJoint& above : skeleton->joints)
+      if (above.parts[1] == j.parts[0] && !above.parts[0].empty())
+        if (const int also = label(above.parts[0])) b.proximalAlso.push_back(also);
     // A limb's joint (elbow, wrist, knee, ankle) bends over 2 radii on each side, so the bend
     // fades into the solved blend along the limbs, where the two agree; over the outer 30 % of
     // 1.5 radii the fade also crossed the joint plane and crushed soft tets there (docs/QUALITY.md,
     // "What closed the thick slices"). A root joint's trunk side bends only near the joint and
     // its limb side over 1.5 radii: bent wider, a raised arm pulls the chest wall along.
-    if (j.parts[0] == "torso")
+    if (kind(j.name) == "shoulder" || kind(j.name) == "hip" || j.parts[0] == "torso")
       b.proximalReach = 0.5, b.distalReach = 1.5;
     else
       b.proximalReach = b.distalReach = 2.0;
@@ -191,7 +200,13 @@ PoseJob::PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRe
     skeleton_ = request_.skeleton;
   else
     skeleton_ = skeletonFor(request_.partsPath, request_.skeletonPath);
+  // Turns beyond a joint's range of motion (the names are still there to say which).
+  for (const std::string& w : jointRangeWarnings(pose_)) warnings_.push_back(w);
   resolveJointsWith(pose_, skeleton_ ? &*skeleton_ : nullptr, request_.partsPath);
+  // The rhythms of the girdles and the pelvis, where the skeleton has their joints.
+  if (skeleton_) rhythms_ = PoseRhythms(*skeleton_, parts.labels());
+  userPose_ = pose_;
+  pose_ = rhythms_.apply(userPose_, &rhythmNotes_);
   // The tissue table: given, else chooseTissues' order; its rigid labels move whole.
   if (request_.tissues) {
     tissues_.table = request_.tissues;
@@ -223,15 +238,29 @@ RigGeometry PoseJob::buildGeometry(const ProgressFn& progress) const {
 }
 
 std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, int threads) const {
-  return makeRig(std::move(geometry), pose_, threads);
+  return makeRig(std::move(geometry), userPose_, threads);
 }
 
 std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, const Pose& pose,
                                           int threads) const {
   auto rig = std::make_unique<PoseRig>(
-      std::move(geometry), pose, parts_->labels(), threads, jointRings_,
+      std::move(geometry), rhythms_.apply(pose), parts_->labels(), threads, jointRings_,
       bendJoints(skeleton_ ? &*skeleton_ : nullptr, parts_->labels()));
+  rig->setRhythms(pose, rhythms_);
   rig->setVolumeRestoration(request_.volumeRestoration);
+  if (skeleton_) {
+    std::vector<std::pair<int, int>> jointed;
+    auto label = [&](const std::string& name) {
+      for (const Label& l : parts_->labels().labels())
+        if (l.name == name) return l.value;
+      return 0;
+    };
+    for (const SkeletonJoint& j : skeleton_->joints)
+      if (const int a = label(j.parts[0]), b = label(j.parts[1]); a > 0 && b > 0)
+        jointed.emplace_back(a, b);
+    rig->setJointedParts(std::move(jointed));
+  }
+  if (request_.volumeRestoration) rig->setTetTissues(tetTissues(rig->mesh(), *organs_, threads));
   return rig;
 }
 
@@ -257,6 +286,9 @@ std::string PoseJob::completeReport(const std::string& reportJson, bool sceneReu
   report["joint_rings"] = jointRings_;
   report["separations"] = nlohmann::json::parse(separations_.reportJson());
   report["skeleton"] = skeleton_ ? nlohmann::json(skeleton_->source) : nlohmann::json();
+  report["rhythms"] = {{"scapulohumeral", userPose_.scapulohumeralRhythm},
+                       {"lumbopelvic", userPose_.lumbopelvicRhythm},
+                       {"applied", rhythmNotes_}};
   return report.dump();
 }
 

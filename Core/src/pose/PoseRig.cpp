@@ -248,7 +248,7 @@ struct PoseRig::CageArap {
 
 PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partLabels, int threads,
                  int jointRings, const std::vector<BendJoint>& bends)
-    : geometry_(std::move(geometry)), pose_(pose) {
+    : geometry_(std::move(geometry)), pose_(pose), userPose_(pose) {
   deformation_ = std::make_unique<CageDeformation>(geometry_.mesh, geometry_.cage, threads,
                                                    geometry_.coordinatesFile);
   handles_ = resolveHandles(pose_, geometry_.cage, geometry_.mesh, partLabels);
@@ -279,9 +279,36 @@ PoseRig::~PoseRig() = default;
 
 VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
                                                      const std::vector<RigidHandle>& handles) const {
-  if (!restoreVolumes_ || bends_.empty()) return {};
+  if (!restoreVolumes_) return {};
   const TransferMesh& m = geometry_.mesh;
-  std::vector<char> zone = bends_.zone(handles, m.vertices.rows());
+  std::vector<char> zone = bends_.empty() ? std::vector<char>(std::size_t(m.vertices.rows()), 0)
+                                          : bends_.zone(handles, m.vertices.rows());
+  // The transitions between two groups that carry jointed parts and move apart this frame.
+  if (!jointedParts_.empty()) {
+    const Eigen::Index groups = influence_.membership.cols();
+    std::vector<std::vector<char>> jointed(std::size_t(groups), std::vector<char>(std::size_t(groups), 0));
+    auto groupOf = [&](int part) {
+      for (std::size_t g = 0; g < handles.size(); ++g)
+        if (std::find(handles[g].parts.begin(), handles[g].parts.end(), part) != handles[g].parts.end())
+          return int(g);
+      return -1;
+    };
+    for (const auto& [a, b] : jointedParts_) {
+      const int ga = groupOf(a), gb = groupOf(b);
+      if (ga < 0 || gb < 0 || ga == gb) continue;
+      if (handles[std::size_t(ga)].motion.isApprox(handles[std::size_t(gb)].motion, 1e-12)) continue;
+      jointed[std::size_t(ga)][std::size_t(gb)] = jointed[std::size_t(gb)][std::size_t(ga)] = 1;
+    }
+    for (Eigen::Index v = 0; v < m.vertices.rows(); ++v)
+      for (Eigen::Index g = 0; g < groups && !zone[std::size_t(v)]; ++g) {
+        if (influence_.membership(v, g) < 0.01) continue;
+        for (Eigen::Index h = g + 1; h < groups; ++h)
+          if (influence_.membership(v, h) >= 0.01 && jointed[std::size_t(g)][std::size_t(h)]) {
+            zone[std::size_t(v)] = 1;
+            break;
+          }
+      }
+  }
   // One ring of tets around the bends: the tets that span the bend's reach.
   std::vector<char> grown = zone;
   for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
@@ -296,7 +323,8 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
     anything = anything || grown[v];
   }
   if (!anything) return {};
-  return restoreVolumes(m, grown, deformed, {}, bends_.reachTets(m, handles));
+  std::vector<char> held = bends_.empty() ? std::vector<char>() : bends_.reachTets(m, handles);
+  return restoreVolumes(m, grown, deformed, {}, held, tissues_.empty() ? nullptr : &tissues_);
 }
 
 PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision,
@@ -319,9 +347,9 @@ PoseRig::Frame PoseRig::liveFrame(const Pose& edited, std::size_t index) const {
 
 PoseRig::Frame PoseRig::solveEdited(const Pose& edited, std::size_t index, GreenPrecision precision,
                                     FrameMaps tetMaps, CageStart start) const {
-  if (!sameHandleGroups(edited, pose_))
+  if (!sameHandleGroups(edited, userPose_))
     throw Error("pose " + edited.name + ": its groups are not those the rig was prepared for");
-  const auto frames = edited.frames();
+  const auto frames = rhythms_.apply(edited).frames();
   if (index >= frames.size())
     throw Error("pose " + edited.name + " has " + std::to_string(frames.size()) + " frames, not " +
                 std::to_string(index + 1));

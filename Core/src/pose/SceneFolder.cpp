@@ -104,11 +104,14 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
   writeTransferMesh(rig.mesh(), (scene / "tm.vtu").string());
   // The coordinates, so that a later run reads them instead of computing them (most of its time).
   rig.deformation().saveCoordinates(greenCoordinatesFileFor((scene / "tm.vtu").string()));
-  const std::string poseFile = (rig.pose().name.empty() ? "pose" : rig.pose().name) + ".pose.json";
-  writePoseFile(rig.pose(), (scene / poseFile).string());
+  // The pose as its user wrote it: the rhythms' groups come after its own and are made again
+  // whenever it is rigged.
+  const Pose& pose = rig.userPose();
+  const std::string poseFile = (pose.name.empty() ? "pose" : pose.name) + ".pose.json";
+  writePoseFile(pose, (scene / poseFile).string());
   json groups = json::array();
-  for (std::size_t g = 0; g < rig.handles().size(); ++g)
-    groups.push_back({{sc::cage::kGroupName, rig.pose().groups[g].name},
+  for (std::size_t g = 0; g < rig.handles().size() && g < pose.groups.size(); ++g)
+    groups.push_back({{sc::cage::kGroupName, pose.groups[g].name},
                       {sc::cage::kGroupVertices, rig.handles()[g].cageVertices}});
   const std::string seg = std::string(sc::segmentation::kClassName) + "1",
                     cage = std::string(sc::cage::kClassName) + "1",
@@ -138,7 +141,7 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
         {sc::transfer_mesh::kSizeMm, settings.meshMm}},
        {{sc::kClass, sc::pose::kClassName},
         {sc::kId, std::string(sc::pose::kClassName) + "1"},
-        {sc::kName, rig.pose().name},
+        {sc::kName, pose.name},
         {sc::kReferences,
          {{sc::kCageRole, cage}, {sc::kSegmentationRole, seg}, {sc::kTransferMeshRole, mesh}}},
         {sc::pose::kFile, poseFile},

@@ -231,6 +231,15 @@ std::vector<std::pair<std::string, Eigen::Vector3d>> jointAxes(
       axes.emplace_back("flexion", turning(anterior));
       axes.emplace_back("lateral", turning(-right));
       break;
+    case JointKind::Sternoclavicular:
+      axes.emplace_back("elevation", turning(superior));
+      axes.emplace_back("protraction", turning(anterior));
+      break;
+    case JointKind::Lumbosacral:
+      // The pelvis tilts back (its lower end forwards), as a hip's flexion turns the thigh.
+      axes.emplace_back("flexion", turning(anterior));
+      axes.emplace_back("lateral", turning(-right));
+      break;
   }
   axes.emplace_back("rotation", d);
   return axes;

@@ -117,7 +117,8 @@ bool phantomRole(const std::string& name, LabelRole& r) {
       {"pelvis", BoneKind::Pelvis},       {"humerus", BoneKind::Humerus},
       {"radius_ulna", BoneKind::Forearm}, {"hand_bones", BoneKind::Hand},
       {"femur", BoneKind::Femur},         {"tibia_fibula", BoneKind::Shank},
-      {"foot_bones", BoneKind::Foot}};
+      {"foot_bones", BoneKind::Foot},     {"clavicle", BoneKind::Clavicle},
+      {"scapula", BoneKind::Scapula}};
   std::string bone = name;
   const bool marrow = endsWith(name, "_marrow");
   if (marrow) bone = name.substr(0, name.size() - 7);

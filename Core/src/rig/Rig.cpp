@@ -105,12 +105,14 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   for (const rig::FittedJoint& j : joints) {
     SkeletonJoint s;
     s.name = j.name;
-    s.parent = j.kind == JointKind::Elbow
-                   ? "shoulder" + std::string(j.side < 0 ? "_left" : "_right")
-               : j.kind == JointKind::Wrist ? "elbow" + std::string(j.side < 0 ? "_left" : "_right")
-               : j.kind == JointKind::Knee  ? "hip" + std::string(j.side < 0 ? "_left" : "_right")
-               : j.kind == JointKind::Ankle ? "knee" + std::string(j.side < 0 ? "_left" : "_right")
-                                            : "";
+    const std::string sfx = j.side < 0 ? "_left" : "_right";
+    s.parent = j.kind == JointKind::Elbow      ? "shoulder" + sfx
+               : j.kind == JointKind::Wrist    ? "elbow" + sfx
+               : j.kind == JointKind::Knee     ? "hip" + sfx
+               : j.kind == JointKind::Ankle    ? "knee" + sfx
+               : j.kind == JointKind::Shoulder ? "sternoclavicular" + sfx
+               : j.kind == JointKind::Hip      ? std::string("lumbosacral")
+                                               : "";
     if (!s.parent.empty() && !std::any_of(joints.begin(), joints.end(),
                                           [&](const auto& o) { return o.name == s.parent; }))
       s.parent.clear();
@@ -143,11 +145,11 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
                          {"length_mm", b.length}});
   nlohmann::json partsJson = nlohmann::json::array();
   {
-    std::vector<std::int64_t> count(15, 0);
+    std::vector<std::int64_t> count(rig::kPartPelvis + 1, 0);
     const std::uint8_t* s = out.parts.data<std::uint8_t>();
-    for (std::int64_t i = 0; i < out.parts.numVoxels(); ++i) ++count[s[i] < 15 ? s[i] : 0];
+    for (std::int64_t i = 0; i < out.parts.numVoxels(); ++i) ++count[s[i] <= rig::kPartPelvis ? s[i] : 0];
     const double ml = std::fabs(organs.geometry().ijkToRas.block<3, 3>(0, 0).determinant()) / 1000;
-    for (int v = 1; v < 15; ++v)
+    for (int v = 1; v <= rig::kPartPelvis; ++v)
       if (count[std::size_t(v)] > 0)
         partsJson.push_back({{"part", partName(v)},
                              {"voxels", count[std::size_t(v)]},
@@ -227,7 +229,7 @@ std::string nameBodyPartsByRigConvention(Volume& parts, const std::string& sourc
   parts.labels() = names;
   return source +
          ": no part names in the file; its values are named as `repose rig` names them (1 head, "
-         "2 torso, 3 upper_arm_left, ... 14 foot_right)";
+         "2 torso, 3 upper_arm_left, ... 14 foot_right, 15-16 shoulder_girdle_left/right, 17 pelvis)";
 }
 
 }  // namespace repose

@@ -118,6 +118,7 @@ Bones findBones(const Volume& organs, const LabelConvention& convention, const G
         if (r->bone == BoneKind::None || r->bone == BoneKind::Teeth) continue;
         const BoneKind kind = r->bone == BoneKind::Patella ? BoneKind::Shank : r->bone;
         raw[{kind, sided(kind) ? r->side : 0}].push_back(i);
+        if (kind == BoneKind::Spine && r->boneName == "sacrum") out.sacrum.push_back(grid.ras(i));
       }
     }
   });

@@ -55,6 +55,9 @@ struct Bones {
   std::map<std::pair<BoneKind, int>, Bone> byKind;  // (kind, side)
   BodyFrame frame;
   double voxelMm = 1;  // the grid's largest spacing: the fits' resolution
+  // The spine's voxels whose labels name the sacrum (ICRP 110's, TotalSegmentator's): where the
+  // lumbosacral joint is, when known.
+  std::vector<V> sacrum;  // their centres, RAS
   const Bone* find(BoneKind kind, int side) const;
 };
 Bones findBones(const Volume& organs, const LabelConvention& convention, const Grid& grid);
@@ -72,11 +75,16 @@ struct FittedJoint {
   std::string method;
   double rms = -1;
   std::array<int, 2> parts{0, 0};  // labels of S: proximal, distal
+  // The two parts meet all around the distal one, not across a plane (the shoulder girdle on the
+  // trunk, the pelvis under the lumbar spine): radius_mm covers their whole interface.
+  bool wholeInterface = false;
 };
 // Fits the joints the bones allow; `missing` gets one line per joint that could not be found.
 std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>& missing);
 
-// The body-part labels of S (the phantom's numbering) and their names.
+// The body-part labels of S (the phantom's numbering, then the girdles and the pelvis) and their
+// names.
+constexpr int kPartGirdleLeft = 15, kPartGirdleRight = 16, kPartPelvis = 17;
 int partOf(BoneKind kind, int side);
 LabelTable rigPartLabels();
 
@@ -92,6 +100,12 @@ struct PartStats {
 Volume assignParts(const Volume& organs, const LabelConvention& convention, const Bones& bones,
                    const std::vector<FittedJoint>& joints, const Grid& grid, int threads,
                    PartStats& stats, const std::vector<std::uint8_t>* body = nullptr);
+
+// The parts of the trunk that move of their own (after assignParts): the pelvis below the
+// lumbosacral joint's plane, and each shoulder girdle (clavicle, scapula and the tissue around
+// them), where the joints were fitted.
+void assignGirdlesAndPelvis(Volume& parts, const Bones& bones,
+                            const std::vector<FittedJoint>& joints, const Grid& grid, int threads);
 
 // The body on G's grid from the scan G was segmented from (any grid over the same place): a CT
 // above -300 HU (else the image above its Otsu threshold), its connected pieces that hold some of

@@ -310,6 +310,43 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
     missing.push_back(std::string("neck: no ") + (skull ? "spine" : "skull") + " found");
   }
 
+  // The pelvis under the lumbar spine: the lumbosacral joint at the top of the sacrum where its
+  // labels say it, else on the spine a quarter of the pelvis's height below the iliac crests
+  // (L5/S1 lies about there).
+  bool lumbosacral = false;
+  if (spine && pelvis) {
+    FittedJoint j;
+    const double top = pelvis->extreme(up).dot(up), bottom = pelvis->extreme(-up).dot(up);
+    double level = top - 0.25 * (top - bottom);
+    std::string how = "on the spine a quarter of the pelvis's height below the iliac crests";
+    if (!bones.sacrum.empty()) {
+      double highest = -1e300;
+      for (const V& p : bones.sacrum) highest = std::max(highest, p.dot(up));
+      level = highest;
+      how = "the top of the sacrum";
+    }
+    // The spine's axis at that level: its boundary in a slab about it, widened when the level
+    // falls in a disc (soft tissue between two vertebrae, no spine voxel in the thin slab).
+    V centre = V::Zero();
+    int count = 0;
+    for (double slab = std::max(1.5 * voxel, 4.0); count == 0 && slab <= 40; slab *= 2)
+      for (const V& p : spine->boundary)
+        if (std::fabs(p.dot(up) - level) <= slab) centre += p, ++count;
+    if (count > 0) {
+      centre /= double(count);
+      j.centre = centre + (level - centre.dot(up)) * up;
+      j.method = how;
+      j.distal = -up;
+      j.planeNormal = -up;
+      j.wholeInterface = true;
+      add(j, JointKind::Lumbosacral, "lumbosacral", 0, 2, kPartPelvis);
+      lumbosacral = true;
+    }
+  }
+  if (!lumbosacral)
+    missing.push_back(std::string("lumbosacral: no ") + (spine ? "pelvis" : "spine") +
+                      " found (the pelvis stays with the torso)");
+
   for (const int side : {-1, +1}) {
     const std::string sfx = sideName(side), sideWord = side < 0 ? "left" : "right";
     const V medial = -double(side) * right;
@@ -335,6 +372,33 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
       return j;
     };
 
+    // ---- the shoulder girdle: the clavicle's medial end beside the sternum ----
+    int girdle = 2;  // the shoulder's proximal part: the girdle when there is one, else the torso
+    if (const Bone* Cl = bones.find(BoneKind::Clavicle, side)) {
+      FittedJoint j;
+      const V end = Cl->extreme(medial);
+      j.centre = end;
+      j.method = "the clavicle's medial end";
+      if (const Bone* St = bones.find(BoneKind::Sternum, 0)) {
+        V nearest = St->centroid;
+        double best = 1e300;
+        for (const V& p : St->boundary)
+          if ((p - end).norm() < best) best = (p - end).norm(), nearest = p;
+        if (best < 40) {
+          j.centre = 0.5 * (end + nearest);
+          j.method = "between the clavicle's medial end and the sternum";
+        }
+      }
+      j.distal = (Cl->extreme(-medial) - end).normalized();
+      j.planeNormal = j.distal;
+      j.wholeInterface = true;
+      girdle = side < 0 ? kPartGirdleLeft : kPartGirdleRight;
+      add(j, JointKind::Sternoclavicular, "sternoclavicular" + sfx, side, 2, girdle);
+    } else if (H) {
+      missing.push_back("sternoclavicular" + sfx + ": no " + sideWord +
+                        " clavicle found (the shoulder girdle stays with the torso)");
+    }
+
     // ---- the arm ----
     V uh = V::Zero(), uf = V::Zero();
     if (H) {
@@ -344,7 +408,7 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
       if (!F && (H->extreme(uh) - spineTop).norm() < (H->extreme(-uh) - spineTop).norm()) uh = -uh;
       FittedJoint j = ballJoint(*H, uh, 0.25, "humeral head", "humerus");
       j.planeNormal = uh;
-      add(j, JointKind::Shoulder, "shoulder" + sfx, side, 2, partOf(BoneKind::Humerus, side));
+      add(j, JointKind::Shoulder, "shoulder" + sfx, side, girdle, partOf(BoneKind::Humerus, side));
     } else {
       missing.push_back("shoulder" + sfx + ", elbow" + sfx + ", wrist" + sfx + ": no " + sideWord +
                         " humerus found (the " + sideWord + " arm stays with the torso)");
@@ -396,7 +460,8 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
       // The groin runs obliquely, 30 degrees lower towards the crotch than at the hip's side.
       const V inward = (medial - medial.dot(ufe) * ufe).normalized();
       j.planeNormal = (std::cos(kPi / 6) * ufe - std::sin(kPi / 6) * inward).normalized();
-      add(j, JointKind::Hip, "hip" + sfx, side, 2, partOf(BoneKind::Femur, side));
+      add(j, JointKind::Hip, "hip" + sfx, side, lumbosacral ? kPartPelvis : 2,
+          partOf(BoneKind::Femur, side));
     } else {
       missing.push_back("hip" + sfx + ", knee" + sfx + ", ankle" + sfx + ": no " + sideWord +
                         " femur found (the " + sideWord + " leg stays with the torso)");
@@ -454,9 +519,12 @@ LabelTable rigPartLabels() {
                                 "foot_left",
                                 "thigh_right",
                                 "shank_right",
-                                "foot_right"};
+                                "foot_right",
+                                "shoulder_girdle_left",
+                                "shoulder_girdle_right",
+                                "pelvis"};
   LabelTable t;
-  for (int v = 1; v < 15; ++v) {
+  for (int v = 1; v <= kPartPelvis; ++v) {
     Label l;
     l.value = v;
     l.name = names[v];

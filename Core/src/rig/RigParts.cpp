@@ -190,7 +190,82 @@ Volume assignParts(const Volume& organs, const LabelConvention& convention, cons
     const int part = limbRooted(bone.kind, bone.side) ? partOf(bone.kind, bone.side) : 2;
     for (const std::int64_t v : bone.voxels) s[v] = std::uint8_t(part);
   }
+  assignGirdlesAndPelvis(parts, bones, joints, grid, threads);
   return parts;
+}
+
+void assignGirdlesAndPelvis(Volume& parts, const Bones& bones,
+                            const std::vector<FittedJoint>& joints, const Grid& grid, int threads) {
+  std::uint8_t* s = parts.data<std::uint8_t>();
+  const std::int64_t n = grid.count();
+  const V up = bones.frame.superior;
+  // The pelvis: the trunk below the lumbosacral joint's plane, with the pelvic bones whole and
+  // the spine below the plane (the sacrum).
+  if (const FittedJoint* ls = jointNamed(joints, "lumbosacral")) {
+    for (std::int64_t i = 0; i < n; ++i)
+      if (s[i] == 2 && (grid.ras(i) - ls->centre).dot(up) < 0) s[i] = kPartPelvis;
+    if (const Bone* pelvis = bones.find(BoneKind::Pelvis, 0))
+      for (const std::int64_t v : pelvis->voxels) s[v] = kPartPelvis;
+  }
+  // Each shoulder girdle: its clavicle and scapula, and the trunk's tissue within kGirdleMm of
+  // them that lies nearer them than the rest of the axial skeleton (the ribs under the scapula,
+  // the spine beside its medial border, the sternum), on their side of the midline.
+  constexpr double kGirdleMm = 25;
+  for (const int side : {-1, 1}) {
+    if (!jointNamed(joints, side < 0 ? "sternoclavicular_left" : "sternoclavicular_right"))
+      continue;
+    const std::uint8_t part = std::uint8_t(side < 0 ? kPartGirdleLeft : kPartGirdleRight);
+    std::vector<const Bone*> own, other;
+    for (const BoneKind k : {BoneKind::Clavicle, BoneKind::Scapula})
+      if (const Bone* b = bones.find(k, side)) own.push_back(b);
+    for (const BoneKind k : {BoneKind::Ribs, BoneKind::Spine, BoneKind::Sternum})
+      if (const Bone* b = bones.find(k, 0)) other.push_back(b);
+    // The girdle bones' box grown by the reach, in voxels.
+    const auto& d = grid.dims;
+    std::array<std::int64_t, 3> lo{d[0], d[1], d[2]}, hi{-1, -1, -1};
+    for (const Bone* b : own)
+      for (const std::int64_t v : b->voxels) {
+        const std::int64_t ijk[3] = {v % d[0], (v / d[0]) % d[1], v / (d[0] * d[1])};
+        for (int a = 0; a < 3; ++a)
+          lo[std::size_t(a)] = std::min(lo[std::size_t(a)], ijk[a]),
+          hi[std::size_t(a)] = std::max(hi[std::size_t(a)], ijk[a]);
+      }
+    if (hi[0] < 0) continue;
+    std::array<std::int64_t, 3> box;
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t grow = std::int64_t(std::ceil(kGirdleMm / grid.spacing[a])) + 1;
+      lo[std::size_t(a)] = std::max<std::int64_t>(0, lo[std::size_t(a)] - grow);
+      hi[std::size_t(a)] = std::min<std::int64_t>(d[std::size_t(a)] - 1, hi[std::size_t(a)] + grow);
+      box[std::size_t(a)] = hi[std::size_t(a)] - lo[std::size_t(a)] + 1;
+    }
+    auto local = [&](std::int64_t v) {
+      const std::int64_t i = v % d[0] - lo[0], j = (v / d[0]) % d[1] - lo[1],
+                         k = v / (d[0] * d[1]) - lo[2];
+      if (i < 0 || j < 0 || k < 0 || i >= box[0] || j >= box[1] || k >= box[2]) return std::int64_t(-1);
+      return i + box[0] * (j + box[1] * k);
+    };
+    std::vector<std::uint8_t> mine(std::size_t(box[0] * box[1] * box[2]), 0), theirs(mine.size(), 0);
+    for (const Bone* b : own)
+      for (const std::int64_t v : b->voxels) mine[std::size_t(local(v))] = 1;
+    for (const Bone* b : other)
+      for (const std::int64_t v : b->voxels)
+        if (const std::int64_t l = local(v); l >= 0) theirs[std::size_t(l)] = 1;
+    const std::vector<float> toMine = squaredDistanceToMask(mine, box, grid.spacing, threads);
+    const std::vector<float> toTheirs = squaredDistanceToMask(theirs, box, grid.spacing, threads);
+    const double reach2 = kGirdleMm * kGirdleMm;
+    for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+      for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
+          const std::int64_t v = i + d[0] * (j + d[1] * k);
+          if (s[v] != 2) continue;  // the trunk's tissue only (not the pelvis, a limb or the head)
+          const std::size_t l = std::size_t((i - lo[0]) + box[0] * ((j - lo[1]) + box[1] * (k - lo[2])));
+          if (double(toMine[l]) > reach2 || toMine[l] >= toTheirs[l]) continue;
+          if ((grid.ras(v).x() - bones.frame.midlineX) * double(side) <= 0) continue;
+          s[v] = part;
+        }
+    for (const Bone* b : own)
+      for (const std::int64_t v : b->voxels) s[v] = part;
+  }
 }
 
 double jointRadius(const Volume& parts, const FittedJoint& joint, const Grid& grid) {
@@ -213,7 +288,8 @@ double jointRadius(const Volume& parts, const FittedJoint& joint, const Grid& gr
         for (int ax = 0; ax < 3; ++ax) {
           if (ijk[ax] + 1 >= d[ax] || !isPair(a, s[v + step[ax]])) continue;
           const V m = 0.5 * (grid.ras(v) + grid.ras(v + step[ax]));
-          if (std::fabs((m - joint.centre).dot(joint.planeNormal)) > slab) continue;
+          if (!joint.wholeInterface && std::fabs((m - joint.centre).dot(joint.planeNormal)) > slab)
+            continue;
           reach.push_back((m - joint.centre).norm());
         }
       }

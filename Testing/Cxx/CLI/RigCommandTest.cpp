@@ -79,12 +79,15 @@ TEST(RigCommand, RigsTheArmsRestingPhantomAndPosesItByNamedJointsWithAutomaticCu
   const double predicted = u["predicted"]["body_change_percent"].get<double>();
   EXPECT_GT(std::fabs(predicted), 0.5);
   EXPECT_NEAR(predicted, uncutBody, 0.5 * std::fabs(uncutBody));
-  EXPECT_EQ(u["predicted"]["worst_part"], "torso");
+  // What is dragged is the body beside the arm (the trunk, or the thigh the hand rests on),
+  // and what drags it is a part of the left arm.
+  const std::string worst = u["predicted"]["worst_part"].get<std::string>();
+  EXPECT_TRUE(worst == "torso" || worst == "thigh_left") << worst;
   EXPECT_NE(u["predicted"]["dragged_by"].get<std::string>().find("_left"), std::string::npos);
   const std::string line = "predicts a body volume change of";
   ASSERT_NE(uncut.err.find(line), std::string::npos) << uncut.err;
   const std::string said = uncut.err.substr(uncut.err.find(line));
-  EXPECT_NE(said.substr(0, said.find('\n')).find("torso"), std::string::npos) << said;
+  EXPECT_NE(said.substr(0, said.find('\n')).find(worst), std::string::npos) << said;
   // With the cut, nothing to warn of: the prediction is within the target, no bones collide.
   EXPECT_LT(std::fabs(report["predicted"]["body_change_percent"].get<double>()), 0.5);
   EXPECT_EQ(pose.err.find(line), std::string::npos) << pose.err;

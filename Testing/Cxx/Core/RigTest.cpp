@@ -37,13 +37,22 @@ void PrintTo(const Variant& v, std::ostream* os) {
 
 class RigPhantom : public ::testing::TestWithParam<Variant> {};
 
+// The phantom's own S has no girdles and no pelvis: where the rig makes them (parts 15-17), they
+// are the phantom's torso.
+double trunk(double part) {
+  return part >= 15 && part <= 17 ? 2 : part;
+}
+std::string trunk(const std::string& part) {
+  return part.rfind("shoulder_girdle", 0) == 0 || part == "pelvis" ? "torso" : part;
+}
+
 double agreement(const Volume& truth, const Volume& rigged) {
   std::int64_t body = 0, same = 0;
   for (std::int64_t i = 0; i < truth.numVoxels(); ++i) {
     const double t = truth.valueAsDouble(i);
     if (t <= 0) continue;
     ++body;
-    same += rigged.valueAsDouble(i) == t;
+    same += trunk(rigged.valueAsDouble(i)) == trunk(t);
   }
   return double(same) / double(std::max<std::int64_t>(1, body));
 }
@@ -61,7 +70,13 @@ TEST_P(RigPhantom, ReproducesThePhantomsPartsAndJoints) {
   RigOptions ro;
   ro.source = v.name;
   const RigResult rig = rigBody(G, ro);
-  EXPECT_TRUE(rig.missing.empty()) << rig.missing.front();
+  // The free-armed phantom has no clavicles (the basic anatomy): its girdles stay with the torso,
+  // and the rig says so; every other joint is made.
+  for (const std::string& m : rig.missing)
+    EXPECT_TRUE(!v.armsResting && m.rfind("sternoclavicular", 0) == 0) << m;
+  if (v.armsResting)
+    for (const char* j : {"sternoclavicular_left", "sternoclavicular_right", "lumbosacral"})
+      EXPECT_NE(rig.skeleton.find(j), nullptr) << j;
   for (const std::string& w : rig.warnings)  // the phantom's margin leaves every bone whole
     EXPECT_EQ(w.find("edge cuts"), std::string::npos) << w;
   EXPECT_GE(agreement(S, rig.parts), 0.95);
@@ -75,7 +90,8 @@ TEST_P(RigPhantom, ReproducesThePhantomsPartsAndJoints) {
     const SkeletonJoint* found = rig.skeleton.find(j.name);
     ASSERT_NE(found, nullptr) << j.name;
     EXPECT_LT((found->centre - j.centre).norm(), 5.0) << j.name;
-    EXPECT_EQ(found->parts, j.parts) << j.name;
+    EXPECT_EQ(trunk(found->parts[0]), trunk(j.parts[0])) << j.name;
+    EXPECT_EQ(found->parts[1], j.parts[1]) << j.name;
     ASSERT_NE(found->axis("flexion"), nullptr) << j.name;
     // The flexion axes agree in direction (within 25 degrees: a hinge fitted to the condyles).
     if (j.axis("flexion"))
@@ -266,7 +282,7 @@ TEST(Rig, AnUnnamedBodyPartMapIsNamedByTheRigsConventionOnlyWhenItFits) {
   EXPECT_EQ(plain.labels().find(14)->name, "foot_right");
   // A value outside the convention: left alone.
   Volume other = s;
-  other.data<std::uint8_t>()[2] = 15;
+  other.data<std::uint8_t>()[2] = 18;
   EXPECT_EQ(nameBodyPartsByRigConvention(other, "S.nrrd"), "");
   EXPECT_TRUE(other.labels().empty());
   // A map with its own names: left alone.

@@ -14,7 +14,7 @@ using namespace repose;
 TEST(TissueTable, ThePhantomTableNamesEveryPhantomLabelWithBonesRigid) {
   const TissueTable t =
       readTissueTable(std::string(REPOSE_SOURCE_DIR) + "/Resources/Tissues/phantom.csv");
-  EXPECT_EQ(t.size(), 34u);  // 27 labels, and 7 more of the detailed anatomy (--arms-resting)
+  EXPECT_EQ(t.size(), 36u);  // 27 labels, and 9 more of the detailed anatomy (--arms-resting)
   EXPECT_EQ(t.at(12).name, "radius_ulna");
   EXPECT_TRUE(t.at(12).rigid);
   EXPECT_FALSE(t.at(3).rigid);  // muscle

@@ -31,6 +31,9 @@ struct BendJoint {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   Eigen::Vector3d distal = Eigen::Vector3d::UnitZ();  // the distal segment's direction at rest
   int proximalPart = 0, distalPart = 0;               // labels of S (the TM's tet labels)
+  // More parts on the proximal side, bent with it where the same group carries them (the torso
+  // beside a shoulder whose girdle is a part of its own: the armpit).
+  std::vector<int> proximalAlso;
   double radiusMm = 0;  // where the two parts meet across the joint (Skeleton's radius_mm)
   // How far from the centre the bend reaches (beyond, each part follows its group's motion), in
   // radii, on the proximal and the distal side; in between it follows the share of the turn, so

@@ -32,6 +32,9 @@ struct RigidHandle {
   std::vector<int> cageVertices;  // indices into the cage; a vertex belongs to one group at most
   std::vector<int> parts;         // labels of S the group carries; empty: decided by the cage
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // rest RAS mm -> posed RAS mm
+  // Rings its transitions are widened by beyond everyone's (PoseGroup::widen): a girdle that
+  // glides over the trunk spreads its turn over a band of tissue, not one ring of tets.
+  int widen = 0;
 };
 
 // Per TM vertex, computed once per handle set: how much each group carries it, and how much the

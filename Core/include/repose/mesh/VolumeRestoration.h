@@ -21,15 +21,32 @@
 #pragma once
 
 #include "repose/mesh/TransferMesh.h"
+#include "repose/volume/Volume.h"
 
 #include <Eigen/Core>
 
+#include <utility>
 #include <vector>
 
 namespace repose {
 
+// Which tissue each soft tet holds at rest: per tet, the labels of G whose voxel centres lie in it
+// and how many (whole pieces' tets hold none: they are rigid). What the per-tissue volumes of the
+// restoration are counted with, as the voxels' rounding counts them (the sum over a label's rest
+// voxels of their tet's volume ratio).
+struct TetTissues {
+  std::vector<int> offsets;                     // #tets + 1: tet t's entries are [offsets[t], offsets[t+1])
+  std::vector<std::pair<int, int>> entries;     // (label, voxels)
+  bool empty() const { return entries.empty(); }
+};
+// G on its own grid (any orientation), the mesh at rest in the same RAS space.
+TetTissues tetTissues(const TransferMesh& mesh, const Volume& organs, int threads = 0);
+
 struct VolumeRestorationOptions {
-  int iterations = 5;
+  // Rounds at most; each moves no vertex more than its shortest rest edge, the rounds stop once
+  // no vertex moves more than 0.1 um, and the positions whose worst constraint is met best are
+  // kept (never worse than the solve and the bends left them).
+  int iterations = 12;
   // Tets whose posed volume differs from their rest volume by more than this fraction free their
   // vertices, and `rings` rings of neighbours around them, for the correction.
   double tolerance = 1e-3;
@@ -43,6 +60,8 @@ struct VolumeRestorationOptions {
 struct VolumeRestorationReport {
   int freeVertices = 0;
   int parts = 0;                 // body parts whose volume was held
+  int tissues = 0;               // labels of G whose volume was held
+  int iterations = 0;            // rounds taken
   double maxCorrectionMm = 0;    // the largest distance a vertex was moved
   double worstPartBefore = 0;    // the largest |volume change| of a part, percent
   double worstPartAfter = 0;
@@ -55,9 +74,14 @@ struct VolumeRestorationReport {
 // `held[t]` (optional, one per tet): the tets whose volumes each part's constraint sums besides
 // those the correction reaches (the soft tets between two bone ends, which no free vertex can
 // reach: the tissue around them makes up for them). Empty: only the reached tets.
+// `tissues` (optional): each tissue of the summed tets is held at its rest volume too (the sum of
+// its tets' volume ratios times its voxels there), so a vessel crossing a crease keeps its
+// volume, not only the body part around it. Constraints that cannot be met together (a tissue
+// only in tets no free vertex reaches) are met as nearly as they can.
 VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vector<char>& movable,
                                        Eigen::MatrixX3d& deformed,
                                        const VolumeRestorationOptions& options = {},
-                                       const std::vector<char>& held = {});
+                                       const std::vector<char>& held = {},
+                                       const TetTissues* tissues = nullptr);
 
 }  // namespace repose

@@ -61,6 +61,9 @@ struct PoseGroup {
   // followed by that group's motion (a chain of joints: the forearm turns at the elbow and goes
   // where the shoulder takes the upper arm). No cycles; a fixed group follows nothing.
   std::string follows;
+  // Rings its transitions are widened by beyond the pose's joint_rings (not in pose files: the
+  // rhythms' groups, whose parts meet the trunk all around, set it).
+  int widen = 0;
 };
 
 struct PoseKeyframe {
@@ -78,6 +81,10 @@ struct PoseSeparation {
 struct Pose {
   std::string name, description;
   int jointRings = 0;  // widening of the joints' transitions (computeHandleInfluence), 0..8
+  // The rhythms a body follows when the skeleton has their joints (pose/PoseRhythm.h): the
+  // shoulder girdle turning with an arm raised beyond 90 degrees, the pelvis tilting back with a
+  // hip flexed beyond 60. A pose file's "rhythms" switches either off.
+  bool scapulohumeralRhythm = true, lumbopelvicRhythm = true;
   std::vector<PoseSeparation> separations;
   std::vector<PoseGroup> groups;
   std::vector<PoseKeyframe> keyframes;

@@ -11,6 +11,7 @@
 #include "repose/pose/ContactSeparation.h"
 #include "repose/pose/Pose.h"
 #include "repose/pose/PoseFrame.h"
+#include "repose/pose/PoseRhythm.h"
 #include "repose/pose/PoseRig.h"
 #include "repose/pose/Skeleton.h"
 #include "repose/volume/TissueTable.h"
@@ -95,13 +96,17 @@ class PoseJob {
   PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRequest request,
           const Volume* image = nullptr);
 
-  const Pose& pose() const { return pose_; }  // joints resolved to places and axes
+  // Joints resolved to places and axes, with the rhythms' groups (PoseRhythm.h) after the user's.
+  const Pose& pose() const { return pose_; }
+  // The same without the rhythms' groups: what makeRig(geometry, threads) rigs and edits change.
+  const Pose& userPose() const { return userPose_; }
   const RigSettings& settings() const { return settings_; }
   const PoseSeparations& separations() const { return separations_; }
   const TissueChoice& tissues() const { return tissues_; }
   const std::optional<Skeleton>& skeleton() const { return skeleton_; }
   int jointRings() const { return jointRings_; }
-  // One line each: a tissue table beside S that does not fit G, touching parts left joined.
+  // One line each: a tissue table beside S that does not fit G, touching parts left joined, turns
+  // beyond a joint's range of motion.
   const std::vector<std::string>& warnings() const { return warnings_; }
   // The scene key of the rig this job builds (SceneFolder.h: sceneRigKey), for S at partsPath
   // ("": the request's).
@@ -111,8 +116,8 @@ class PoseJob {
   RigGeometry buildGeometry(const ProgressFn& progress = {}) const;
   // The rig of a geometry (built here, or a scene's) for this job's pose, with its joints bent.
   std::unique_ptr<PoseRig> makeRig(RigGeometry geometry, int threads = 0) const;
-  // A rig for another pose of the same body (an edit of the groups, a live session): the same
-  // joints bent.
+  // A rig for another pose of the same body (an edit of the groups, a live session; as its user
+  // wrote it: the rhythms' groups are added here): the same joints bent.
   std::unique_ptr<PoseRig> makeRig(RigGeometry geometry, const Pose& pose, int threads) const;
   // The frame options the job decides (the tissue table and its name); the caller adds output
   // spacing, image, progress and warnings.
@@ -128,7 +133,9 @@ class PoseJob {
   const Volume* organs_;
   const Volume* parts_;
   PoseJobRequest request_;
-  Pose pose_;
+  Pose pose_, userPose_;
+  PoseRhythms rhythms_;
+  std::vector<std::string> rhythmNotes_;  // report.json's rhythms.applied
   RigSettings settings_;
   PoseSeparations separations_;
   TissueChoice tissues_;

@@ -10,6 +10,7 @@
 #include "repose/mesh/Refinement.h"
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseRhythm.h"
 #include "repose/util/Progress.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
@@ -159,10 +160,26 @@ class PoseRig {
   const CageDeformation& deformation() const { return *deformation_; }
   const std::vector<RigidHandle>& handles() const { return handles_; }
   const HandleInfluence& influence() const { return influence_; }
+  // The pose the rig solves: with the rhythms' groups, when the rig was given rhythms.
   const Pose& pose() const { return pose_; }
+  // The pose as its user wrote it (without the rhythms' groups): edits of it are what
+  // frame(edited) and liveFrame take, and what a scene folder keeps.
+  const Pose& userPose() const { return userPose_; }
+  // The rhythms `pose` was given (PoseJob::makeRig): edits of the user's pose get them too.
+  void setRhythms(const Pose& userPose, PoseRhythms rhythms) {
+    userPose_ = userPose;
+    rhythms_ = std::move(rhythms);
+  }
   // Whether frame() restores the soft tissue's volumes after the solve and the bends
   // (VolumeRestoration.h; on by default). Live frames never do: they are previews.
   void setVolumeRestoration(bool on) { restoreVolumes_ = on; }
+  // The tissues of G each soft tet holds at rest (tetTissues): with them the restoration holds
+  // each tissue's volume at the joints as well as each body part's. Without, parts only.
+  void setTetTissues(TetTissues tissues) { tissues_ = std::move(tissues); }
+  // The pairs of body parts (labels of S) a joint of the skeleton connects: where two groups
+  // carrying such a pair blend their motions (the girdle on the trunk, the pelvis under it), the
+  // restoration relaxes the transition as it does a bend. Elsewhere a blend is a tether.
+  void setJointedParts(std::vector<std::pair<int, int>> pairs) { jointedParts_ = std::move(pairs); }
   bool volumeRestoration() const { return restoreVolumes_; }
   // The restoration frame() applies, on posed vertices of this rig's mesh solved elsewhere (a
   // live frame, to predict what its export will measure) with the frame's handles (their
@@ -185,13 +202,16 @@ class PoseRig {
   struct CageArap;
   std::unique_ptr<CageArap> arap_;
   RigGeometry geometry_;
-  Pose pose_;
+  Pose pose_, userPose_;
+  PoseRhythms rhythms_;
   std::unique_ptr<CageDeformation> deformation_;
   std::vector<RigidHandle> handles_;
   HandleInfluence influence_;
   JointBends bends_;
   std::vector<char> movable_;  // per TM vertex: not a whole piece's
   bool restoreVolumes_ = true;
+  TetTissues tissues_;
+  std::vector<std::pair<int, int>> jointedParts_;
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames_;
 };
 

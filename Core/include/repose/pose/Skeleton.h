@@ -69,7 +69,11 @@ std::string findTissuesBeside(const std::string& partsPath);
 // and the body's frame; `side` is +1 for the body's right, -1 for its left, 0 on the midline;
 // `palmar` (wrist only) is where the palm faces. What the phantom's and the rig's skeletons both
 // use, so a pose file means the same motion on either.
-enum class JointKind { Shoulder, Elbow, Wrist, Hip, Knee, Ankle, Neck };
+// Sternoclavicular: the shoulder girdle on the trunk (distal: along the clavicle, outwards; its
+// axes "elevation", "protraction" and "rotation"); Lumbosacral: the pelvis under the lumbar spine
+// (distal: downwards; "flexion" tilts the pelvis back, the same turn as the hips' flexion,
+// "lateral", "rotation").
+enum class JointKind { Shoulder, Elbow, Wrist, Hip, Knee, Ankle, Neck, Sternoclavicular, Lumbosacral };
 std::vector<std::pair<std::string, Eigen::Vector3d>> jointAxes(
     JointKind kind, const Eigen::Vector3d& distal, const Eigen::Vector3d& anterior,
     const Eigen::Vector3d& superior, int side,

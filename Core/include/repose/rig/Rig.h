@@ -1,5 +1,7 @@
 // `repose rig`: from a user's organ map G alone to what posing needs — the body-part map S (the
-// phantom's part names: head, torso, upper_arm_left, forearm_left, hand_left, ... foot_right),
+// phantom's part names: head, torso, upper_arm_left, forearm_left, hand_left, ... foot_right;
+// and where G has the clavicles and the pelvis, shoulder_girdle_left/right and pelvis, which the
+// pose's rhythms move: pose/PoseRhythm.h),
 // the skeleton (named joints with their anatomical axes, fitted to the bones' articular ends) and
 // the tissue table (names, densities, which labels are bone and which bone). Works from the bones
 // of G under a label convention (LabelConvention.h); a body part whose bones are missing (a scan
@@ -47,7 +49,8 @@ RigResult rigBody(const Volume& organs, const RigOptions& options = {});
 void writeRigFolder(const RigResult& rig, const std::string& folder, const std::string& input);
 
 // The part names `repose rig` and `repose phantom` give S's values (1 head, 2 torso, 3
-// upper_arm_left, ... 14 foot_right). Names S when it carries no label table at all and its values
+// upper_arm_left, ... 14 foot_right; the rig's 15 and 16 shoulder_girdle_left and _right, 17
+// pelvis). Names S when it carries no label table at all and its values
 // all lie in that range: a plain NRRD or NIfTI without a table, as 3D Slicer hands a CLI module
 // the label map volumes it exports. Returns the warning to give (empty when S was left alone).
 std::string nameBodyPartsByRigConvention(Volume& parts, const std::string& source);
