@@ -10,7 +10,7 @@
 
 #include "repose/dosimetry/FdtdModel.h"
 #include "repose/io/AtomicOutput.h"
-#include "repose/io/FdtdModelIO.h"
+#include "repose/dosimetry/FdtdModelIO.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/util/Error.h"
 

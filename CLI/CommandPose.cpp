@@ -22,6 +22,7 @@
 #include "repose/pose/PoseJob.h"
 #include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRig.h"
+#include "repose/pose/PoseRun.h"
 #include "repose/pose/SceneFolder.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
@@ -300,84 +301,63 @@ int runPose(const Args& args) {
         formatFixed(job.separations().automatic.reachMm, 0) + " mm" +
         (c.joint.empty() ? std::string() : ", outside the " + c.joint + " joint") + ")");
   // Cage and transfer mesh: from the scene when it matches, else built (and saved there).
-  const std::string key = job.sceneKey();
-  std::optional<RigGeometry> fromScene;
-  if (p.has("scene")) {
-    std::string why;
-    fromScene = readSceneRig(p.get("scene"), key, &why);
-    if (!why.empty())
-      std::cerr << "repose pose: note: the scene's rig is built again and saved over it: " << why
-                << std::endl;
-  }
-  const bool reused = fromScene.has_value();
-  RigGeometry geometry;
-  std::string rigCoordinates;
-  if (reused) {
-    geometry = std::move(*fromScene);
-    rigCoordinates = geometry.coordinatesFile;
-    say("reusing the cage and transfer mesh of " + p.get("scene"));
-  } else {
-    say("building the cage (" + std::to_string(rs.cageVertices) + " vertices) and the mesh");
-    geometry = job.buildGeometry(quiet ? ProgressFn{} : terminalProgress());
-  }
-  say("embedding the mesh in the cage");
-  const std::unique_ptr<PoseRig> rigHolder = job.makeRig(std::move(geometry), threads);
-  const PoseRig& rig = *rigHolder;
-  if (p.has("scene") && !reused)
-    writeSceneFolder(p.get("scene"), rig, key,
-                     {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""},
-                     job.settings());
-  if (reused && rig.deformation().coordinatesRead()) {
-    say("Green coordinates read from " + rigCoordinates);
-  } else if (reused) {
-    // A scene of an older version, or one whose file does not belong to its mesh and cage:
-    // computed here, and saved so that the next run reads them.
-    say("Green coordinates computed again: " + rig.deformation().coordinatesNote());
-    rig.deformation().saveCoordinates(rigCoordinates);
-  }
+  SceneRigRun sceneRun;
+  if (p.has("scene")) sceneRun.folder = p.get("scene");
+  sceneRun.inputs = {p.get("input"), p.get("parts"), p.has("image") ? p.get("image") : ""};
+  sceneRun.threads = threads;
+  sceneRun.buildProgress = quiet ? ProgressFn{} : terminalProgress();
+  sceneRun.say = say;
+  sceneRun.note = [](const std::string& line) {
+    std::cerr << "repose pose: note: " << line << std::endl;
+  };
+  const SceneRig sceneRig = rigForScene(job, sceneRun);
+  const PoseRig& rig = *sceneRig.rig;
+  const bool reused = sceneRig.reused;
   const bool oneFrame = rig.frameCount() == 1;
   if (single.frame >= rig.frameCount())
     throw Error(p.get("pose") + ": has " + std::to_string(rig.frameCount()) +
                 " frame(s); --frame " + std::to_string(single.frame) + " is not one of them");
   fs::create_directories(outDir);
-  PoseFrameOptions fo = job.frameOptions();
-  fo.image = image ? &*image : nullptr;
-  fo.background = background;  // unset: the image's minimum (Core's rule)
-  fo.spacingMm = spacingMm;
-  fo.fillPockets = !p.has("keep-pockets");
-  fo.preserveLabelVolumes = p.get("label-volumes") == "preserve";
-  fo.labelMapFiles = labelMapFiles;
+  // The frame step is Core's (pose/PoseRun.h): this command says what it was asked and what
+  // came back.
+  FrameRun run;
+  run.image = image ? &*image : nullptr;
+  run.background = background;  // unset: the image's minimum (Core's rule)
+  run.spacingMm = spacingMm;
+  run.fillPockets = !p.has("keep-pockets");
+  run.preserveLabelVolumes = p.get("label-volumes") == "preserve";
+  run.labelMapFiles = labelMapFiles;
+  run.memoryBudget = budget;
+  run.budgetHint = "--memory; out of core: `repose warp`";
+  run.sceneReused = reused;
+  if (labelMapFiles == LabelMapFiles::DicomSeg)
+    run.write.sourceDicom = dicomSourceOf(p.get("input"));
+  if (p.has("scene")) {  // a Slicer scene of the frame, with the rig kept in the scene folder
+    const fs::path scene = fs::absolute(p.get("scene"));
+    run.write.sceneInputLabels = fs::absolute(p.get("input")).string();
+    run.write.sceneCage = (scene / "cage.vtk").string();
+    run.write.sceneTransferMesh = (scene / "tm.vtu").string();
+  }
   json summary = json::array();
   int missedFrames = 0;
   for (std::size_t index = 0; index < rig.frameCount(); ++index) {
     const std::string frameName = rig.frameName(index);
-    // Memory: the posed G and S, the image and the field beside the inputs, refused above the
-    // budget before anything is allocated.
-    fo.checkGrid = [&](const VolumeGeometry& grid) {
-      checkFrameMemory(grid, posedBytesPerVoxel(organs, parts, fo.image), budget,
-                       outDir + ": frame " + frameName, "--memory; out of core: `repose warp`");
+    const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
+    run.folder = dir.string();
+    run.budgetWhat = outDir + ": frame " + frameName;
+    run.onGrid = [&](const VolumeGeometry& grid) {
       say("frame " + frameName + ": " + std::to_string(grid.dims[0]) + " x " +
           std::to_string(grid.dims[1]) + " x " + std::to_string(grid.dims[2]) + " voxels");
     };
-    fo.progress = quiet ? ProgressFn{} : terminalProgress();
+    run.progress = quiet ? ProgressFn{} : terminalProgress();
     // What a pose can do wrong (the body volume the posed mesh predicts, bones run into each
     // other, folds), said on stderr as soon as it is known (stdout may be JSON).
-    fo.warn = [&](const std::string& line) {
+    run.warn = [&](const std::string& line) {
       std::cerr << "repose pose: warning: frame " << frameName << ": " << line << std::endl;
     };
-    PosedFrame posed = poseFrame(rig, index, organs, parts, fo);
-    posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
-    const fs::path dir = oneFrame ? fs::path(outDir) : fs::path(outDir) / frameName;
-    FrameWriteOptions wo;
-    wo.labelMapFiles = labelMapFiles;
-    if (labelMapFiles == LabelMapFiles::DicomSeg) wo.sourceDicom = dicomSourceOf(p.get("input"));
-    if (p.has("scene")) {  // a Slicer scene of the frame, with the rig kept in the scene folder
-      const fs::path scene = fs::absolute(p.get("scene"));
-      wo.sceneInputLabels = fs::absolute(p.get("input")).string();
-      wo.sceneCage = (scene / "cage.vtk").string();
-      wo.sceneTransferMesh = (scene / "tm.vtu").string();
-    }
-    const json report = json::parse(writePosedFrame(posed, dir.string(), wo));
+    const FrameOutcome outcome = runPoseFrame(job, rig, index, organs, parts, run);
+    const PosedFrame& posed = outcome.frame;
+    const json report = json::parse(outcome.reportJson);
     if (index == single.frame) {
       writeFrameOutputs(single, posed);
       if (!single.returnParameters.empty()) writeReturnParameters(single.returnParameters, report);
@@ -393,12 +373,9 @@ int runPose(const Args& args) {
         (dir / "report.json").string());
     // A frame that missed a target is written all the same (users may want it), and said so in
     // one line naming what missed; the exit status says it too.
-    if (!report["targets"]["met"].get<bool>()) {
-      std::string what;
-      for (const auto& line : report["targets"]["missed"])
-        what += (what.empty() ? "" : "; ") + line.get<std::string>();
+    if (!outcome.targetsMet) {
       std::cerr << "repose pose: frame " << frameName << " written, but it missed its targets: "
-                << what << std::endl;
+                << outcome.missedLine() << std::endl;
       ++missedFrames;
     }
     summary.push_back(report);

@@ -17,6 +17,7 @@
 #include "repose/pose/Pose.h"
 #include "repose/pose/PoseFrame.h"
 #include "repose/pose/PoseJob.h"
+#include "repose/pose/PoseRun.h"
 #include "repose/pose/SceneFolder.h"
 #include "repose/pose/Sweep.h"
 #include "repose/rig/Rig.h"
@@ -107,9 +108,13 @@ class Worker {
   const PoseRig& rig(std::int64_t task, bool& reused) {
     const PoseJob& j = job(task);
     if (!rig_) {
-      std::optional<RigGeometry> g = readSceneRig(sceneFolder(task), j.sceneKey());
-      rigReused_ = g.has_value();
-      rig_ = j.makeRig(rigReused_ ? std::move(*g) : j.buildGeometry(), settings_.threads);
+      SceneRigRun run;
+      run.folder = sceneFolder(task);
+      run.saveBuilt = false;  // phase 2 saved it, or could not
+      run.threads = settings_.threads;
+      SceneRig r = rigForScene(j, run);
+      rigReused_ = r.reused;
+      rig_ = std::move(r.rig);
     }
     reused = rigReused_;
     return *rig_;
@@ -208,11 +213,12 @@ std::map<std::string, std::string> buildScenes(SweepComm& comm, Worker& worker,
     try {
       if (readSceneRig(folder, plans[t].key)) continue;  // a scene of an earlier run
       const auto start = Clock::now();
-      const PoseJob& job = worker.job(t);
-      const std::unique_ptr<PoseRig> rig = job.makeRig(job.buildGeometry(), settings.threads);
+      SceneRigRun run;
+      run.folder = folder;
+      run.inputs = {worker.subject(t).organs, worker.subject(t).parts, ""};
+      run.threads = settings.threads;
       fs::create_directories(fs::path(folder).parent_path());
-      writeSceneFolder(folder, *rig, plans[t].key,
-                       {worker.subject(t).organs, worker.subject(t).parts, ""}, job.settings());
+      rigForScene(worker.job(t), run);
       if (!settings.quiet)
         std::cout << "rank " << comm.rank() << ": built the rig of " << worker.subject(t).name
                   << " for " << worker.pose(t).name << " in " << int(secondsSince(start))
@@ -238,31 +244,23 @@ void runJob(Worker& worker, std::int64_t t, std::size_t f, const TaskPlan& plan,
   const PoseJob& job = worker.job(t);
   if (rig.frameCount() != plan.frames.size())
     throw Error(worker.pose(t).path + ": changed during the sweep");
-  PoseFrameOptions fo = job.frameOptions();
-  fo.fillPockets = true;
-  fo.labelMapFiles = labelMapFilesFor(settings.format, worker.subject(t).organs);
-  const double budget = settings.budget;
-  fo.checkGrid = [&](const VolumeGeometry& grid) {
-    const double need =
-        double(grid.numVoxels()) * posedBytesPerVoxel(worker.organs(), worker.parts(), nullptr);
-    if (peakResidentBytes() + need > budget)
-      throw Error(record.folder + ": needs " + gib(need) + " for " +
-                  std::to_string(grid.numVoxels()) + " output voxels beyond the " +
-                  gib(peakResidentBytes()) + " in use, more than the budget of " + gib(budget));
-  };
-  PosedFrame posed = poseFrame(rig, f, worker.organs(), worker.parts(), fo);
-  posed.reportJson = job.completeReport(posed.reportJson, reused, rig);
-  FrameWriteOptions wo;
-  wo.labelMapFiles = fo.labelMapFiles;
-  if (wo.labelMapFiles == LabelMapFiles::DicomSeg)
-    wo.sourceDicom = dicomSourceOf(worker.subject(t).organs);
+  // The frame step is Core's (pose/PoseRun.h), with the memory rule every front end has.
+  FrameRun run;
+  run.labelMapFiles = labelMapFilesFor(settings.format, worker.subject(t).organs);
+  run.memoryBudget = settings.budget;
+  run.budgetWhat = record.folder;
+  run.budgetHint = "--memory";
+  run.sceneReused = reused;
+  if (run.labelMapFiles == LabelMapFiles::DicomSeg)
+    run.write.sourceDicom = dicomSourceOf(worker.subject(t).organs);
   const fs::path scene = fs::absolute(worker.sceneFolder(t));
-  wo.sceneInputLabels = fs::absolute(worker.subject(t).organs).string();
-  wo.sceneCage = (scene / "cage.vtk").string();
-  wo.sceneTransferMesh = (scene / "tm.vtu").string();
+  run.write.sceneInputLabels = fs::absolute(worker.subject(t).organs).string();
+  run.write.sceneCage = (scene / "cage.vtk").string();
+  run.write.sceneTransferMesh = (scene / "tm.vtu").string();
   const std::string dir = (fs::path(settings.outDir) / record.folder).string();
   fs::create_directories(fs::path(dir).parent_path());
-  writePosedFrame(posed, dir, wo);
+  run.folder = dir;
+  runPoseFrame(job, rig, f, worker.organs(), worker.parts(), run);
   readSweepFigures(record, (fs::path(dir) / "report.json").string());
 }
 

@@ -18,6 +18,7 @@
 #include "repose/mesh/RigiditySolver.h"
 #include "repose/mesh/TransferMesh.h"
 #include "repose/pose/PoseFrame.h"
+#include "repose/raster/RasterFile.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"

@@ -1,7 +1,8 @@
-// Checks of input volumes shared by the commands that pose: one line naming the file for what
-// cannot be posed, a warning for what can but may surprise.
+// The command line's side of the input checks: Core's one poseable rule (pose/PoseRun.h) for
+// every front end, and its unnamed-label warning said on stderr as the commands say warnings.
 #pragma once
 
+#include "repose/pose/PoseRun.h"
 #include "repose/volume/Volume.h"
 
 #include <string>
@@ -9,11 +10,9 @@
 
 namespace repose::cli {
 
-// A label map a rig is built from or posed: integer voxels, at least one non-zero voxel, and
-// orthogonal voxel axes. Throws repose::Error naming `path`.
-void requirePoseableLabels(const Volume& volume, const std::string& path);
+using repose::requirePoseableLabels;
 
-// "warning: <path>: labels 7, 9 have voxels but no name in its label table" on stderr.
+// "repose <command>: warning: <path>: labels 7, 9 have voxels but no name ..." on stderr.
 void warnUnnamedLabels(const Volume& volume, const std::string& path, const std::string& command);
 // The same for label values already counted (warp's out-of-core path never holds the volume).
 void warnUnnamedLabels(const std::vector<int>& values, const std::string& path,

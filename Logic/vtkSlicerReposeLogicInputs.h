@@ -4,7 +4,7 @@
 #ifndef vtkSlicerReposeLogicInputs_h
 #define vtkSlicerReposeLogicInputs_h
 
-#include <repose/pose/Skeleton.h>
+#include <repose/skeleton/Skeleton.h>
 #include <repose/volume/LabelTable.h>
 
 #include <optional>

@@ -17,7 +17,7 @@
 #include <repose/mesh/VolumePrediction.h>
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseRig.h>
-#include <repose/pose/Skeleton.h>
+#include <repose/skeleton/Skeleton.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/util/Error.h>
 

@@ -24,6 +24,7 @@
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseReport.h>
 #include <repose/pose/PoseRig.h>
+#include <repose/pose/PoseRun.h>
 #include <repose/raster/PocketFilling.h>
 #include <repose/raster/Rasterizer.h>
 #include <repose/rig/Rig.h>
@@ -140,7 +141,7 @@ vtkMRMLReposeSegmentationNode* vtkSlicerReposeLogic::AddSegmentation(const std::
               ijkToRas(r, c) = this->VolumeIJKToRASMatrix->GetElement(r, c);
         } else {
           repose::Volume G = vtkSlicerReposeLogicRead::ReadVolume(labels, &readNotes);
-          if (!G.isLabelMap()) throw repose::Error(labels + ": not a label map (float voxels)");
+          repose::requirePoseableLabels(G, labels);  // the rule of every front end
           // Names and colours the file left out, so the views and the probe tell labels apart.
           vtkSlicerReposeLogicRead::NameLabels(G, this->TissueTablePath, labels);
           labelMap = Conversion::ToImageData(G);
@@ -308,7 +309,7 @@ bool vtkSlicerReposeLogic::StartRigFromOrganMap(const std::string& labelsPath,
     if (folder.empty()) throw repose::Error("no folder given for the rig");
     auto G =
         std::make_shared<const repose::Volume>(vtkSlicerReposeLogicRead::ReadVolume(labelsPath));
-    if (!G->isLabelMap()) throw repose::Error(labelsPath + ": not a label map (float voxels)");
+    repose::requirePoseableLabels(*G, labelsPath);  // the rule of every front end
     const std::string imagePath = this->ParameterNode ? this->ParameterNode->GetImagePath() : "";
     std::shared_ptr<const repose::Volume> image;
     if (!imagePath.empty())
@@ -435,12 +436,9 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     // physical memory, as --memory's default.
     const double budget =
         1048576.0 * (this->ParameterNode ? this->ParameterNode->GetOutputMemoryBudgetMB() : 0);
-    const double bytesPerVoxel = repose::posedBytesPerVoxel(*G, *S, I.get());
-    auto checkBudget = [budget, bytesPerVoxel](const repose::VolumeGeometry& grid) {
-      repose::checkFrameMemory(grid, bytesPerVoxel, budget, "the posed volumes",
-                               "Output > Memory budget; out of core: `repose warp`");
-    };
-    checkBudget(G->geometry());
+    const char* budgetHint = "Output > Memory budget; out of core: `repose warp`";
+    repose::checkFrameMemory(G->geometry(), repose::posedBytesPerVoxel(*G, *S, I.get()), budget,
+                             "the posed volumes", budgetHint);
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Job->Start(
@@ -449,25 +447,23 @@ bool vtkSlicerReposeLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
             const repose::ProgressFn& progress) mutable -> vtkSlicerReposeJob::Commit {
           repose::reportProgress(progress, 0, "embedding");
           const std::unique_ptr<repose::PoseRig> rig = job->makeRig(std::move(geometry));
-          // The frame as `repose pose` poses it (one implementation: repose::poseFrame).
-          repose::PoseFrameOptions fo = job->frameOptions();
-          fo.image = I.get();  // where no tissue is: Core's rule (imageBackground)
-          fo.checkGrid = checkBudget;
-          fo.progress = [&](double x, const std::string& stage) {
+          // The frame as `repose pose` runs it (one implementation: repose::runPoseFrame).
+          repose::FrameRun run;
+          run.image = I.get();  // where no tissue is: Core's rule (imageBackground)
+          run.memoryBudget = budget;
+          run.budgetHint = budgetHint;
+          run.sceneReused = true;  // the scene's nodes' rig
+          run.progress = [&](double x, const std::string& stage) {
             return progress(0.1 + 0.8 * x, stage);
           };
-          auto f = std::make_shared<repose::PosedFrame>(
-              repose::poseFrame(*rig, std::min(frame, rig->frameCount() - 1), *G, *S, fo));
-          f->reportJson = job->completeReport(f->reportJson, true, *rig);  // the scene's nodes' rig
           // Written here, on the worker: past the rasterization nothing can cancel the job, and
           // the files are atomic, so a cancelled export still leaves the folder as it was.
           // Locked like `repose pose --out`: a run of it writing there refuses, and so does this.
-          if (!outputFolder.empty()) {
-            repose::FrameWriteOptions wo;
-            wo.labelMapFiles = f->labelMapFiles;
-            wo.lockFolder = true;
-            repose::writePosedFrame(*f, outputFolder, wo);
-          }
+          run.folder = outputFolder;
+          run.write.lockFolder = true;
+          auto f = std::make_shared<repose::PosedFrame>(
+              repose::runPoseFrame(*job, *rig, std::min(frame, rig->frameCount() - 1), *G, *S, run)
+                  .frame);
           repose::reportProgress(progress, 1, "posed");
           return [=] {
             auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();

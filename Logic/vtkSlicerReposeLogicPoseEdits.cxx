@@ -10,7 +10,7 @@
 #include "vtkSlicerReposeLogicRead.h"
 
 #include <repose/pose/Pose.h>
-#include <repose/pose/Skeleton.h>
+#include <repose/skeleton/Skeleton.h>
 #include <repose/util/Error.h>
 
 #include <vtkMatrix4x4.h>

@@ -17,7 +17,7 @@
 #include <repose/io/VolumeIO.h>
 #include <repose/mesh/RigiditySolver.h>
 #include <repose/pose/Pose.h>
-#include <repose/pose/Skeleton.h>
+#include <repose/skeleton/Skeleton.h>
 #include <repose/pose/SlicerSceneMrml.h>
 #include <repose/schema/SceneSchema.h>
 #include <repose/util/Error.h>

@@ -11,7 +11,9 @@
 #include "repose/pose/PoseJob.h"
 #include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRig.h"
+#include "repose/pose/PoseRun.h"
 #include "repose/pose/SceneFolder.h"
+#include "repose/raster/RasterFile.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 
@@ -312,8 +314,9 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
                        const py::object& skeleton, bool autoSeparate, const py::object& progress,
                        const std::string& partsPath) {
              const Volume& organs = organsVolume(organsObject);
-             if (!isIntegerType(organs.scalarType()))
-               throw Error("the organ map holds float voxels, not labels");
+             // The rule of every front end (pose/PoseRun.h).
+             requirePoseableLabels(organs, "the organ map");
+             requirePoseableLabels(parts, partsPath.empty() ? "the body-part map" : partsPath);
              PoseJobRequest request =
                  requestFrom(tissuesPath, tissuesAuto, tissuesCsv, skeleton, partsPath);
              request.organsNotes = readNotesOf(organsObject);
@@ -397,37 +400,32 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
              const py::object& image, std::optional<double> background, double spacingMm,
              bool fillPockets, const std::string& labelVolumes, double memoryBytes,
              const py::object& progress) {
-            PoseFrameOptions o = r.job->frameOptions();
-            o.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
-            o.background = background;
-            o.fillPockets = fillPockets;
+            // The frame step is Core's (pose/PoseRun.h), as for `repose pose`.
+            FrameRun run;
+            run.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
+            run.background = background;
+            run.fillPockets = fillPockets;
             if (labelVolumes != "preserve" && labelVolumes != "nearest")
               throw Error("label_volumes must be 'preserve' or 'nearest', not '" + labelVolumes +
                           "'");
-            o.preserveLabelVolumes = labelVolumes == "preserve";
-            o.spacingMm = spacingMm;
+            run.preserveLabelVolumes = labelVolumes == "preserve";
+            run.spacingMm = spacingMm;
             if (!(memoryBytes >= 0)) throw Error("pose_frame: memory_bytes must be >= 0");
-            o.checkGrid = [&](const VolumeGeometry& grid) {
-              checkFrameMemory(grid, posedBytesPerVoxel(organs, parts, o.image), memoryBytes,
-                               "pose_frame", "memory_bytes=; out of core: pose_labels_to_file");
-            };
+            run.memoryBudget = memoryBytes;
+            run.budgetWhat = "pose_frame";
+            run.budgetHint = "memory_bytes=; out of core: pose_labels_to_file";
+            run.sceneReused = r.sceneReused;
             std::vector<std::string> warnings;
-            o.warn = [&](const std::string& line) { warnings.push_back(line); };
-            PosedFrame f = withProgress(progress, [&](const ProgressFn& fn) {
-              o.progress = fn;
-              PosedFrame posed = poseFrame(*r.rig, index, organs, parts, o);
-              posed.reportJson = r.job->completeReport(posed.reportJson, r.sceneReused, *r.rig);
-              return posed;
+            run.warn = [&](const std::string& line) { warnings.push_back(line); };
+            FrameOutcome outcome = withProgress(progress, [&](const ProgressFn& fn) {
+              run.progress = fn;
+              return runPoseFrame(*r.job, *r.rig, index, organs, parts, run);
             });
             // A frame that missed a target is returned all the same, and said so in one line,
             // as `repose pose` says it.
-            const nlohmann::json targets = nlohmann::json::parse(f.reportJson)["targets"];
-            if (!targets["met"].get<bool>()) {
-              std::string missed;
-              for (const auto& line : targets["missed"])
-                missed += (missed.empty() ? "" : "; ") + line.get<std::string>();
-              warnings.push_back("it missed its targets: " + missed);
-            }
+            if (!outcome.targetsMet)
+              warnings.push_back("it missed its targets: " + outcome.missedLine());
+            PosedFrame f = std::move(outcome.frame);
             issueWarnings(f.name, warnings);
             return f;
           },

@@ -2,7 +2,7 @@
 // posing needs (`repose rig`), and skeletons read from skeleton.json.
 #include "PythonCommon.h"
 
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/rig/Rig.h"
 #include "repose/util/Error.h"
 

@@ -21,7 +21,7 @@
 #include <repose/io/AtomicOutput.h>
 #include <repose/io/VolumeIO.h>
 #include <repose/phantom/Phantom.h>
-#include <repose/pose/Skeleton.h>
+#include <repose/skeleton/Skeleton.h>
 
 #include <Eigen/Geometry>
 

@@ -17,15 +17,16 @@ import pytest
 import repose
 import repose.openems as oe
 
-pytest.importorskip("h5py")
-pytest.importorskip("openEMS")
+# scripts/install-deps.sh installs both (python3-h5py, python3-openems): their absence is an error.
+import h5py  # noqa: F401  (openEMS writes its probes in HDF5)
+import openEMS  # noqa: F401
 
 # Under the sanitizer build (make test-asan) the interpreter runs with ASan preloaded; preloading
 # libReposeCsxcadFix (and with it CSXCAD, VTK, boost) beside it deadlocks the child interpreter at
 # start in glibc's setlocale lock. The C++ these tests reach is checked under the sanitizer by
 # CsxcadReadback (the fix, CSXCAD reading our files) and ExportFdtdCommand (the export).
-needs_openems = pytest.mark.skipif(
-    os.environ.get("REPOSE_SANITIZE") == "1",
+UNDER_SANITIZER = os.environ.get("REPOSE_SANITIZE") == "1"
+needs_openems = pytest.mark.skipif(UNDER_SANITIZER,
     reason="openEMS children with ASan and the CSXCAD fix preloaded deadlock at start")
 
 REPO = pathlib.Path(__file__).resolve().parents[2]

@@ -2,7 +2,7 @@
 // frame, the joints fitted to the bones' articular ends, and the part assignment.
 #pragma once
 
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/rig/LabelConvention.h"
 #include "repose/volume/Volume.h"
 

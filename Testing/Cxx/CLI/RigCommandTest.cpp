@@ -164,7 +164,7 @@ TEST(RigCommand, ASegmentationWithoutLimbBonesIsAOneLineErrorAndWritesNothing) {
   // names: one bone, the vertebrae): both told by their names, both without limb bones.
   for (const char* file : {"example_seg.nii.gz", "example_seg_mr.nii.gz"}) {
     const std::string seg = std::string(REPOSE_DATA_DIR) + "/totalsegmentator/" + file;
-    if (!std::filesystem::exists(seg)) GTEST_SKIP() << seg << " not found";
+    ASSERT_TRUE(std::filesystem::exists(seg)) << seg << " not found (../shared/data)";
     ScratchDir dir;
     const CommandResult r = runCommand(
         "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("rig")));
@@ -183,7 +183,8 @@ TEST(RigCommand, ARealOrganSegmentationTakesItsBodyFromItsCtSeries) {
   const std::string data = std::string(REPOSE_DATA_DIR) + "/totalsegmentator/";
   const std::string seg = data + "example_seg_dicom.nii.gz";
   const std::string ct = data + "example_ct_dicom_uncompressed";
-  if (!std::filesystem::exists(seg) || !std::filesystem::exists(ct)) GTEST_SKIP() << "no data";
+  ASSERT_TRUE(std::filesystem::exists(seg) && std::filesystem::exists(ct))
+      << seg << " or " << ct << " not found (../shared/data)";
   ScratchDir dir;
   const CommandResult bare = runCommand(
       "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("bare")));

@@ -57,7 +57,7 @@ struct Elbow {
 }  // namespace
 
 TEST(WarpMpiCommand, SlabsOverRanksWriteTheSerialOutOfCoreFileByteForByte) {
-  if (!fs::exists("/usr/bin/mpirun")) GTEST_SKIP() << "no mpirun";
+  ASSERT_TRUE(fs::exists("/usr/bin/mpirun")) << "scripts/install-deps.sh installs openmpi-bin";
   // As for the sweep: sanitized ranks under mpirun are not yet checked (docs/RELIABILITY.md).
   if (kAddressSanitizer) GTEST_SKIP() << "mpirun under AddressSanitizer (docs/RELIABILITY.md)";
   Elbow e;
@@ -102,7 +102,7 @@ TEST(WarpMpiCommand, SlabsOverRanksWriteTheSerialOutOfCoreFileByteForByte) {
 }
 
 TEST(WarpMpiCommand, AFailureOnTheRanksIsReportedOnceAndLeavesNothing) {
-  if (!fs::exists("/usr/bin/mpirun")) GTEST_SKIP() << "no mpirun";
+  ASSERT_TRUE(fs::exists("/usr/bin/mpirun")) << "scripts/install-deps.sh installs openmpi-bin";
   if (kAddressSanitizer) GTEST_SKIP() << "mpirun under AddressSanitizer (docs/RELIABILITY.md)";
   Elbow e;
   TriangleMesh wrong = readTriangleMesh(e.cage);

@@ -437,8 +437,9 @@ TEST(AnatomyColors, SlicersOwnTableIsFoundInItsInstallation) {
     const ScopedEnv noHome("SLICER_HOME", nullptr), inHome("HOME", &userHome);
     const std::string found = repose::findSlicerColorTable();
     // /opt or /usr/local may hold a newer Slicer on a developer's machine; here, ours.
-    if (found.rfind("/opt", 0) != 0 && found.rfind("/usr/local", 0) != 0)
+    if (found.rfind("/opt", 0) != 0 && found.rfind("/usr/local", 0) != 0) {
       EXPECT_EQ(found, (home / "share/Slicer-5.10/ColorFiles/GenericAnatomyColors.txt").string());
+    }
   }
   // A table that does not exist in the installation: nothing found.
   EXPECT_EQ(repose::findSlicerColorTable("NoSuchTable.txt"), "");

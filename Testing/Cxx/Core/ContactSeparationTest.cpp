@@ -101,7 +101,7 @@ Plain plainCount(const Volume& s, double reach) {
 }  // namespace
 
 TEST(ContactSeparation, NearPartsAreCutAsAPlainCountFindsThemAlongEveryAxisAndGrid) {
-  for (const Eigen::Vector3d spacing :
+  for (const Eigen::Vector3d& spacing :
        {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1.8, 1.8, 4.8), Eigen::Vector3d(4.8, 2, 1.5)})
     for (int axis = 0; axis < 3; ++axis)
       for (const int gapVoxels : {0, 1, 3}) {
@@ -138,8 +138,9 @@ TEST(ContactSeparation, NearPartsAreCutAsAPlainCountFindsThemAlongEveryAxisAndGr
         EXPECT_EQ(touching.made.size(), gapVoxels == 0 ? 1u : 0u) << what;
         // Beyond the reach nothing is near.
         options.reachMm = 0.99 * (gapVoxels + 1) * spacing[axis];
-        if (gapVoxels > 0)
+        if (gapVoxels > 0) {
           EXPECT_TRUE(findContactSeparations(s, aMoves(), nullptr, options).made.empty()) << what;
+        }
       }
 }
 

@@ -332,7 +332,8 @@ TEST(Phantom, HandsClearOfTheHipsByDefaultAndPressedAgainstThemWhenTouching) {
 // gap apart (within two voxels beyond it), and the forearm beyond its elbow end keeps its gap from
 // the trunk and hips; the upper arm still rests on the chest wall.
 TEST(Phantom, TheGapVariantHoldsHandsAndForearmsOffTheBodyByTheirGaps) {
-  for (const Eigen::Vector3d spacing : {Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(1.8, 1.8, 4.8)}) {
+  for (const Eigen::Vector3d& spacing :
+       {Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(1.8, 1.8, 4.8)}) {
     PhantomOptions o;
     o.spacingMm = spacing;
     o.armsResting = true;

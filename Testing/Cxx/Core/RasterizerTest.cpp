@@ -11,6 +11,7 @@
 #include "repose/mesh/TransferMesh.h"
 #include "repose/phantom/Phantom.h"
 #include "repose/phantom/PhantomPoses.h"
+#include "repose/raster/RasterFile.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 

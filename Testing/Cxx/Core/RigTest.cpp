@@ -74,15 +74,18 @@ TEST_P(RigPhantom, ReproducesThePhantomsPartsAndJoints) {
   // and the rig says so; every other joint is made.
   for (const std::string& m : rig.missing)
     EXPECT_TRUE(!v.armsResting && m.rfind("sternoclavicular", 0) == 0) << m;
-  if (v.armsResting)
+  if (v.armsResting) {
     for (const char* j : {"sternoclavicular_left", "sternoclavicular_right", "lumbosacral"})
       EXPECT_NE(rig.skeleton.find(j), nullptr) << j;
+  }
   for (const std::string& w : rig.warnings)  // the phantom's margin leaves every bone whole
     EXPECT_EQ(w.find("edge cuts"), std::string::npos) << w;
   EXPECT_GE(agreement(S, rig.parts), 0.95);
   // The parts keep the phantom's names and numbers, so pose files written for it pose this rig.
   for (const Label& l : S.labels().labels())
-    if (l.value > 0) EXPECT_EQ(rig.parts.labels().find(l.value)->name, l.name);
+    if (l.value > 0) {
+      EXPECT_EQ(rig.parts.labels().find(l.value)->name, l.name);
+    }
   const Skeleton truth = phantom.skeleton();
   int compared = 0;
   for (const SkeletonJoint& j : truth.joints) {
@@ -94,9 +97,10 @@ TEST_P(RigPhantom, ReproducesThePhantomsPartsAndJoints) {
     EXPECT_EQ(found->parts[1], j.parts[1]) << j.name;
     ASSERT_NE(found->axis("flexion"), nullptr) << j.name;
     // The flexion axes agree in direction (within 25 degrees: a hinge fitted to the condyles).
-    if (j.axis("flexion"))
+    if (j.axis("flexion")) {
       EXPECT_GT(found->axis("flexion")->dot(*j.axis("flexion")), std::cos(25 * M_PI / 180))
           << j.name;
+    }
     ++compared;
   }
   EXPECT_GE(compared, 13);

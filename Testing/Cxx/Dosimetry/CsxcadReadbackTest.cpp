@@ -6,7 +6,7 @@
 #include "TestPaths.h"
 
 #include "repose/dosimetry/FdtdModel.h"
-#include "repose/io/FdtdModelIO.h"
+#include "repose/dosimetry/FdtdModelIO.h"
 
 #include <ContinuousStructure.h>
 #include <CSPropDiscMaterial.h>

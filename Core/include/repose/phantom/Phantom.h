@@ -2,7 +2,7 @@
 // and a skeleton of named joints in RAS mm, all defined analytically so tests can pose it exactly.
 #pragma once
 
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/util/Progress.h"
 #include "repose/volume/Volume.h"
 

@@ -8,7 +8,7 @@
 
 #include "repose/cage/CageBuilder.h"
 #include "repose/pose/Pose.h"
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/volume/Volume.h"
 
 #include <array>

@@ -9,7 +9,7 @@
 #include "repose/cage/TriangleMesh.h"
 #include "repose/mesh/RigidHandles.h"
 #include "repose/mesh/TransferMesh.h"
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/volume/LabelTable.h"
 
 #include <Eigen/Geometry>

@@ -13,7 +13,7 @@
 #include "repose/pose/PoseFrame.h"
 #include "repose/pose/PoseRhythm.h"
 #include "repose/pose/PoseRig.h"
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 

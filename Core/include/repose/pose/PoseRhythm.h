@@ -9,7 +9,7 @@
 #pragma once
 
 #include "repose/pose/Pose.h"
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/volume/LabelTable.h"
 
 #include <string>

@@ -105,18 +105,10 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
                        const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
                        const RasterOptions& options = {}, RasterReport* report = nullptr);
 
-// Out of core: the same labels, voxel for voxel, for an input read in place through `input` and an
-// output written slab by slab to the NIfTI file `path` (.nii or .nii.gz; atomic), holding at most
-// `slabBytes` of output at a time. The scan runs on one thread (the cache is not shared).
-void rasterizeLabelsToFile(SliceCache& input, const TransferMesh& mesh,
-                           const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
-                           const std::string& path, std::size_t slabBytes,
-                           const RasterOptions& options = {}, RasterReport* report = nullptr);
-
 // The out-of-core path's step on its own: output slices [k0, k1) of the same labels into a
-// caller's buffer. Slabs are independent, so callers can write them in any order: the file
-// writer above in order, `repose warp --mpi` a rank's share of them. Set-up (the deformed tets'
-// scan input and the shell) is done once; each slab costs one pass over the tets whose boxes
+// caller's buffer. Slabs are independent, so callers can write them in any order: the file writer
+// (raster/RasterFile.h) in order, `repose warp --mpi` a rank's share of them. Set-up (the deformed
+// tets' scan input and the shell) is done once; each slab costs one pass over the tets whose boxes
 // meet it. The scan runs on one thread (the cache is not shared).
 class LabelSlabRasterizer {
  public:

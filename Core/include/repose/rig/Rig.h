@@ -8,7 +8,7 @@
 // without arms) is left out and said so.
 #pragma once
 
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 #include "repose/rig/LabelConvention.h"
 #include "repose/util/Progress.h"
 #include "repose/volume/TissueTable.h"

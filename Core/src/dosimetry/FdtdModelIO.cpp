@@ -1,4 +1,4 @@
-#include "repose/io/FdtdModelIO.h"
+#include "repose/dosimetry/FdtdModelIO.h"
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/util/Error.h"

@@ -1,6 +1,6 @@
 // skeleton.json reading and writing, the joint axes' conventions, and where a skeleton and a
 // tissue table are found beside S.
-#include "repose/pose/Skeleton.h"
+#include "repose/skeleton/Skeleton.h"
 
 #include "repose/io/AtomicOutput.h"
 #include "repose/util/Error.h"
