@@ -23,7 +23,10 @@
 #include <QStatusBar>
 #include <QTextBrowser>
 #include <QScrollArea>
+#include <QScrollBar>
 #include <QVBoxLayout>
+
+#include <algorithm>
 
 qReposeMainWindow::qReposeMainWindow(qReposeModuleDiscovery* discovery, QWidget* parent)
     : QMainWindow(parent), Discovery(discovery) {
@@ -121,6 +124,17 @@ qReposeMainWindow::qReposeMainWindow(qReposeModuleDiscovery* discovery, QWidget*
           &qReposeMainWindow::onModuleIndexChanged);
   if (this->ModuleSelector->count() > 0) this->onModuleIndexChanged(0);
   this->resize(1280, 800);
+  // The panel's fields whole, as Slicer's module panel shows them: the dock as wide as the widest
+  // panel needs (at least a third of the window), never scrolled sideways; the messages a few
+  // lines high, so the views keep the height.
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  const QMargins margins = layout->contentsMargins();
+  const int panelWidth = std::max(this->ModulePanels->minimumSizeHint().width(),
+                                  this->ModuleSelector->sizeHint().width()) +
+                         margins.left() + margins.right() +
+                         scroll->verticalScrollBar()->sizeHint().width() + 8;
+  this->resizeDocks({dock}, {std::max(panelWidth, this->width() / 3)}, Qt::Horizontal);
+  this->resizeDocks({logDock}, {110}, Qt::Vertical);
 }
 
 bool qReposeMainWindow::selectModule(const QString& name) {

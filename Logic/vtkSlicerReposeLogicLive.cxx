@@ -138,6 +138,10 @@ bool vtkSlicerReposeLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
         vtkSlicerReposeLogicInputs::PartsOf(nodes.Segmentation));
     const std::shared_ptr<const repose::PoseJob> job =
         this->PoseJobFor(nodes.Segmentation, pose, *G, *S);
+    // A pose that turns about named joints (a scene `repose pose --scene` wrote, a pose file of
+    // the suite) is written back in numbers, as the rig's build writes it: every frame of the
+    // live session and every edit reads the node, and the joints' places are the skeleton's.
+    if (repose::poseNamesJoints(pose)) poseNode->SetPoseJSON(repose::poseToJson(job->userPose()));
     const std::optional<repose::Skeleton> skeleton =
         vtkSlicerReposeLogicInputs::SkeletonOf(nodes.Segmentation);
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;

@@ -56,11 +56,14 @@ class qSlicerReposeViewsWidgetPrivate {
   vtkSmartPointer<vtkActor> BodyActor, CageActor, CageVertexActor;
   vtkSmartPointer<vtkPolyDataMapper> BodyMapper, CageMapper, CageVertexMapper;
   // The skeleton's joints: spheres at the posed centres (glyphs of JointPoints), their axes as
-  // coloured lines (JointAxes), their names as labels at the centres.
+  // coloured lines (JointAxes), their names as labels at the centres. The labels go by side
+  // (JointLabels: the patient's right, left, the midline): seen from the front, a right joint's
+  // name ends at its centre and a left one's starts there, so a pair's names never overlap.
   vtkSmartPointer<vtkPolyData> JointPoints, JointAxes;
   vtkSmartPointer<vtkSphereSource> JointSphere;
   vtkSmartPointer<vtkActor> JointActor, JointAxisActor;
-  vtkSmartPointer<vtkActor2D> JointLabelActor;
+  vtkSmartPointer<vtkPolyData> JointLabels[3];
+  vtkSmartPointer<vtkActor2D> JointLabelActors[3];
   QHash<int, QColor> PartColors;  // the body-part overlay's colours, per live pose
   vtkMRMLReposePoseNode* PartColorsFor = nullptr;
   qSlicerReposeSliceView* Slices[3] = {nullptr, nullptr, nullptr};
@@ -142,18 +145,27 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
     d->JointAxisActor->GetProperty()->LightingOff();
     d->JointAxisActor->VisibilityOff();
     d->Renderer->AddActor(d->JointAxisActor);
-    vtkNew<vtkLabeledDataMapper> labelMapper;
-    labelMapper->SetInputData(d->JointPoints);
-    labelMapper->SetLabelModeToLabelFieldData();
-    labelMapper->SetFieldDataName("name");
-    labelMapper->GetLabelTextProperty()->SetFontSize(12);
-    labelMapper->GetLabelTextProperty()->SetColor(1, 1, 1);
-    labelMapper->GetLabelTextProperty()->ShadowOn();
-    labelMapper->GetLabelTextProperty()->BoldOn();
-    d->JointLabelActor = vtkSmartPointer<vtkActor2D>::New();
-    d->JointLabelActor->SetMapper(labelMapper);
-    d->JointLabelActor->VisibilityOff();
-    d->Renderer->AddActor2D(d->JointLabelActor);
+    for (int side = 0; side < 3; ++side) {
+      d->JointLabels[side] = vtkSmartPointer<vtkPolyData>::New();
+      vtkNew<vtkLabeledDataMapper> labelMapper;
+      labelMapper->SetInputData(d->JointLabels[side]);
+      labelMapper->SetLabelModeToLabelFieldData();
+      labelMapper->SetFieldDataName("name");
+      vtkTextProperty* text = labelMapper->GetLabelTextProperty();
+      text->SetFontSize(12);
+      text->SetColor(1, 1, 1);
+      text->ShadowOn();
+      text->BoldOn();
+      text->SetVerticalJustificationToCentered();
+      // 0: the patient's right (the viewer's left from the front), 1: left, 2: the midline.
+      if (side == 0) text->SetJustificationToRight();
+      if (side == 1) text->SetJustificationToLeft();
+      if (side == 2) text->SetJustificationToCentered();
+      d->JointLabelActors[side] = vtkSmartPointer<vtkActor2D>::New();
+      d->JointLabelActors[side]->SetMapper(labelMapper);
+      d->JointLabelActors[side]->VisibilityOff();
+      d->Renderer->AddActor2D(d->JointLabelActors[side]);
+    }
   }
   d->Timing = vtkSmartPointer<vtkTextActor>::New();
   d->Timing->GetTextProperty()->SetFontSize(13);
@@ -328,8 +340,9 @@ void qSlicerReposeViewsWidget::refresh() {
     d->Slices[o]->setSlice(slice, d->Lookup, image);
   }
   // What a drag costs, by the stages ReposeLiveBench reports (docs/PERFORMANCE.md): the frame's
-  // solve (posed cage, Green coordinates, rigidity) and each slice's labels.
-  d->Timing->SetInput(QString("live frame %1 ms + slices %2 ms (axial %3, coronal %4, sagittal %5)")
+  // solve (posed cage, Green coordinates, rigidity) and each slice's labels; short enough for
+  // the 3D view of a 1280 x 800 window.
+  d->Timing->SetInput(QString("frame %1 ms + slices %2 ms (ax %3, cor %4, sag %5)")
                           .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
                           .arg(d->SliceMilliseconds, 0, 'f', 1)
                           .arg(sliceMs[0], 0, 'f', 1)
@@ -364,10 +377,13 @@ void qSlicerReposeViewsWidget::updateJoints(bool show) {
   const bool visible = !joints.empty();
   d->JointActor->SetVisibility(visible);
   d->JointAxisActor->SetVisibility(visible);
-  d->JointLabelActor->SetVisibility(visible);
+  for (const auto& actor : d->JointLabelActors) actor->SetVisibility(visible);
   vtkNew<vtkPoints> centres;
   vtkNew<vtkStringArray> names;
   names->SetName("name");
+  vtkNew<vtkPoints> sideCentres[3];
+  vtkNew<vtkStringArray> sideNames[3];
+  for (auto& n : sideNames) n->SetName("name");
   vtkNew<vtkPoints> axisPoints;
   vtkNew<vtkCellArray> axisLines;
   vtkNew<vtkUnsignedCharArray> axisColors;
@@ -381,6 +397,15 @@ void qSlicerReposeViewsWidget::updateJoints(bool show) {
   for (const auto& joint : joints) {
     centres->InsertNextPoint(joint.centre.data());
     names->InsertNextValue(joint.name);
+    auto endsWith = [&](const std::string& suffix) {
+      return joint.name.size() > suffix.size() &&
+             joint.name.compare(joint.name.size() - suffix.size(), suffix.size(), suffix) == 0;
+    };
+    const int side = endsWith("_right") ? 0 : endsWith("_left") ? 1 : 2;
+    sideCentres[side]->InsertNextPoint(joint.centre.data());
+    // A space on the joint's side of the name keeps it clear of the sphere.
+    sideNames[side]->InsertNextValue(side == 0 ? joint.name + "  " : side == 1 ? "  " + joint.name
+                                                                                : joint.name);
     for (const auto& [axisName, axis] : joint.axes) {
       // flexion red, abduction green, rotation blue, the neck's lateral bend yellow
       const unsigned char rgb[4][3] = {
@@ -404,6 +429,12 @@ void qSlicerReposeViewsWidget::updateJoints(bool show) {
   d->JointPoints->SetPoints(centres);
   d->JointPoints->GetPointData()->AddArray(names);
   d->JointPoints->Modified();
+  for (int side = 0; side < 3; ++side) {
+    d->JointLabels[side]->Initialize();
+    d->JointLabels[side]->SetPoints(sideCentres[side]);
+    d->JointLabels[side]->GetPointData()->AddArray(sideNames[side]);
+    d->JointLabels[side]->Modified();
+  }
   d->JointAxes->Initialize();
   d->JointAxes->SetPoints(axisPoints);
   d->JointAxes->SetLines(axisLines);

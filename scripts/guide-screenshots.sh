@@ -22,4 +22,17 @@ done
 if [ -f "$BUILD_DIR/demo/workbench_elbow90.png" ]; then
   cp "$BUILD_DIR/demo/workbench_elbow90.png" "$DOCS/workbench_elbow90.png"
 fi
+# The workbench as a user first sees it (issue 55): 1280 x 800, a phantom of a reference
+# phantom's size and slices (1.8 x 1.8 x 4.8 mm), its elbow scene opened with the suite's pose
+# (named joints): the panel's fields whole, the 3D view from the front.
+REAL="$(mktemp -d)"
+trap 'rm -rf "$REAL"' EXIT
+"$BUILD_DIR/bin/repose" phantom --out "$REAL/body" --arms-resting --spacing 1.8,1.8,4.8 --image \
+  >/dev/null
+POSE="$(dirname "$0")/../bench/poses/elbow90.pose.json"
+"$BUILD_DIR/bin/repose" pose --input "$REAL/body/G.nii.gz" --parts "$REAL/body/S.nii.gz" \
+  --image "$REAL/body/CT.nii.gz" --pose "$POSE" --scene "$REAL/scene" --out "$REAL/out" >/dev/null
+cp "$POSE" "$REAL/scene/elbow90.pose.json"
+xvfb-run -a -s "-screen 0 1280x800x24" "$BUILD_DIR/bin/ReposeWorkbench" \
+  --scene "$REAL/scene" --screenshot "$DOCS/workbench_1280x800.png"
 ls -l "$DOCS"

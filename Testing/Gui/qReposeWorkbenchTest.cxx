@@ -6,6 +6,7 @@
 
 #include <QImage>
 #include <QPlainTextEdit>
+#include <QScrollArea>
 #include <QProcess>
 #include <QTemporaryDir>
 #include <QtTest>
@@ -98,6 +99,24 @@ class qReposeWorkbenchTest : public QObject {
              qPrintable(info->toPlainText()));
     QVERIFY(window.logText().contains("Opened " + kSegmentation));
     QVERIFY(window.logText().contains("Loaded module Repose " REPOSE_PROJECT_VERSION));
+
+    // At the window's 1280 x 800 the panel's fields are whole: the panel is never scrolled
+    // sideways and the dock is as wide as its widest field needs (issue 55).
+    QCOMPARE(window.size(), QSize(1280, 800));
+    QCoreApplication::processEvents();
+    auto* scroll = window.findChild<QScrollArea*>("ModulePanelScrollArea");
+    QVERIFY(scroll);
+    QCOMPARE(scroll->horizontalScrollBarPolicy(), Qt::ScrollBarAlwaysOff);
+    QVERIFY2(scroll->widget()->minimumSizeHint().width() <= scroll->viewport()->width(),
+             qPrintable(QString("panel needs %1 px, shows %2")
+                            .arg(scroll->widget()->minimumSizeHint().width())
+                            .arg(scroll->viewport()->width())));
+    for (const char* name : {"RigFromOrganMapButton", "InputInfoTextBox"}) {
+      auto* field = window.findChild<QWidget*>(name);
+      QVERIFY2(field, name);
+      const QRect inViewport(field->mapTo(scroll->viewport(), QPoint(0, 0)), field->size());
+      QVERIFY2(inViewport.right() < scroll->viewport()->width(), name);
+    }
 
     QVERIFY(!window.openFile("/no/such/file.nii.gz"));
     QVERIFY(window.logText().contains("Error: /no/such/file.nii.gz"));

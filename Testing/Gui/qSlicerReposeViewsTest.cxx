@@ -54,6 +54,9 @@
 #include <QToolButton>
 #include <QtTest>
 
+#include <vtkCamera.h>
+#include <vtkRenderer.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -169,6 +172,15 @@ class qSlicerReposeViewsTest : public QObject {
     panel->waitForJobs();
     QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
     QCOMPARE(panel->activeGroupAngle(), 90.0);
+    // The 3D view opens from the front, as Slicer's: towards the face (along -A), S up, so a
+    // pair of left and right joints stands apart across the view.
+    double towards[3], up[3];
+    views->renderer3D()->GetActiveCamera()->GetDirectionOfProjection(towards);
+    views->renderer3D()->GetActiveCamera()->GetViewUp(up);
+    QVERIFY2(towards[1] < -0.99 && up[2] > 0.99,
+             qPrintable(QString("looking along %1 %2 %3, up %4 %5 %6")
+                            .arg(towards[0]).arg(towards[1]).arg(towards[2])
+                            .arg(up[0]).arg(up[1]).arg(up[2])));
 
     // The coronal view through the elbow: the forearm is turned forward, out of the plane.
     views->setSlicePosition(1, -14);

@@ -1,12 +1,14 @@
 // Live posing on the 8 mm phantom: a pose node prepared once on the worker, then every edit of it
 // re-solves the frame on this thread; the live slice through the left forearm shows G as it is at
 // rest when the elbow is straight, changes when it bends, and undo brings back the same voxels.
+#include "vtkMRMLReposeParametersNode.h"
 #include "vtkMRMLReposePoseNode.h"
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkMRMLReposeTransferMeshNode.h"
 #include "vtkSlicerReposeLogic.h"
 
+#include "CommandRunner.h"
 #include "TestPaths.h"
 
 #include <repose/io/AtomicOutput.h>
@@ -30,6 +32,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 
 using namespace repose::test;
@@ -464,4 +467,34 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
       EXPECT_NEAR(after->GetElement(i, j), drag->GetMatrix()->GetElement(i, j), 1e-9);
       EXPECT_NEAR(upperAfter->GetElement(i, j), upper->GetElement(i, j), 1e-12);
     }
+}
+
+// A scene folder whose pose turns about named joints (elbow_left), as `make demo` makes one: the
+// scene `repose pose --scene` wrote, with the suite's pose file put beside it. Opened in the
+// workbench it goes live: the frame is solved with the joints in numbers, and the slices show the
+// posed labels (the demo's scene opened with "no live pose" in every slice view).
+TEST(vtkSlicerReposeLogicLive, AScenePoseTurningAboutNamedJointsGoesLive) {
+  const PhantomFolder phantom("named");
+  const std::string scene = phantom.dir.file("scene"), out = phantom.dir.file("out");
+  const CommandResult r =
+      runCommand("repose", "pose --input " + shellQuote(phantom.G) + " --parts " +
+                               shellQuote(phantom.S) + " --pose " + shellQuote(kElbow) +
+                               " --scene " + shellQuote(scene) + " --out " + shellQuote(out) +
+                               " --cage-vertices 200");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::filesystem::copy_file(kElbow, scene + "/elbow90.pose.json",
+                             std::filesystem::copy_options::overwrite_existing);
+  ASSERT_TRUE(repose::poseNamesJoints(repose::readPoseFile(scene + "/elbow90.pose.json")));
+  vtkNew<vtkSlicerReposeLogic> logic;
+  vtkNew<vtkMRMLReposeParametersNode> parameters;
+  logic->SetParameterNode(parameters);
+  ASSERT_TRUE(logic->OpenScene(scene)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+      << logic->GetLastErrorMessage();
+  auto* pose = logic->GetLivePose();
+  ASSERT_NE(pose, nullptr) << logic->GetLastErrorMessage();
+  EXPECT_GT(logic->GetLiveFrameMilliseconds(), 0.0) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(logic->ComputeLiveSlice(1, -14, 64)) << logic->GetLastErrorMessage();
+  // The node now holds the joints in numbers, as a rig built in the workbench writes them.
+  EXPECT_FALSE(repose::poseNamesJoints(repose::parsePose(pose->GetPoseJSON(), "node")));
 }
