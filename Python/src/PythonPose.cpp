@@ -7,6 +7,7 @@
 #include "repose/io/SliceCache.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/pose/Pose.h"
+#include "repose/pose/PoseEdit.h"
 #include "repose/pose/PoseFrame.h"
 #include "repose/pose/PoseJob.h"
 #include "repose/pose/PoseReport.h"
@@ -247,6 +248,74 @@ set_transform; write with write.)doc")
           "Sets any of axis=, angle_deg=, pivot=, translation=, then= of the group's transform (in "
           "a "
           "keyframe by index or name, or the base pose).")
+      // Edits by the workbench's rules (Core's pose/PoseEdit.h): the same pose, edited here or
+      // in the workbench, gives the same pose file.
+      .def_static(
+          "new", [](const std::string& name) { return newPose(name); }, py::arg("name") = "pose",
+          "A new pose with one group: the fixed rest of the body (as the workbench's New pose).")
+      .def(
+          "turns",
+          [](const Pose& p, const std::string& group, std::size_t frame) {
+            py::list out;
+            for (const GroupTurn& t : groupTurns(p, group, frame)) {
+              py::dict d;
+              d["axis_name"] = t.axisName;
+              d["axis"] = t.axis;
+              d["angle_deg"] = t.angleDeg;
+              out.append(d);
+            }
+            return out;
+          },
+          py::arg("group"), py::arg("frame") = 0,
+          "The group's turns in frame `frame` [{axis_name, axis, angle_deg}]: its first turn, then "
+          "each further one (a joint group: rotation, abduction, flexion).")
+      .def(
+          "set_turn_angle",
+          [](Pose& p, const std::string& group, int turn, double angleDeg, std::size_t frame) {
+            setGroupTurnAngle(p, group, frame, turn, angleDeg);
+          },
+          py::arg("group"), py::arg("turn"), py::arg("angle_deg"), py::arg("frame") = 0,
+          "Sets the angle of the group's turn `turn` (0: the first) in frame `frame`, as the "
+          "workbench's joint sliders do.")
+      .def(
+          "motion",
+          [](const Pose& p, const std::string& group, std::size_t frame) {
+            return Eigen::Matrix4d(groupMotion(p, group, frame).matrix());
+          },
+          py::arg("group"), py::arg("frame") = 0,
+          "The group's motion in the world in frame `frame` (4x4, RAS mm): its own transform "
+          "carried by the groups it follows.")
+      .def(
+          "set_motion",
+          [](Pose& p, const std::string& group, const Eigen::Matrix4d& world, std::size_t frame) {
+            Eigen::Isometry3d m;
+            m.matrix() = world;
+            setGroupMotion(p, group, frame, m);
+          },
+          py::arg("group"), py::arg("matrix"), py::arg("frame") = 0,
+          "Moves the group so that its motion in the world is `matrix` (4x4 rigid), as a drag of "
+          "the workbench's 3D box: a rotation about its own pivot and a translation, after the "
+          "groups it follows.")
+      .def(
+          "add_separation",
+          [](Pose& p, const std::string& a, const std::string& b, const std::string& region) {
+            addPoseSeparation(p, a, b, region);
+          },
+          py::arg("part_a"), py::arg("part_b"), py::arg("region"),
+          "Adds a separation of two body parts (labels or names of S) within a region "
+          "(e.g. 'box:x0,y0,z0,x1,y1,z1').")
+      .def(
+          "set_joint_group",
+          [](Pose& p, const Skeleton& skeleton, const std::string& joint, const py::object& parts) {
+            const LabelTable labels =
+                parts.is_none() ? LabelTable() : parts.cast<const Volume&>().labels();
+            return setJointGroup(p, skeleton, joint, labels);
+          },
+          py::arg("skeleton"), py::arg("joint"), py::arg("parts") = py::none(),
+          "Poses a limb by its joint, as the workbench's joint control: adds (or keeps) the group "
+          "named after the joint, turning about each of its axes, in the chain of joint groups. "
+          "parts: S, whose label table tells which groups select the joint's parts by label. "
+          "Returns the group's name.")
       .def_property_readonly("names_joints", &poseNamesJoints,
                              "Whether a group turns about a joint named in the skeleton.")
       .def(

@@ -399,3 +399,50 @@ def test_cmake_install_gives_an_importable_package(tmp_path, bin_dir):
                        env=dict(os.environ, PYTHONPATH=str(package)))
     assert r.returncode == 0, r.stderr
     assert r.stdout.startswith(rp.__version__)
+
+
+def test_a_pose_is_edited_by_the_workbenchs_rules(phantom):
+    """Core's pose edits (pose/PoseEdit.h) from Python, the rules the workbench edits by: joint
+    groups posed by their turns, a group moved in the world as the 3D box moves it, separations."""
+    skeleton, parts = phantom["skeleton"], phantom["parts"]
+    p = rp.Pose.new("scripted")
+    assert p.groups == ["rest"]
+    # Both joints of the left arm, as the workbench's joint control adds them: the elbow follows
+    # the shoulder, each turns about its joint's axes (rotation, then abduction, then flexion).
+    assert p.set_joint_group(skeleton, "shoulder_left", parts) == "shoulder_left"
+    assert p.set_joint_group(skeleton, "elbow_left", parts) == "elbow_left"
+    turns = p.turns("elbow_left")
+    assert [t["axis_name"] for t in turns][-1] == "elbow_left.flexion"
+    p.set_turn_angle("elbow_left", len(turns) - 1, 90.0)
+    assert p.turns("elbow_left")[-1]["angle_deg"] == 90.0
+    p.set_turn_angle("shoulder_left", 1, 40.0)
+    shoulder = p.motion("shoulder_left")
+    elbow = p.motion("elbow_left")
+    # The elbow's motion is its own carried by the shoulder's.
+    own = p.transform("elbow_left")
+    assert own["pivot"] is not None
+    assert not np.allclose(elbow, shoulder)
+    # A follower's world motion set back exactly: a single-turn group (a box drag's kind).
+    q = rp.Pose.new("box")
+    q.set_joint_group(skeleton, "elbow_left", parts)
+    world = np.eye(4)
+    c, s_ = np.cos(0.4), np.sin(0.4)
+    world[:3, :3] = [[1, 0, 0], [0, c, -s_], [0, s_, c]]
+    world[:3, 3] = [3.0, -2.0, 5.0]
+    with pytest.raises(rp.Error, match="several axes"):
+        q.set_motion("elbow_left", world)  # a joint group is moved by its turns
+    box = rp.Pose.read(str(POSES / "elbow90.pose.json"))
+    box.resolve_joints(skeleton)
+    box.set_motion("left forearm and hand", world)
+    assert np.allclose(box.motion("left forearm and hand"), world, atol=1e-9)
+    # About its own pivot still: only the angle and translation changed.
+    assert np.allclose(box.transform("left forearm and hand")["pivot"], skeleton.centre("elbow_left"))
+    with pytest.raises(rp.Error, match="is fixed"):
+        q.set_turn_angle("rest", 0, 10.0)
+    # Separations by name or label, refused for one part twice.
+    p.add_separation("hand_left", "thigh_left", "sphere:0,0,0,40")
+    with pytest.raises(rp.Error, match="itself"):
+        p.add_separation("hand_left", "hand_left", "everywhere")
+    # The edited pose round-trips as a file.
+    back = rp.Pose.from_json(p.to_json(), "back")
+    assert back.to_json() == p.to_json()
