@@ -294,9 +294,9 @@ int runPose(const Args& args) {
     std::cerr << "repose pose: warning: " << line << "\n";
   for (const ContactSeparation& c : job.separations().automatic.made)
     say("separating " + c.names[0] + " from " + c.names[1] +
-        (c.touchingVoxels > 0 ? " where they touch (" + std::to_string(c.touchingVoxels) +
-                                    " touching, "
-                              : " across a gap of " + formatFixed(c.gapMm, 1) + " mm (") +
+        (c.touchingVoxels > 0
+             ? " where they touch (" + std::to_string(c.touchingVoxels) + " touching, "
+             : " across a gap of " + formatFixed(c.gapMm, 1) + " mm (") +
         std::to_string(c.contactVoxels) + " voxels within " +
         formatFixed(job.separations().automatic.reachMm, 0) + " mm" +
         (c.joint.empty() ? std::string() : ", outside the " + c.joint + " joint") + ")");
@@ -374,8 +374,8 @@ int runPose(const Args& args) {
     // A frame that missed a target is written all the same (users may want it), and said so in
     // one line naming what missed; the exit status says it too.
     if (!outcome.targetsMet) {
-      std::cerr << "repose pose: frame " << frameName << " written, but it missed its targets: "
-                << outcome.missedLine() << std::endl;
+      std::cerr << "repose pose: frame " << frameName
+                << " written, but it missed its targets: " << outcome.missedLine() << std::endl;
       ++missedFrames;
     }
     summary.push_back(report);

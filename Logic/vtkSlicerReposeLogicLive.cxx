@@ -44,7 +44,7 @@ struct vtkSlicerReposeLogic::LiveSession {
   std::shared_ptr<const repose::PoseRig> Rig;
   repose::LabelTable PartLabels;  // S's, for groups selecting parts
   std::vector<std::uint8_t> OuterFaces;
-  Eigen::MatrixX3d Deformed;  // the live frame's TM vertices
+  Eigen::MatrixX3d Deformed;                 // the live frame's TM vertices
   std::vector<repose::RigidHandle> Handles;  // and its groups' motions
   Eigen::Vector3d Lo{0, 0, 0}, Hi{0, 0, 0};
   vtkSmartPointer<vtkPolyData> Cage, Body;

@@ -404,8 +404,9 @@ void qSlicerReposeViewsWidget::updateJoints(bool show) {
     const int side = endsWith("_right") ? 0 : endsWith("_left") ? 1 : 2;
     sideCentres[side]->InsertNextPoint(joint.centre.data());
     // A space on the joint's side of the name keeps it clear of the sphere.
-    sideNames[side]->InsertNextValue(side == 0 ? joint.name + "  " : side == 1 ? "  " + joint.name
-                                                                                : joint.name);
+    sideNames[side]->InsertNextValue(side == 0   ? joint.name + "  "
+                                     : side == 1 ? "  " + joint.name
+                                                 : joint.name);
     for (const auto& [axisName, axis] : joint.axes) {
       // flexion red, abduction green, rotation blue, the neck's lateral bend yellow
       const unsigned char rgb[4][3] = {

@@ -179,8 +179,12 @@ class qSlicerReposeViewsTest : public QObject {
     views->renderer3D()->GetActiveCamera()->GetViewUp(up);
     QVERIFY2(towards[1] < -0.99 && up[2] > 0.99,
              qPrintable(QString("looking along %1 %2 %3, up %4 %5 %6")
-                            .arg(towards[0]).arg(towards[1]).arg(towards[2])
-                            .arg(up[0]).arg(up[1]).arg(up[2])));
+                            .arg(towards[0])
+                            .arg(towards[1])
+                            .arg(towards[2])
+                            .arg(up[0])
+                            .arg(up[1])
+                            .arg(up[2])));
 
     // The coronal view through the elbow: the forearm is turned forward, out of the plane.
     views->setSlicePosition(1, -14);

@@ -82,7 +82,8 @@ void lockRigidTissue(const TransferMesh& mesh, const std::vector<RigidHandle>& h
           handles[g].parts.end())
         carrier[std::size_t(b)] = int(g);
     Eigen::Index g = 0;
-    if (carrier[std::size_t(b)] < 0 && vote.row(b).maxCoeff(&g) > 0) carrier[std::size_t(b)] = int(g);
+    if (carrier[std::size_t(b)] < 0 && vote.row(b).maxCoeff(&g) > 0)
+      carrier[std::size_t(b)] = int(g);
   }
   Eigen::MatrixXd locked = Eigen::MatrixXd::Zero(membership.rows(), groups);
   for (Eigen::Index t = 0; t < nt; ++t)
@@ -271,11 +272,13 @@ HandleInfluence computeHandleInfluence(const TransferMesh& mesh, const TriangleM
       std::vector<char> near(std::size_t(n), 0);
       for (std::size_t g = 0; g < handles.size(); ++g) {
         if (handles[g].widen <= ring) continue;
-        for (Eigen::Index v = 0; v < n; ++v) near[std::size_t(v)] |= membership(v, Eigen::Index(g)) > 0;
+        for (Eigen::Index v = 0; v < n; ++v)
+          near[std::size_t(v)] |= membership(v, Eigen::Index(g)) > 0;
       }
       std::vector<char> grown = near;
       for (const auto& [i, j] : adjacency.edges)
-        if (near[std::size_t(i)] || near[std::size_t(j)]) grown[std::size_t(i)] = grown[std::size_t(j)] = 1;
+        if (near[std::size_t(i)] || near[std::size_t(j)])
+          grown[std::size_t(i)] = grown[std::size_t(j)] = 1;
       Eigen::MatrixXd sum = membership;
       Eigen::VectorXd count = Eigen::VectorXd::Ones(n);
       for (const auto& [i, j] : adjacency.edges) {

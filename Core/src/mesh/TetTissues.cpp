@@ -37,13 +37,15 @@ TetTissues tetTissues(const TransferMesh& mesh, const Volume& organs, int thread
           std::int64_t a[3], b[3];
           for (int w = 0; w < 3; ++w) {
             a[w] = std::max<std::int64_t>(0, std::int64_t(std::ceil(lo[w] - 1e-9)));
-            b[w] = std::min<std::int64_t>(d[std::size_t(w)] - 1, std::int64_t(std::floor(hi[w] + 1e-9)));
+            b[w] = std::min<std::int64_t>(d[std::size_t(w)] - 1,
+                                          std::int64_t(std::floor(hi[w] + 1e-9)));
           }
           count.clear();
           for (std::int64_t k = a[2]; k <= b[2]; ++k)
             for (std::int64_t j = a[1]; j <= b[1]; ++j)
               for (std::int64_t i = a[0]; i <= b[0]; ++i) {
-                const Eigen::Vector3d l = inverse * (Eigen::Vector3d(double(i), double(j), double(k)) - c[0]);
+                const Eigen::Vector3d l =
+                    inverse * (Eigen::Vector3d(double(i), double(j), double(k)) - c[0]);
                 if (l.minCoeff() < 0 || l.sum() > 1) continue;
                 const double label = organs.valueAsDouble(organs.index(i, j, k));
                 if (label > 0) ++count[int(label)];

@@ -35,8 +35,7 @@ double volumeOf(const std::array<Eigen::Vector3d, 4>& x) {
 VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vector<char>& movable,
                                        Eigen::MatrixX3d& deformed,
                                        const VolumeRestorationOptions& options,
-                                       const std::vector<char>& held,
-                                       const TetTissues* tissues) {
+                                       const std::vector<char>& held, const TetTissues* tissues) {
   VolumeRestorationReport report;
   const Eigen::Index nv = mesh.vertices.rows(), nt = mesh.tets.rows();
   auto corners = [&](const Eigen::MatrixX3d& x, Eigen::Index t) {
@@ -121,7 +120,8 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
   double meanRest = 0, meanEdge2 = 0;
   for (const Eigen::Index t : active) meanRest += rest[std::size_t(t)];
   meanRest /= double(active.size());
-  for (const auto& [a, b] : edges) meanEdge2 += (mesh.vertices.row(a) - mesh.vertices.row(b)).squaredNorm();
+  for (const auto& [a, b] : edges)
+    meanEdge2 += (mesh.vertices.row(a) - mesh.vertices.row(b)).squaredNorm();
   meanEdge2 /= double(std::max<std::size_t>(1, edges.size()));
   const double lambda = options.smoothness * meanRest / std::max(1e-12, meanEdge2);
   // Each free vertex's shortest rest edge: how far one round may move it.
@@ -135,12 +135,13 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
   }
 
   // The tissues held besides the parts: each label of G in the summed tets with enough voxels
-  // there to be counted (64: a handful of voxels would only add noise). Each constraint is scaled by
-  // its rest amount, so all say a fraction.
+  // there to be counted (64: a handful of voxels would only add noise). Each constraint is scaled
+  // by its rest amount, so all say a fraction.
   std::map<int, int> tissueRow;
   std::vector<double> amount;  // per constraint: the part's rest volume or the tissue's voxels
   amount.assign(partRow.size(), 0.0);
-  for (const Eigen::Index t : summed) amount[std::size_t(partRow.at(mesh.labels[t]))] += rest[std::size_t(t)];
+  for (const Eigen::Index t : summed)
+    amount[std::size_t(partRow.at(mesh.labels[t]))] += rest[std::size_t(t)];
   if (tissues && !tissues->empty()) {
     std::map<int, double> voxels;
     for (const Eigen::Index t : summed)
@@ -167,10 +168,12 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       const double change = volumeOf(corners(x, t)) - rest[std::size_t(t)];
       r[partRow.at(mesh.labels[t])] += change;
       if (!tissueRow.empty())
-        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1]; ++e) {
+        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1];
+             ++e) {
           const auto it = tissueRow.find(tissues->entries[std::size_t(e)].first);
           if (it != tissueRow.end())
-            r[it->second] += change / rest[std::size_t(t)] * tissues->entries[std::size_t(e)].second;
+            r[it->second] +=
+                change / rest[std::size_t(t)] * tissues->entries[std::size_t(e)].second;
         }
     }
     return r;
@@ -202,11 +205,13 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       // The tissues this tet holds: their constraints' gradients, voxels over the rest volume.
       std::vector<std::pair<int, double>> carried;
       if (!tissueRow.empty())
-        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1]; ++e) {
+        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1];
+             ++e) {
           const auto it = tissueRow.find(tissues->entries[std::size_t(e)].first);
           if (it != tissueRow.end())
             carried.emplace_back(it->second, tissues->entries[std::size_t(e)].second /
-                                              rest[std::size_t(t)] / amount[std::size_t(it->second)]);
+                                                 rest[std::size_t(t)] /
+                                                 amount[std::size_t(it->second)]);
         }
       for (int a = 0; a < 4; ++a) {
         const int ia = index[std::size_t(mesh.tets(t, a))];
@@ -214,7 +219,8 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
         for (int c = 0; c < 3; ++c) {
           rhs[3 * ia + c] -= w * r * g[std::size_t(a)][c];
           C(3 * ia + c, column) += g[std::size_t(a)][c] / amount[std::size_t(column)];
-          for (const auto& [row, scale] : carried) C(3 * ia + c, row) += scale * g[std::size_t(a)][c];
+          for (const auto& [row, scale] : carried)
+            C(3 * ia + c, row) += scale * g[std::size_t(a)][c];
         }
         for (int b = 0; b < 4; ++b) {
           const int ib = index[std::size_t(mesh.tets(t, b))];
@@ -229,7 +235,8 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     // Smoothness of the whole correction so far (deformed - start), edge by edge.
     for (const auto& [u, w] : edges) {
       const int iu = index[std::size_t(u)], iw = index[std::size_t(w)];
-      const Eigen::Vector3d du = deformed.row(u) - start.row(u), dw = deformed.row(w) - start.row(w);
+      const Eigen::Vector3d du = deformed.row(u) - start.row(u),
+                            dw = deformed.row(w) - start.row(w);
       const Eigen::Vector3d diff = du - dw;
       for (int c = 0; c < 3; ++c) {
         if (iu >= 0) {
@@ -294,9 +301,11 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
   report.worstPartAfter = 0;
   for (const auto& [label, v] : after)
     if (v.first > 0)
-      report.worstPartAfter = std::max(report.worstPartAfter, std::fabs(100 * (v.second / v.first - 1)));
+      report.worstPartAfter =
+          std::max(report.worstPartAfter, std::fabs(100 * (v.second / v.first - 1)));
   for (Eigen::Index v = 0; v < nv; ++v)
-    report.maxCorrectionMm = std::max(report.maxCorrectionMm, (deformed.row(v) - start.row(v)).norm());
+    report.maxCorrectionMm =
+        std::max(report.maxCorrectionMm, (deformed.row(v) - start.row(v)).norm());
   return report;
 }
 

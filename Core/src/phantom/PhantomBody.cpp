@@ -294,8 +294,7 @@ void restArms(SideJoints& j, const Builder& b, double press, double forearmGap, 
   if (handGap > 0)
     holdHandOff(j, b.thighs, handGap);
   else
-    restOn(j.wrist, j.handTip, kHandR[0] * kHandThin, kHandR[1] * kHandThin, b.thighs, 0.1,
-           press);
+    restOn(j.wrist, j.handTip, kHandR[0] * kHandThin, kHandR[1] * kHandThin, b.thighs, 0.1, press);
 }
 
 void addTorsoAndHead(Builder& b) {

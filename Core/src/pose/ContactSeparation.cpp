@@ -70,8 +70,8 @@ std::string ContactSeparations::json() const {
 
 double contactReachMm(const CageOptions& cage, const Volume& parts) {
   // The cage's working voxel as CageField.cpp chooses it: whole blocks of input voxels.
-  const double target = cage.workingVoxelMm > 0 ? cage.workingVoxelMm
-                                                : std::clamp(cage.dilateMm / 2.5, 3.0, 8.0);
+  const double target =
+      cage.workingVoxelMm > 0 ? cage.workingVoxelMm : std::clamp(cage.dilateMm / 2.5, 3.0, 8.0);
   const Eigen::Vector3d spacing = parts.geometry().spacing();
   double work = 0;
   for (int c = 0; c < 3; ++c)
@@ -161,8 +161,8 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
             const double v = double(s[at]);
             if (!(v > 0 && v < 65536) || groupOf[std::size_t(v)] < 0) continue;
             labelAt[std::size_t(at)] = int(v);
-            auto [it, fresh] = boxes.try_emplace(int(v), std::array<std::int64_t, 6>{
-                                                             i, j, k, i, j, k});
+            auto [it, fresh] =
+                boxes.try_emplace(int(v), std::array<std::int64_t, 6>{i, j, k, i, j, k});
             if (!fresh) {
               auto& b = it->second;
               b[0] = std::min(b[0], i), b[1] = std::min(b[1], j), b[2] = std::min(b[2], k);
@@ -197,7 +197,8 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
   // half the smallest spacing. A gap is air between two parts; voxels as close through the body
   // itself (the two sides of a joint beyond its sphere) are not near each other.
   std::vector<std::uint8_t> bodyAt(std::size_t(parts.numVoxels()), 0);
-  for (std::int64_t v = 0; v < parts.numVoxels(); ++v) bodyAt[std::size_t(v)] = parts.valueAsDouble(v) != 0;
+  for (std::int64_t v = 0; v < parts.numVoxels(); ++v)
+    bodyAt[std::size_t(v)] = parts.valueAsDouble(v) != 0;
   auto acrossAir = [&](const std::array<std::int64_t, 3>& at, const std::array<std::int64_t, 3>& n,
                        const std::array<std::int64_t, 3>& lo, const std::vector<float>& d2,
                        double dist2) {
@@ -219,8 +220,8 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
     for (double t = stepMm; t < length; t += stepMm) {
       std::array<std::int64_t, 3> q;
       for (int c = 0; c < 3; ++c)
-        q[std::size_t(c)] = lo[std::size_t(c)] + at[std::size_t(c)] +
-                            std::llround(t * towards[c] / spacing[c]);
+        q[std::size_t(c)] =
+            lo[std::size_t(c)] + at[std::size_t(c)] + std::llround(t * towards[c] / spacing[c]);
       if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= d[0] || q[1] >= d[1] || q[2] >= d[2])
         return true;  // outside the volume: air
       if (!bodyAt[std::size_t(parts.index(q[0], q[1], q[2]))]) return true;
@@ -357,10 +358,9 @@ ContactSeparations findContactSeparations(const Volume& parts, const Pose& pose,
               const std::int64_t x = ijk[0] + di, y = ijk[1] + dj, z = ijk[2] + dk;
               if (x < 0 || y < 0 || z < 0 || x >= d[0] || y >= d[1] || z >= d[2]) continue;
               if (labelAt[std::size_t(parts.index(x, y, z))] != other) continue;
-              const Eigen::Vector3d air(
-                  std::max(0.0, double(std::llabs(di)) - 1) * spacing[0],
-                  std::max(0.0, double(std::llabs(dj)) - 1) * spacing[1],
-                  std::max(0.0, double(std::llabs(dk)) - 1) * spacing[2]);
+              const Eigen::Vector3d air(std::max(0.0, double(std::llabs(di)) - 1) * spacing[0],
+                                        std::max(0.0, double(std::llabs(dj)) - 1) * spacing[1],
+                                        std::max(0.0, double(std::llabs(dk)) - 1) * spacing[2]);
               best = std::min(best, air.norm());
             }
       }

@@ -81,12 +81,11 @@ nlohmann::json predictionReport(const VolumePrediction& p, const PoseRig& rig,
   const auto it = std::find_if(p.parts.begin(), p.parts.end(),
                                [&](const PartVolumeChange& c) { return c.part == named; });
   const std::string worstName = partName(parts, named);
-  warning = bodyMissed ? "the posed mesh predicts a body volume change of " +
-                             percent(p.changePercent()) + " (target within 0.5 %): " + worstName +
-                             " " + percent(it->changePercent())
-                       : "the posed mesh predicts a volume change of " +
-                             percent(it->changePercent()) + " for " + worstName +
-                             " (target within 1 %)";
+  warning = bodyMissed
+                ? "the posed mesh predicts a body volume change of " + percent(p.changePercent()) +
+                      " (target within 0.5 %): " + worstName + " " + percent(it->changePercent())
+                : "the posed mesh predicts a volume change of " + percent(it->changePercent()) +
+                      " for " + worstName + " (target within 1 %)";
   out["worst_part"] = worstName;
   const std::string worstGroup = groupCarrying(rig, handles, named);
   const int draggedBy = named == p.worstPart ? p.draggedBy : 0;

@@ -229,8 +229,8 @@ Pose PoseRhythms::apply(const Pose& pose, std::vector<std::string>* notes) const
       setPerFrame(out, armName, newArmT);
       if (notes)
         notes->push_back("scapulohumeral rhythm: " + gd.girdlePart + " turns up to " +
-                         degrees(most) + " deg about sternoclavicular" + gd.side + " with group \"" +
-                         armName + "\"");
+                         degrees(most) + " deg about sternoclavicular" + gd.side +
+                         " with group \"" + armName + "\"");
     }
 
   if (pose.lumbopelvicRhythm && pelvis_.present && !selectedByAny(pelvis_.part)) {
@@ -261,7 +261,8 @@ Pose PoseRhythms::apply(const Pose& pose, std::vector<std::string>* notes) const
       for (const auto& [name, hip] : thighs) {
         const std::vector<PoseTransform> thighT = perFrame(out, name);
         std::vector<PoseTransform> onPelvis;
-        for (std::size_t f = 0; f < frames; ++f) onPelvis.push_back(onCarrier(thighT[f], pelvisT[f]));
+        for (std::size_t f = 0; f < frames; ++f)
+          onPelvis.push_back(onCarrier(thighT[f], pelvisT[f]));
         for (PoseGroup& g : out.groups)
           if (g.name == name) {
             if (!g.follows.empty() && g.follows != torsoGroup) pelvis.follows = g.follows;

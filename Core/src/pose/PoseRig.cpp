@@ -277,8 +277,8 @@ PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partL
 
 PoseRig::~PoseRig() = default;
 
-VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
-                                                     const std::vector<RigidHandle>& handles) const {
+VolumeRestorationReport PoseRig::restoreFrameVolumes(
+    Eigen::MatrixX3d& deformed, const std::vector<RigidHandle>& handles) const {
   if (!restoreVolumes_) return {};
   const TransferMesh& m = geometry_.mesh;
   std::vector<char> zone = bends_.empty() ? std::vector<char>(std::size_t(m.vertices.rows()), 0)
@@ -286,17 +286,20 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
   // The transitions between two groups that carry jointed parts and move apart this frame.
   if (!jointedParts_.empty()) {
     const Eigen::Index groups = influence_.membership.cols();
-    std::vector<std::vector<char>> jointed(std::size_t(groups), std::vector<char>(std::size_t(groups), 0));
+    std::vector<std::vector<char>> jointed(std::size_t(groups),
+                                           std::vector<char>(std::size_t(groups), 0));
     auto groupOf = [&](int part) {
       for (std::size_t g = 0; g < handles.size(); ++g)
-        if (std::find(handles[g].parts.begin(), handles[g].parts.end(), part) != handles[g].parts.end())
+        if (std::find(handles[g].parts.begin(), handles[g].parts.end(), part) !=
+            handles[g].parts.end())
           return int(g);
       return -1;
     };
     for (const auto& [a, b] : jointedParts_) {
       const int ga = groupOf(a), gb = groupOf(b);
       if (ga < 0 || gb < 0 || ga == gb) continue;
-      if (handles[std::size_t(ga)].motion.isApprox(handles[std::size_t(gb)].motion, 1e-12)) continue;
+      if (handles[std::size_t(ga)].motion.isApprox(handles[std::size_t(gb)].motion, 1e-12))
+        continue;
       jointed[std::size_t(ga)][std::size_t(gb)] = jointed[std::size_t(gb)][std::size_t(ga)] = 1;
     }
     for (Eigen::Index v = 0; v < m.vertices.rows(); ++v)

@@ -19,8 +19,8 @@ void requirePoseableLabels(const Volume& volume, const std::string& name) {
   // An integer image (a CT in Hounsfield units, an MR) that its reader did not take for labels:
   // values below 0, or more distinct values than any anatomical label set holds.
   constexpr std::size_t kMostLabels = 4096;
-  const bool negative = std::any_of(labels.begin(), labels.end(),
-                                    [](const LabelCount& c) { return c.value < 0; });
+  const bool negative =
+      std::any_of(labels.begin(), labels.end(), [](const LabelCount& c) { return c.value < 0; });
   if (!volume.isLabelMap() && (negative || labels.size() > kMostLabels))
     throwFileError(name, "not a label map (" +
                              (negative ? std::string("values below 0")

@@ -478,11 +478,13 @@ LabelConvention conventionOf(const Volume& organs, const std::vector<int>& label
       c.detection = "auto: G's label names are TotalSegmentator's";
     } else if (icrpValues) {
       c = icrp110(organs, labels);
-      c.detection = "auto: labels that are ICRP 110 organ IDs (1-141), with its humerus and femur IDs";
+      c.detection =
+          "auto: labels that are ICRP 110 organ IDs (1-141), with its humerus and femur IDs";
     } else {
-      throw Error(source + ": cannot tell the label convention (" + std::to_string(labels.size()) +
-                  " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs 1-141): "
-                  "give --labels phantom|icrp110|totalsegmentator|FILE.csv");
+      throw Error(
+          source + ": cannot tell the label convention (" + std::to_string(labels.size()) +
+          " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs 1-141): "
+          "give --labels phantom|icrp110|totalsegmentator|FILE.csv");
     }
   } else {
     c = fromCsv(organs, requested, labels);

@@ -147,7 +147,8 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   {
     std::vector<std::int64_t> count(rig::kPartPelvis + 1, 0);
     const std::uint8_t* s = out.parts.data<std::uint8_t>();
-    for (std::int64_t i = 0; i < out.parts.numVoxels(); ++i) ++count[s[i] <= rig::kPartPelvis ? s[i] : 0];
+    for (std::int64_t i = 0; i < out.parts.numVoxels(); ++i)
+      ++count[s[i] <= rig::kPartPelvis ? s[i] : 0];
     const double ml = std::fabs(organs.geometry().ijkToRas.block<3, 3>(0, 0).determinant()) / 1000;
     for (int v = 1; v <= rig::kPartPelvis; ++v)
       if (count[std::size_t(v)] > 0)
@@ -158,12 +159,11 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   nlohmann::json unknownJson = nlohmann::json::array();
   for (const int v : out.convention.unknown) {
     const auto r = out.convention.roles.find(v);
-    unknownJson.push_back({{"label", v},
-                           {"name", r != out.convention.roles.end() ? r->second.name : ""},
-                           {"taken_as", "soft tissue"},
-                           {"density_kg_m3", r != out.convention.roles.end()
-                                                 ? r->second.densityKgM3
-                                                 : 0.0}});
+    unknownJson.push_back(
+        {{"label", v},
+         {"name", r != out.convention.roles.end() ? r->second.name : ""},
+         {"taken_as", "soft tissue"},
+         {"density_kg_m3", r != out.convention.roles.end() ? r->second.densityKgM3 : 0.0}});
   }
   nlohmann::json jointsJson = nlohmann::json::parse(skeletonToJson(out.skeleton))["joints"];
   nlohmann::json report = {
@@ -229,7 +229,8 @@ std::string nameBodyPartsByRigConvention(Volume& parts, const std::string& sourc
   parts.labels() = names;
   return source +
          ": no part names in the file; its values are named as `repose rig` names them (1 head, "
-         "2 torso, 3 upper_arm_left, ... 14 foot_right, 15-16 shoulder_girdle_left/right, 17 pelvis)";
+         "2 torso, 3 upper_arm_left, ... 14 foot_right, 15-16 shoulder_girdle_left/right, 17 "
+         "pelvis)";
 }
 
 }  // namespace repose

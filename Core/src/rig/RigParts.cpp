@@ -241,10 +241,12 @@ void assignGirdlesAndPelvis(Volume& parts, const Bones& bones,
     auto local = [&](std::int64_t v) {
       const std::int64_t i = v % d[0] - lo[0], j = (v / d[0]) % d[1] - lo[1],
                          k = v / (d[0] * d[1]) - lo[2];
-      if (i < 0 || j < 0 || k < 0 || i >= box[0] || j >= box[1] || k >= box[2]) return std::int64_t(-1);
+      if (i < 0 || j < 0 || k < 0 || i >= box[0] || j >= box[1] || k >= box[2])
+        return std::int64_t(-1);
       return i + box[0] * (j + box[1] * k);
     };
-    std::vector<std::uint8_t> mine(std::size_t(box[0] * box[1] * box[2]), 0), theirs(mine.size(), 0);
+    std::vector<std::uint8_t> mine(std::size_t(box[0] * box[1] * box[2]), 0),
+        theirs(mine.size(), 0);
     for (const Bone* b : own)
       for (const std::int64_t v : b->voxels) mine[std::size_t(local(v))] = 1;
     for (const Bone* b : other)
@@ -258,7 +260,8 @@ void assignGirdlesAndPelvis(Volume& parts, const Bones& bones,
         for (std::int64_t i = lo[0]; i <= hi[0]; ++i) {
           const std::int64_t v = i + d[0] * (j + d[1] * k);
           if (s[v] != 2) continue;  // the trunk's tissue only (not the pelvis, a limb or the head)
-          const std::size_t l = std::size_t((i - lo[0]) + box[0] * ((j - lo[1]) + box[1] * (k - lo[2])));
+          const std::size_t l =
+              std::size_t((i - lo[0]) + box[0] * ((j - lo[1]) + box[1] * (k - lo[2])));
           if (double(toMine[l]) > reach2 || toMine[l] >= toTheirs[l]) continue;
           if ((grid.ras(v).x() - bones.frame.midlineX) * double(side) <= 0) continue;
           s[v] = part;

@@ -225,17 +225,17 @@ TEST(RigCommand, AThickSliceBodyPosedOntoAFinerGridKeepsEveryBone) {
   // grid every bone lost 1-2 %, the unmoved femur 2.2 %.)
   ScratchDir dir;
   const std::string d = shellQuote(dir.path().string());
-  ASSERT_EQ(
-      runCommand("repose", "phantom --spacing 2.4,2.4,6 --arms-resting --out " + d).exitCode, 0);
+  ASSERT_EQ(runCommand("repose", "phantom --spacing 2.4,2.4,6 --arms-resting --out " + d).exitCode,
+            0);
   ASSERT_EQ(runCommand("repose", "rig --input " + shellQuote(dir.file("G.nii.gz")) + " --out " +
                                      shellQuote(dir.file("rig")))
                 .exitCode,
             0);
-  const CommandResult pose = runCommand(
-      "repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
-                    shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
-                    shellQuote(suitePoseFile("elbow90")) + " --spacing-mm 1.2 --out " +
-                    shellQuote(dir.file("out")) + " --json");
+  const CommandResult pose =
+      runCommand("repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                               shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
+                               shellQuote(suitePoseFile("elbow90")) + " --spacing-mm 1.2 --out " +
+                               shellQuote(dir.file("out")) + " --json");
   ASSERT_EQ(pose.exitCode, 0) << pose.err;
   const nlohmann::json report = nlohmann::json::parse(pose.out);
   std::set<int> bones;

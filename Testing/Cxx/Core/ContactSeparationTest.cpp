@@ -83,8 +83,8 @@ Plain plainCount(const Volume& s, double reach) {
               bool acrossAir = false;
               for (double t = 0.02; t < 1 && !acrossAir; t += 0.02)
                 acrossAir = v[s.index(std::llround(double(i) + t * double(di)),
-                                std::llround(double(j) + t * double(dj)),
-                                std::llround(double(k) + t * double(dk)))] == 0;
+                                      std::llround(double(j) + t * double(dj)),
+                                      std::llround(double(k) + t * double(dk)))] == 0;
               if (!face && !acrossAir) continue;
               near.insert(s.index(i, j, k));
               near.insert(s.index(x, y, z));
@@ -188,7 +188,7 @@ TEST(ContactSeparation, AJointedPairIsNearOnlyBeyondItsJointsSphereGrownByTheRea
   Volume s = emptyParts({60, 16, 16}, Eigen::Vector3d(1, 1, 1));
   fill(s, {2, 4, 4}, {30, 10, 10}, 1);
   fill(s, {30, 4, 4}, {50, 10, 10}, 2);
-  fill(s, {8, 12, 4}, {30, 14, 10}, 2);  // the lip, y 12..13 over a's top at y 9
+  fill(s, {8, 12, 4}, {30, 14, 10}, 2);   // the lip, y 12..13 over a's top at y 9
   fill(s, {30, 10, 4}, {32, 14, 10}, 2);  // joins the lip to b
   Skeleton skeleton;
   SkeletonJoint j;

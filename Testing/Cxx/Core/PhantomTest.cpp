@@ -349,9 +349,8 @@ TEST(Phantom, TheGapVariantHoldsHandsAndForearmsOffTheBodyByTheirGaps) {
       for (std::size_t i = 0; i < n; ++i) mask[i] = pick(int(s[i]));
       return squaredDistanceToMask(mask, d, spacing);
     };
-    const std::vector<float> toThigh = distanceTo([](int p) {
-      return p == kPartThighLeft || p == kPartThighRight;
-    });
+    const std::vector<float> toThigh =
+        distanceTo([](int p) { return p == kPartThighLeft || p == kPartThighRight; });
     const std::vector<float> toTrunkOrThigh = distanceTo(isTorsoOrThigh);
     const std::vector<float> toTorso = distanceTo([](int p) { return p == kPartTorso; });
     for (const bool left : {true, false}) {

@@ -76,7 +76,7 @@ TEST(PoseEdit, ATransformIsSetInTheFrameEditedAndKeepsItsFurtherTurns) {
   const PoseTransform t = groupTransform(pose, "upper", 0);
   EXPECT_TRUE(t.axis.isApprox(Eigen::Vector3d::UnitZ()));  // made unit length
   EXPECT_EQ(t.angleDeg, 10);
-  EXPECT_EQ(pose.groups[1].transform.angleDeg, 30);  // the base pose is untouched
+  EXPECT_EQ(pose.groups[1].transform.angleDeg, 30);          // the base pose is untouched
   EXPECT_EQ(groupTransform(pose, "upper", 1).angleDeg, 60);  // and so is the other keyframe
   // A joint group's further turns stay as they were.
   pose.groups[2].transform.then = {PoseTurn{Eigen::Vector3d::UnitZ(), 20, ""}};

@@ -95,7 +95,7 @@ TEST(PoseRhythm, TheSharesFollowThePublishedRatios) {
   EXPECT_NEAR(girdleTurnDeg(180), 30, 1e-12);
   EXPECT_EQ(pelvisTiltDeg(45), 0);
   EXPECT_EQ(pelvisTiltDeg(60), 0);
-  EXPECT_NEAR(pelvisTiltDeg(90), 25, 1e-12);  // sitting: the hip itself flexes 65
+  EXPECT_NEAR(pelvisTiltDeg(90), 25, 1e-12);   // sitting: the hip itself flexes 65
   EXPECT_NEAR(pelvisTiltDeg(120), 30, 1e-12);  // at most 30
 }
 

@@ -277,7 +277,8 @@ TEST(PoseRun, ARigIsBuiltAndSavedOnceThenReusedFromItsScene) {
   EXPECT_EQ(again.rig->mesh().tets, built.rig->mesh().tets);
   EXPECT_TRUE(again.rig->frame(0).deformed.isApprox(built.rig->frame(0).deformed, 1e-9));
   // Green coordinates: written with the scene, then read back rather than computed.
-  EXPECT_TRUE(again.rig->deformation().coordinatesRead()) << again.rig->deformation().coordinatesNote();
+  EXPECT_TRUE(again.rig->deformation().coordinatesRead())
+      << again.rig->deformation().coordinatesNote();
 
   // A scene built for other settings is not reused, and the note says why.
   PoseJobRequest other;

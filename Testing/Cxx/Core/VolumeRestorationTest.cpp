@@ -70,8 +70,11 @@ TEST(VolumeRestoration, EveryPartItReachesGetsItsRestVolumeBackAndFixedVerticesS
   EXPECT_NEAR(partVolume(m, x, 3), rest3, 1e-5 * rest3);
   EXPECT_NEAR(partVolume(m, x, 4), rest4, 1e-5 * rest4);
   EXPECT_LE(r.invertedAfter, r.invertedBefore);
-  for (Eigen::Index v = 0; v < x.rows(); ++v)
-    if (!movable[std::size_t(v)]) EXPECT_EQ((x.row(v) - before.row(v)).norm(), 0) << v;
+  for (Eigen::Index v = 0; v < x.rows(); ++v) {
+    if (!movable[std::size_t(v)]) {
+      EXPECT_EQ((x.row(v) - before.row(v)).norm(), 0) << v;
+    }
+  }
   // Each tet nearer its own volume: the summed squared relative misfit falls several times.
   double misfitBefore = 0, misfitAfter = 0;
   for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {

@@ -476,11 +476,10 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
 TEST(vtkSlicerReposeLogicLive, AScenePoseTurningAboutNamedJointsGoesLive) {
   const PhantomFolder phantom("named");
   const std::string scene = phantom.dir.file("scene"), out = phantom.dir.file("out");
-  const CommandResult r =
-      runCommand("repose", "pose --input " + shellQuote(phantom.G) + " --parts " +
-                               shellQuote(phantom.S) + " --pose " + shellQuote(kElbow) +
-                               " --scene " + shellQuote(scene) + " --out " + shellQuote(out) +
-                               " --cage-vertices 200");
+  const CommandResult r = runCommand(
+      "repose", "pose --input " + shellQuote(phantom.G) + " --parts " + shellQuote(phantom.S) +
+                    " --pose " + shellQuote(kElbow) + " --scene " + shellQuote(scene) + " --out " +
+                    shellQuote(out) + " --cage-vertices 200");
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::filesystem::copy_file(kElbow, scene + "/elbow90.pose.json",
                              std::filesystem::copy_options::overwrite_existing);

@@ -68,7 +68,8 @@ class JointBends {
   std::vector<char> zone(const std::vector<RigidHandle>& frame, Eigen::Index vertexCount) const;
   // The tets whose centre lies within the reach of a joint that turns in this frame, whatever
   // their vertices (the soft tissue between two bone ends, every vertex on a bone, among them).
-  std::vector<char> reachTets(const TransferMesh& mesh, const std::vector<RigidHandle>& frame) const;
+  std::vector<char> reachTets(const TransferMesh& mesh,
+                              const std::vector<RigidHandle>& frame) const;
 
  private:
   struct Joint {

@@ -16,8 +16,8 @@
 // Gauss-Newton on the tets' volumes: each round linearises every tet's volume in its free
 // vertices and minimises sum_t (dV_t)^2 / V0_t + lambda * sum_edges |corr_a - corr_b|^2 (the
 // correction kept smooth along the mesh's edges) subject to every touched part's linearised
-// volume, over the tets with a free vertex, equal to its rest volume (Lagrange multipliers: one sparse Cholesky factorisation and a
-// small dense system per round).
+// volume, over the tets with a free vertex, equal to its rest volume (Lagrange multipliers: one
+// sparse Cholesky factorisation and a small dense system per round).
 #pragma once
 
 #include "repose/mesh/TransferMesh.h"
@@ -35,8 +35,8 @@ namespace repose {
 // restoration are counted with, as the voxels' rounding counts them (the sum over a label's rest
 // voxels of their tet's volume ratio).
 struct TetTissues {
-  std::vector<int> offsets;                     // #tets + 1: tet t's entries are [offsets[t], offsets[t+1])
-  std::vector<std::pair<int, int>> entries;     // (label, voxels)
+  std::vector<int> offsets;  // #tets + 1: tet t's entries are [offsets[t], offsets[t+1])
+  std::vector<std::pair<int, int>> entries;  // (label, voxels)
   bool empty() const { return entries.empty(); }
 };
 // G on its own grid (any orientation), the mesh at rest in the same RAS space.
@@ -59,18 +59,18 @@ struct VolumeRestorationOptions {
 
 struct VolumeRestorationReport {
   int freeVertices = 0;
-  int parts = 0;                 // body parts whose volume was held
-  int tissues = 0;               // labels of G whose volume was held
-  int iterations = 0;            // rounds taken
-  double maxCorrectionMm = 0;    // the largest distance a vertex was moved
-  double worstPartBefore = 0;    // the largest |volume change| of a part, percent
+  int parts = 0;               // body parts whose volume was held
+  int tissues = 0;             // labels of G whose volume was held
+  int iterations = 0;          // rounds taken
+  double maxCorrectionMm = 0;  // the largest distance a vertex was moved
+  double worstPartBefore = 0;  // the largest |volume change| of a part, percent
   double worstPartAfter = 0;
   int invertedBefore = 0, invertedAfter = 0;
 };
 
 // `movable[v]`: whether vertex v may be moved at all (the soft tissue of the joints' bends; never
-// a vertex of a whole piece, which must stay rigid). Modifies `deformed` (the posed vertices, RAS mm) in place. Parts whose tets all
-// keep their volume within the tolerance are left as they are.
+// a vertex of a whole piece, which must stay rigid). Modifies `deformed` (the posed vertices, RAS
+// mm) in place. Parts whose tets all keep their volume within the tolerance are left as they are.
 // `held[t]` (optional, one per tet): the tets whose volumes each part's constraint sums besides
 // those the correction reaches (the soft tets between two bone ends, which no free vertex can
 // reach: the tissue around them makes up for them). Empty: only the reached tets.

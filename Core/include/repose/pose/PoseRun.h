@@ -36,10 +36,10 @@ std::string unnamedLabelsWarning(const std::vector<int>& values, const std::stri
 // The rig of a job, reused from a scene folder when the folder holds one built for the same S and
 // settings (the job's sceneKey), else built, and saved there.
 struct SceneRigRun {
-  std::string folder;  // the scene folder; "": none (built here, kept nowhere)
-  SceneInputs inputs;  // what scene.json records of G, S and the image when it is written
-  bool saveBuilt = true;  // write a rig built here into the folder (with a folder)
-  int threads = 0;        // embedding (0: all cores)
+  std::string folder;        // the scene folder; "": none (built here, kept nowhere)
+  SceneInputs inputs;        // what scene.json records of G, S and the image when it is written
+  bool saveBuilt = true;     // write a rig built here into the folder (with a folder)
+  int threads = 0;           // embedding (0: all cores)
   ProgressFn buildProgress;  // building the cage (0-0.5) and the mesh (0.5-1)
   // What happens, one line each, as a front end shows its progress ("reusing the cage and
   // transfer mesh of ...", "building the cage ...", "embedding the mesh in the cage", where the

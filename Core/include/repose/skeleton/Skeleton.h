@@ -73,7 +73,17 @@ std::string findTissuesBeside(const std::string& partsPath);
 // axes "elevation", "protraction" and "rotation"); Lumbosacral: the pelvis under the lumbar spine
 // (distal: downwards; "flexion" tilts the pelvis back, the same turn as the hips' flexion,
 // "lateral", "rotation").
-enum class JointKind { Shoulder, Elbow, Wrist, Hip, Knee, Ankle, Neck, Sternoclavicular, Lumbosacral };
+enum class JointKind {
+  Shoulder,
+  Elbow,
+  Wrist,
+  Hip,
+  Knee,
+  Ankle,
+  Neck,
+  Sternoclavicular,
+  Lumbosacral
+};
 std::vector<std::pair<std::string, Eigen::Vector3d>> jointAxes(
     JointKind kind, const Eigen::Vector3d& distal, const Eigen::Vector3d& anterior,
     const Eigen::Vector3d& superior, int side,
