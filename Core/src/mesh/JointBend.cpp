@@ -69,13 +69,7 @@ JointBends::JointBends(const TransferMesh& mesh, const std::vector<RigidHandle>&
       if (!mesh.rigid.empty() && mesh.rigid[std::size_t(t)])
         piece[std::size_t(mesh.tets(t, k))] = 1;
     }
-  auto groupOf = [&](int label) {
-    for (std::size_t g = 0; g < handles.size(); ++g)
-      if (std::find(handles[g].parts.begin(), handles[g].parts.end(), label) !=
-          handles[g].parts.end())
-        return int(g);
-    return -1;
-  };
+  auto groupOf = [&](int label) { return handleGroupOfPart(handles, label); };
   for (const BendJoint& j : joints) {
     Joint out;
     out.joint = j;

@@ -15,6 +15,13 @@
 #include <string>
 
 namespace repose {
+
+int handleGroupOfPart(const std::vector<RigidHandle>& handles, int part) {
+  for (std::size_t g = 0; g < handles.size(); ++g)
+    if (std::find(handles[g].parts.begin(), handles[g].parts.end(), part) != handles[g].parts.end())
+      return int(g);
+  return -1;
+}
 namespace {
 
 // Cage vertex -> group index (or -1), checking the handle list.

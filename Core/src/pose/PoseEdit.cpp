@@ -13,7 +13,9 @@ std::string who(const Pose& pose) {
   return "pose " + (pose.name.empty() ? std::string("(unnamed)") : pose.name);
 }
 
-PoseGroup& findGroup(Pose& pose, const std::string& group) {
+// The group named `group` of a pose, const or not; throws for an unknown one.
+template <class P>
+auto& findGroup(P& pose, const std::string& group) {
   const auto it = std::find_if(pose.groups.begin(), pose.groups.end(),
                                [&](const PoseGroup& g) { return g.name == group; });
   if (it == pose.groups.end()) throw Error(who(pose) + ": no group \"" + group + "\"");
@@ -91,7 +93,7 @@ Pose newPose(const std::string& name) {
 }
 
 const PoseGroup& poseGroup(const Pose& pose, const std::string& group) {
-  return findGroup(const_cast<Pose&>(pose), group);
+  return findGroup(pose, group);
 }
 
 PoseTransform groupTransform(const Pose& pose, const std::string& group, std::size_t frame) {

@@ -288,15 +288,8 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(
     const Eigen::Index groups = influence_.membership.cols();
     std::vector<std::vector<char>> jointed(std::size_t(groups),
                                            std::vector<char>(std::size_t(groups), 0));
-    auto groupOf = [&](int part) {
-      for (std::size_t g = 0; g < handles.size(); ++g)
-        if (std::find(handles[g].parts.begin(), handles[g].parts.end(), part) !=
-            handles[g].parts.end())
-          return int(g);
-      return -1;
-    };
     for (const auto& [a, b] : jointedParts_) {
-      const int ga = groupOf(a), gb = groupOf(b);
+      const int ga = handleGroupOfPart(handles, a), gb = handleGroupOfPart(handles, b);
       if (ga < 0 || gb < 0 || ga == gb) continue;
       if (handles[std::size_t(ga)].motion.isApprox(handles[std::size_t(gb)].motion, 1e-12))
         continue;

@@ -37,6 +37,9 @@ struct RigidHandle {
   int widen = 0;
 };
 
+// The group (index into `handles`) that carries body part `part` of S, -1 when none does.
+int handleGroupOfPart(const std::vector<RigidHandle>& handles, int part);
+
 // Per TM vertex, computed once per handle set: how much each group carries it, and how much the
 // groups' motions (against its Green position) decide where it goes.
 struct HandleInfluence {
