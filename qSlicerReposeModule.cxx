@@ -125,7 +125,7 @@ bool qSlicerReposeModule::saveScene(const QString& folder, QString* errorMessage
 }
 
 bool qSlicerReposeModule::isBusy() const {
-  return this->Logic && this->Logic->IsJobRunning();
+  return this->Logic && this->Logic->GetJobs()->IsJobRunning();
 }
 
 vtkSlicerReposeLogic* qSlicerReposeModule::logic() const {

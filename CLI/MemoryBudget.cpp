@@ -42,8 +42,9 @@ ReadOptions readOptionsWithin(double budget, bool progress) {
   ReadOptions r;
   if (progress) r.progress = terminalProgress();
   r.note = [](const std::string& n) { std::cerr << "repose: note: " << n << "\n"; };
-  // Never 0 (no limit): a budget already used up refuses every read.
-  r.memoryLimitBytes = std::max(1.0, budget - peakResidentBytes());
+  // Core's rule for every front end (the workbench and Python read by it too): the budget less
+  // the resident set now; never 0 (no limit), so a budget already used up refuses every read.
+  r.memoryLimitBytes = memoryLeftWithin(budget);
   return r;
 }
 
@@ -55,7 +56,7 @@ Volume readLabelsWithinBudget(const std::string& path, double budget, double byt
     Volume v = readVolume(path, readOptionsWithin(budget, false));
     const double need = double(v.numVoxels()) * bytesPerVoxelNeeded;
     const double held = double(v.numVoxels()) * double(scalarSize(v.scalarType())) * v.layers();
-    if (need - held > budget - peakResidentBytes())
+    if (need - held > memoryLeftWithin(budget))
       throw Error(path + ": working on it needs " + gib(need) + " (" +
                   std::to_string(v.numVoxels()) + " voxels), more than the memory budget of " +
                   gib(budget) +
@@ -64,7 +65,7 @@ Volume readLabelsWithinBudget(const std::string& path, double budget, double byt
     return v;
   }
   const NiftiLayout layout = readNiftiLayout(path);
-  const double available = budget - peakResidentBytes();
+  const double available = memoryLeftWithin(budget);
   const std::int64_t voxels = layout.geometry.numVoxels();
   if (double(voxels) * bytesPerVoxelNeeded <= available)
     return readVolume(path, readOptionsWithin(budget, false));
@@ -72,7 +73,7 @@ Volume readLabelsWithinBudget(const std::string& path, double budget, double byt
   factor = proxyFactor(voxels, static_cast<std::size_t>(std::ceil(bytesPerVoxelNeeded)),
                        0.5 * available);
   const double cacheBytes = 0.25 * available;
-  if (cacheBytes <= 0)
+  if (available <= 1)
     throw Error(path + ": the memory budget of " + gib(budget) + " is already used up");
   SliceCache cache(path, static_cast<std::size_t>(cacheBytes));
   return labelModeProxy(cache, factor, terminalProgress());

@@ -19,7 +19,8 @@ void declareMemoryOption(ArgParser& p, const std::string& aboveIt);
 double parseMemoryBudget(const std::string& text);
 
 // Read options for a volume read in core under `budget`: the reader refuses, naming the file and
-// the numbers, when its estimate exceeds what the budget leaves beyond the process's peak so far.
+// the numbers, when its estimate exceeds what the budget leaves beside what the process holds now
+// (Core's memoryLeftWithin: the rule the workbench and Python read by too).
 ReadOptions readOptionsWithin(double budget, bool progress = true);
 
 // Reads the label map at `path` in core when voxels * bytesPerVoxelNeeded fit in `budget`;

@@ -6,6 +6,7 @@
 #include "vtkMRMLReposeScene.h"
 #include "vtkMRMLReposeSegmentationNode.h"
 #include "vtkSlicerReposeJob.h"
+#include "vtkSlicerReposeLogicContext.h"
 #include "vtkSlicerReposeLogicRead.h"
 
 #include <repose/io/VolumeIO.h>
@@ -28,29 +29,59 @@
 vtkStandardNewMacro(vtkSlicerReposeLogic);
 
 vtkSlicerReposeLogic::vtkSlicerReposeLogic()
-    : Scene(vtkSmartPointer<vtkMRMLReposeScene>::New()),
-      Job(std::make_unique<vtkSlicerReposeJob>()) {}
+    : Context(std::make_shared<vtkSlicerReposeLogicContext>()),
+      Jobs(vtkSmartPointer<vtkSlicerReposeJobsLogic>::New()),
+      Live(vtkSmartPointer<vtkSlicerReposeLiveLogic>::New()),
+      PoseEdits(vtkSmartPointer<vtkSlicerReposePoseEditLogic>::New()) {
+  this->Context->Jobs = this->Jobs;
+  this->Context->Live = this->Live;
+  this->Context->Edits = this->PoseEdits;
+  this->Jobs->SetContext(this->Context);
+  this->Live->SetContext(this->Context);
+  this->PoseEdits->SetContext(this->Context);
+  // A part's news is the module's: the panel and the views observe this logic only.
+  for (vtkObject* part : {static_cast<vtkObject*>(this->Jobs), static_cast<vtkObject*>(this->Live),
+                          static_cast<vtkObject*>(this->PoseEdits)})
+    part->AddObserver(vtkCommand::ModifiedEvent, this, &vtkSlicerReposeLogic::Modified);
+  this->SetParameterNode(nullptr);  // a node of its own
+}
 
 vtkSlicerReposeLogic::~vtkSlicerReposeLogic() {
-  this->SetParameterNode(nullptr);
-  this->Job.reset();  // a running job is cancelled and its commit dropped before the rest goes
-  this->ReleaseLivePose();
+  if (this->Context->ParameterNode)
+    this->Context->ParameterNode->RemoveObserver(this->ParameterNodeObserverTag);
+  // A running job is cancelled and its commit dropped before the rest goes.
+  this->Context->Job.reset();
+  for (vtkObject* part : {static_cast<vtkObject*>(this->Jobs), static_cast<vtkObject*>(this->Live),
+                          static_cast<vtkObject*>(this->PoseEdits)})
+    part->RemoveObservers(vtkCommand::ModifiedEvent);
+  this->Live->ReleaseLivePose();
+  this->Context->Jobs = nullptr;
+  this->Context->Live = nullptr;
+  this->Context->Edits = nullptr;
+}
+
+vtkMRMLReposeParametersNode* vtkSlicerReposeLogic::GetParameterNode() const {
+  return this->Context->ParameterNode;
+}
+
+const std::string& vtkSlicerReposeLogic::GetLastErrorMessage() const {
+  return this->Context->LastErrorMessage;
 }
 
 void vtkSlicerReposeLogic::SetParameterNode(vtkMRMLReposeParametersNode* node) {
-  if (node == this->ParameterNode) return;
-  if (this->ParameterNode) this->ParameterNode->RemoveObserver(this->ParameterNodeObserverTag);
-  this->ParameterNode = node;
-  if (node) {
-    this->ParameterNodeObserverTag = node->AddObserver(
-        vtkCommand::ModifiedEvent, this, &vtkSlicerReposeLogic::OnParameterNodeModified);
-    this->OnParameterNodeModified();  // bring the volume in line with the new node
-  }
+  vtkSmartPointer<vtkMRMLReposeParametersNode>& current = this->Context->ParameterNode;
+  if (node && node == current) return;
+  if (current) current->RemoveObserver(this->ParameterNodeObserverTag);
+  current = node ? vtkSmartPointer<vtkMRMLReposeParametersNode>(node)
+                 : vtkSmartPointer<vtkMRMLReposeParametersNode>::New();
+  this->ParameterNodeObserverTag = current->AddObserver(
+      vtkCommand::ModifiedEvent, this, &vtkSlicerReposeLogic::OnParameterNodeModified);
+  this->OnParameterNodeModified();  // bring the volume in line with the new node
   this->Modified();
 }
 
 void vtkSlicerReposeLogic::OnParameterNodeModified() {
-  const std::string& path = this->ParameterNode->GetInputSegmentationPath();
+  const std::string& path = this->Context->ParameterNode->GetInputSegmentationPath();
   if (path == this->VolumePath) return;
   if (path.empty())
     this->ClearVolume();
@@ -71,7 +102,7 @@ bool vtkSlicerReposeLogic::LoadVolume(const std::string& path) {
   return this->ShowVolume(path, nullptr);
 }
 
-bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* held) {
+void vtkSlicerReposeLogic::ResetVolume() {
   this->VolumeImageData = nullptr;
   this->VolumeIJKToRASMatrix = nullptr;
   this->VolumeLookupTable = nullptr;
@@ -80,14 +111,21 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
   this->VolumeReadNotes.clear();
   this->VolumeStamp.clear();
   this->VolumeLabelsPresent = -1;
+  this->VolumePath.clear();
+}
+
+bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* held) {
+  this->ResetVolume();
   this->VolumePath = path;  // before the node is told, so its Modified does not reload
-  this->LastErrorMessage.clear();
+  std::string& message = this->Context->LastErrorMessage;
+  message.clear();
+  const std::string tissues = this->Context->TissueTablePath();
   try {
     if (path.empty()) throw repose::Error("no input file given");
     std::vector<std::string> readNotes;
     // Before reading: a file changed during the read does not match it afterwards.
     const std::string stamp =
-        held ? std::string() : vtkSlicerReposeLogicRead::FilesStamp({path, this->TissueTablePath});
+        held ? std::string() : vtkSlicerReposeLogicRead::FilesStamp({path, tissues});
     repose::Volume volume = held ? vtkSlicerReposeVolumeConversion::FromImageData(held)
                                  : vtkSlicerReposeLogicRead::ReadVolume(path, &readNotes);
     for (const repose::Label& l : volume.labels().labels())
@@ -97,8 +135,7 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
     const std::vector<repose::LabelCount> counts =
         volume.isLabelMap() ? repose::countLabels(volume) : std::vector<repose::LabelCount>();
     // The display's names and colours of labels the file left without (the file's names above).
-    this->VolumeLabelNote =
-        vtkSlicerReposeLogicRead::NameLabels(volume, this->TissueTablePath, path, &counts);
+    this->VolumeLabelNote = vtkSlicerReposeLogicRead::NameLabels(volume, tissues, path, &counts);
     this->VolumeReadNotes = readNotes;  // a SEG's grid, a fractional SEG thresholded
     this->VolumeImageData = held ? vtkSmartPointer<vtkImageData>(held)
                                  : vtkSlicerReposeVolumeConversion::ToImageData(volume);
@@ -114,29 +151,21 @@ bool vtkSlicerReposeLogic::ShowVolume(const std::string& path, vtkImageData* hel
         vtkSlicerReposeVolumeConversion::ToLookupTable(volume.labels(), 0, present);
     if (volume.isLabelMap()) this->VolumeStamp = stamp;
   } catch (const repose::Error& e) {
-    this->LastErrorMessage = oneLine(e.what());
+    message = oneLine(e.what());
   } catch (const std::bad_alloc&) {
-    this->LastErrorMessage = path + ": not enough memory to load the volume";
+    message = path + ": not enough memory to load the volume";
   } catch (const std::exception& e) {
-    this->LastErrorMessage = oneLine(path + ": " + e.what());
+    message = oneLine(path + ": " + e.what());
   }
-  if (!this->LastErrorMessage.empty()) this->VolumeImageData = nullptr, this->VolumeStamp.clear();
-  if (this->ParameterNode) this->ParameterNode->SetInputSegmentationPath(path);
+  if (!message.empty()) this->VolumeImageData = nullptr, this->VolumeStamp.clear();
+  this->Context->ParameterNode->SetInputSegmentationPath(path);
   this->Modified();
-  return this->LastErrorMessage.empty();
+  return message.empty();
 }
 
 void vtkSlicerReposeLogic::ClearVolume() {
-  this->VolumeImageData = nullptr;
-  this->VolumeIJKToRASMatrix = nullptr;
-  this->VolumeLookupTable = nullptr;
-  this->VolumeLabelNames.clear();
-  this->VolumeLabelNote.clear();
-  this->VolumeReadNotes.clear();
-  this->VolumeStamp.clear();
-  this->VolumeLabelsPresent = -1;
-  this->VolumePath.clear();
-  this->LastErrorMessage.clear();
+  this->ResetVolume();
+  this->Context->LastErrorMessage.clear();
   this->Modified();
 }
 
@@ -186,8 +215,8 @@ std::string vtkSlicerReposeLogic::GetVolumeSummary() const {
 
 void vtkSlicerReposeLogic::PrintSelf(ostream& os, vtkIndent indent) {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "ParameterNode: " << this->ParameterNode.GetPointer() << "\n";
+  os << indent << "ParameterNode: " << this->Context->ParameterNode.GetPointer() << "\n";
   os << indent << "VolumePath: " << this->VolumePath << "\n";
   os << indent << "VolumeImageData: " << this->VolumeImageData.GetPointer() << "\n";
-  os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
+  os << indent << "LastErrorMessage: " << this->Context->LastErrorMessage << "\n";
 }

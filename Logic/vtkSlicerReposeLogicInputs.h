@@ -7,8 +7,15 @@
 #include <repose/skeleton/Skeleton.h>
 #include <repose/volume/LabelTable.h>
 
+#include <memory>
 #include <optional>
 
+namespace repose {
+class PoseJob;
+struct Pose;
+class Volume;
+}  // namespace repose
+class vtkMRMLReposeParametersNode;
 class vtkMRMLReposeCageNode;
 class vtkMRMLReposePoseNode;
 class vtkMRMLReposeScene;
@@ -34,6 +41,21 @@ repose::Volume PartsOf(vtkMRMLReposeSegmentationNode* seg);
 
 // S's label table, or the one-label table of the body mask when the segmentation has no S.
 repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg);
+
+// The pose job of a segmentation (Core's policy, as `repose pose` and Python use it): its tissue
+// table, skeleton and joints, separations, the rig's settings from the parameter node (null:
+// the defaults). G and S must outlive it.
+std::shared_ptr<const repose::PoseJob> PoseJobFor(vtkMRMLReposeParametersNode* parameters,
+                                                  vtkMRMLReposeSegmentationNode* seg,
+                                                  const repose::Pose& pose, const repose::Volume& G,
+                                                  const repose::Volume& S);
+
+// A new pose node named `name` holding `pose`, added to the scene.
+vtkMRMLReposePoseNode* AddPoseNode(vtkMRMLReposeScene* scene, const std::string& name,
+                                   repose::Pose pose);
+
+// The pose a pose node holds; throws repose::Error naming the node when it holds none.
+const repose::Pose& PoseOf(vtkMRMLReposePoseNode* node);
 
 }  // namespace vtkSlicerReposeLogicInputs
 

@@ -13,6 +13,14 @@
 
 namespace vtkSlicerReposeLogicRead {
 
+std::string FileStem(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  for (const std::string ext : {".nii.gz", ".seg.nrrd", ".pose.json", ".nii", ".nrrd", ".nhdr"})
+    if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0)
+      return name.substr(0, name.size() - ext.size());
+  return name;
+}
+
 repose::Volume ReadVolume(const std::string& path, std::vector<std::string>* notes) {
   repose::ReadOptions options;
   if (notes) options.note = [notes](const std::string& n) { notes->push_back(n); };

@@ -29,6 +29,9 @@ std::string ReadText(const std::string& path);
 // with its size and modification time (a folder, such as a DICOM series: of every file in it).
 // "" when a non-empty path does not exist; empty paths stand for themselves.
 std::string FilesStamp(const std::vector<std::string>& paths);
+// A file's name without its folder and its volume, mesh or pose extension ("G" of
+// "/d/G.nii.gz"): what nodes read from it are named.
+std::string FileStem(const std::string& path);
 
 }  // namespace vtkSlicerReposeLogicRead
 

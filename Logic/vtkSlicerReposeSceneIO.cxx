@@ -22,6 +22,7 @@
 #include <repose/schema/SceneSchema.h>
 #include <repose/util/Error.h>
 
+#include <nlohmann/json.hpp>
 #include <vtkNew.h>
 
 #include <filesystem>
@@ -36,7 +37,7 @@ namespace {}  // namespace
 
 namespace vtkSlicerReposeSceneIO {
 
-void Save(vtkMRMLReposeScene* scene, const std::string& folder) {
+void Save(vtkMRMLReposeScene* scene, const std::string& folder, const std::string& parameters) {
   if (!fs::is_directory(fs::absolute(folder).parent_path()))
     throw repose::Error(folder + ": its parent folder does not exist");
   fs::create_directories(folder);
@@ -83,7 +84,8 @@ void Save(vtkMRMLReposeScene* scene, const std::string& folder) {
       }
     } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
       pose->SetFileName(id + ".pose.json");
-      repose::writeTextFileAtomically((dir / pose->GetFileName()).string(), pose->GetPoseJSON());
+      if (!pose->GetPose()) throw repose::Error("pose node " + id + " holds no pose to save");
+      repose::writePoseFile(*pose->GetPose(), (dir / pose->GetFileName()).string());
     }
   }
   // The same scene for 3D Slicer (docs/SLICER.md): the input and the last posed label maps
@@ -109,18 +111,28 @@ void Save(vtkMRMLReposeScene* scene, const std::string& folder) {
   }
   repose::writeTextFileAtomically((dir / "scene.mrml").string(),
                                   repose::formatSlicerScene(mrml, dir.string()));
+  nlohmann::ordered_json document = nlohmann::ordered_json::parse(scene->WriteJSON());
+  if (!parameters.empty())
+    document[repose::scene_schema::kParameters] = nlohmann::ordered_json::parse(parameters);
   repose::writeTextFileAtomically((dir / repose::scene_schema::kDocument).string(),
-                                  scene->WriteJSON() + "\n");
+                                  document.dump(2) + "\n");
 }
 
-vtkSmartPointer<vtkMRMLReposeScene> Load(const std::string& folder) {
+Loaded Load(const std::string& folder) {
   const fs::path dir = folder;
   auto loaded = vtkSmartPointer<vtkMRMLReposeScene>::New();
   std::string error;
-  if (!loaded->ReadJSON(
-          vtkSlicerReposeLogicRead::ReadText((dir / repose::scene_schema::kDocument).string()),
-          &error))
-    throw repose::Error((dir / repose::scene_schema::kDocument).string() + ": " + error);
+  const std::string document = (dir / repose::scene_schema::kDocument).string();
+  const std::string text = vtkSlicerReposeLogicRead::ReadText(document);
+  if (!loaded->ReadJSON(text, &error)) throw repose::Error(document + ": " + error);
+  std::string parameters;
+  if (const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+      json.is_object() && json.contains(repose::scene_schema::kParameters)) {
+    if (!json[repose::scene_schema::kParameters].is_object())
+      throw repose::Error(document + ": " + repose::scene_schema::kParameters +
+                          ": expected an object");
+    parameters = json[repose::scene_schema::kParameters].dump();
+  }
   auto need = [&](const std::string& name, vtkMRMLReposeNode* node) {
     if (name.empty())
       throw repose::Error(folder + ": node " + node->GetID() + " names no data file");
@@ -161,10 +173,10 @@ vtkSmartPointer<vtkMRMLReposeScene> Load(const std::string& folder) {
       tm->SetCoordinatesFile(repose::greenCoordinatesFileFor(meshFile));
     } else if (auto* pose = vtkMRMLReposePoseNode::SafeDownCast(node)) {
       const std::string path = need(pose->GetFileName(), pose);
-      pose->SetPoseJSON(repose::poseToJson(repose::readPoseFile(path)));
+      pose->SetPose(std::make_shared<const repose::Pose>(repose::readPoseFile(path)));
     }
   }
-  return loaded;
+  return {loaded, parameters};
 }
 
 }  // namespace vtkSlicerReposeSceneIO

@@ -34,6 +34,10 @@ void vtkMRMLReposeParametersNode::ForEachField(F&& f) {
   f("LabelOpacity", &Self::LabelOpacity, &Self::SetLabelOpacity);
   f("ShowBodyParts", &Self::ShowBodyParts, &Self::SetShowBodyParts);
   f("ShowJoints", &Self::ShowJoints, &Self::SetShowJoints);
+  f("TissueTablePath", &Self::TissueTablePath, &Self::SetTissueTablePath);
+  f("RigSummary", &Self::RigSummary, &Self::SetRigSummary);
+  f("OutputSegmentationNodeID", &Self::OutputSegmentationNodeID,
+    &Self::SetOutputSegmentationNodeID);
 }
 
 namespace {

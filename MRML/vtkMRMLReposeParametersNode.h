@@ -89,6 +89,18 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   void SetShowJoints(bool show);
   bool GetShowJoints() const { return this->ShowJoints; }
 
+  // Tissue table (CSV, docs/FORMATS.md) for the reports of pose jobs; empty: the phantom's table
+  // when G's labels are the phantom's, else none (no masses, no bone check). Rigging from the
+  // organ map sets it to the rig folder's tissues.csv.
+  vtkSetMacro(TissueTablePath, std::string);
+  const std::string& GetTissueTablePath() const { return this->TissueTablePath; }
+  // What the last rig from the organ map found (convention, joints, what it could not make).
+  vtkSetMacro(RigSummary, std::string);
+  const std::string& GetRigSummary() const { return this->RigSummary; }
+  // The segmentation node the last export of a pose made (its report and warnings are on it).
+  vtkSetMacro(OutputSegmentationNodeID, std::string);
+  const std::string& GetOutputSegmentationNodeID() const { return this->OutputSegmentationNodeID; }
+
  protected:
   vtkMRMLReposeParametersNode() = default;
   ~vtkMRMLReposeParametersNode() override = default;
@@ -115,6 +127,9 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeParametersNode : public 
   double LabelOpacity = 0.8;
   bool ShowBodyParts = false;
   bool ShowJoints = true;
+  std::string TissueTablePath;
+  std::string RigSummary;
+  std::string OutputSegmentationNodeID;
 
  private:
   vtkMRMLReposeParametersNode(const vtkMRMLReposeParametersNode&) = delete;

@@ -1,13 +1,36 @@
 #include "vtkMRMLReposePoseNode.h"
 
 #include <vtkObjectFactory.h>
+#include "repose/pose/Pose.h"
 #include "repose/schema/SceneSchema.h"
+
+#include <exception>
 
 namespace sc = repose::scene_schema;
 
 vtkStandardNewMacro(vtkMRMLReposePoseNode);
 
-// The pose text is the node's bulk data (its file); the JSON carries where it is and the frame.
+void vtkMRMLReposePoseNode::SetPose(std::shared_ptr<const repose::Pose> pose) {
+  if (pose == this->Pose) return;
+  this->Pose = std::move(pose);
+  this->Modified();
+}
+
+std::string vtkMRMLReposePoseNode::GetPoseJSON() const {
+  return this->Pose ? repose::poseToJson(*this->Pose) : std::string();
+}
+
+bool vtkMRMLReposePoseNode::SetPoseJSON(const std::string& text, std::string* error) {
+  try {
+    this->SetPose(std::make_shared<const repose::Pose>(repose::parsePose(text, this->GetName())));
+    return true;
+  } catch (const std::exception& e) {
+    if (error) *error = e.what();
+    return false;
+  }
+}
+
+// The pose is the node's bulk data (its file); the JSON carries where it is and the frame.
 void vtkMRMLReposePoseNode::WriteFields(nlohmann::ordered_json& json) const {
   json[sc::pose::kFile] = this->FileName;
   json[sc::pose::kCurrentFrame] = this->CurrentFrame;
@@ -26,5 +49,5 @@ void vtkMRMLReposePoseNode::CopyContent(vtkMRMLReposeNode* other) {
   auto* o = static_cast<vtkMRMLReposePoseNode*>(other);
   this->SetFileName(o->FileName);
   this->SetCurrentFrame(o->CurrentFrame);
-  this->SetPoseJSON(o->PoseJSON);
+  this->SetPose(o->Pose);  // a snapshot: shared, never changed in place
 }

@@ -1,10 +1,18 @@
 // vtkMRMLReposePoseNode: a pose — handle groups with their transforms, keyframes, separations —
-// held as the text of a pose file (docs/POSES.md), which the Logic parses and edits, and the
-// keyframe shown. MRML knows no pose semantics; keeping the document whole makes undo a swap of
-// two strings and saving a plain write.
+// held parsed (repose::Pose, as Slicer's nodes hold their data objects, not their files' text),
+// and the keyframe shown. The pose is an immutable snapshot the node shares: an edit sets a new
+// one, undo puts an old one back (no copy, nothing to parse), and pose-file text is made only
+// where it is written (a saved scene) or read (a file opened). The header names no Core type
+// beyond a declaration, so the widgets, which include it, reach no Core header through it.
 #pragma once
 
 #include "vtkMRMLReposeNode.h"
+
+#include <memory>
+
+namespace repose {
+struct Pose;
+}
 
 class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposePoseNode : public vtkMRMLReposeNode {
  public:
@@ -12,8 +20,14 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposePoseNode : public vtkMRM
   vtkTypeMacro(vtkMRMLReposePoseNode, vtkMRMLReposeNode);
   const char* GetNodeClassName() const override { return "vtkMRMLReposePoseNode"; }
 
-  const std::string& GetPoseJSON() const { return this->PoseJSON; }
-  void SetPoseJSON(const std::string& text) { this->SetField(this->PoseJSON, text); }
+  // The pose (null before one is set). Setting another snapshot fires ModifiedEvent.
+  std::shared_ptr<const repose::Pose> GetPose() const { return this->Pose; }
+  void SetPose(std::shared_ptr<const repose::Pose> pose);
+  // The pose as a pose file's text (docs/POSES.md), written now: "" without a pose.
+  std::string GetPoseJSON() const;
+  // Parses pose-file text (named after the node) into the node's pose. False, with the
+  // parser's one line in `error`, and the node unchanged, for text that is not a pose.
+  bool SetPoseJSON(const std::string& text, std::string* error = nullptr);
   const std::string& GetFileName() const { return this->FileName; }
   void SetFileName(const std::string& name) { this->SetField(this->FileName, name); }
   int GetCurrentFrame() const { return this->CurrentFrame; }  // keyframe index, 0 without
@@ -26,6 +40,7 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposePoseNode : public vtkMRM
   void CopyContent(vtkMRMLReposeNode* other) override;
 
  private:
-  std::string PoseJSON, FileName;
+  std::shared_ptr<const repose::Pose> Pose;
+  std::string FileName;
   int CurrentFrame = 0;
 };

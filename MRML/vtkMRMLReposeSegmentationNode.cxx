@@ -3,6 +3,8 @@
 #include <vtkObjectFactory.h>
 #include "repose/schema/SceneSchema.h"
 
+#include <algorithm>
+
 namespace sc = repose::scene_schema;
 
 vtkStandardNewMacro(vtkMRMLReposeSegmentationNode);
@@ -38,6 +40,8 @@ void vtkMRMLReposeSegmentationNode::WriteFields(nlohmann::ordered_json& json) co
   json[sc::segmentation::kBodyPartMapFile] = this->BodyPartMapFileName;
   json[sc::segmentation::kImageFile] = this->ImageFileName;
   json[sc::segmentation::kSkeleton] = this->SkeletonJSON;
+  if (!this->PoseReportJSON.empty()) json[sc::segmentation::kPoseReport] = this->PoseReportJSON;
+  if (!this->PoseWarnings.empty()) json[sc::segmentation::kPoseWarnings] = this->PoseWarnings;
 }
 
 bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool apply,
@@ -45,6 +49,13 @@ bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool 
   if (!apply) {
     for (const char* key : kFileFields)
       if (!CheckString(json, key, error)) return false;
+    if (!CheckString(json, sc::segmentation::kPoseReport, error)) return false;
+    if (json.contains(sc::segmentation::kPoseWarnings)) {
+      const auto& w = json[sc::segmentation::kPoseWarnings];
+      if (!w.is_array() || !std::all_of(w.begin(), w.end(), [](auto& x) { return x.is_string(); }))
+        return error = std::string(sc::segmentation::kPoseWarnings) + ": expected an array of text",
+               false;
+    }
     return true;
   }
   if (json.contains(sc::segmentation::kLabelMapFile))
@@ -55,6 +66,10 @@ bool vtkMRMLReposeSegmentationNode::ReadFields(const nlohmann::json& json, bool 
     this->SetImageFileName(json[sc::segmentation::kImageFile]);
   if (json.contains(sc::segmentation::kSkeleton))
     this->SetSkeletonJSON(json[sc::segmentation::kSkeleton]);
+  if (json.contains(sc::segmentation::kPoseReport))
+    this->SetPoseReportJSON(json[sc::segmentation::kPoseReport]);
+  if (json.contains(sc::segmentation::kPoseWarnings))
+    this->SetPoseWarnings(json[sc::segmentation::kPoseWarnings].get<std::vector<std::string>>());
   return true;
 }
 
@@ -66,6 +81,8 @@ void vtkMRMLReposeSegmentationNode::CopyContent(vtkMRMLReposeNode* other) {
   this->SetSkeletonJSON(o->SkeletonJSON);
   this->SetLabelMapReadNotes(o->LabelMapReadNotes);
   this->SetSourceStamp(o->SourceStamp);
+  this->SetPoseReportJSON(o->PoseReportJSON);
+  this->SetPoseWarnings(o->PoseWarnings);
   this->SetLabelMap(copyOf(o->LabelMap));
   this->SetBodyPartMap(copyOf(o->BodyPartMap));
   this->SetImage(copyOf(o->Image));

@@ -59,6 +59,16 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
   const std::string& GetSourceStamp() const { return this->SourceStamp; }
   void SetSourceStamp(const std::string& stamp) { this->SetField(this->SourceStamp, stamp); }
 
+  // A posed segmentation (an export of a pose): the report.json its job wrote and the job's
+  // warnings (separations not made, a tissue table that does not fit). Empty for an input.
+  // Saved with the scene, so the panel shows the export's quality again when it is reopened.
+  const std::string& GetPoseReportJSON() const { return this->PoseReportJSON; }
+  void SetPoseReportJSON(const std::string& text) { this->SetField(this->PoseReportJSON, text); }
+  const std::vector<std::string>& GetPoseWarnings() const { return this->PoseWarnings; }
+  void SetPoseWarnings(const std::vector<std::string>& warnings) {
+    this->SetField(this->PoseWarnings, warnings);
+  }
+
  protected:
   vtkMRMLReposeSegmentationNode() = default;
   void WriteFields(nlohmann::ordered_json& json) const override;
@@ -68,5 +78,7 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeSegmentationNode
  private:
   vtkSmartPointer<vtkImageData> LabelMap, BodyPartMap, Image;
   std::string LabelMapFileName, BodyPartMapFileName, ImageFileName, SkeletonJSON, SourceStamp;
+  std::string PoseReportJSON;
+  std::vector<std::string> PoseWarnings;
   std::vector<std::string> LabelMapReadNotes;
 };

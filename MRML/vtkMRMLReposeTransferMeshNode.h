@@ -7,6 +7,8 @@
 #include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
 
+#include <vector>
+
 class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeTransferMeshNode
     : public vtkMRMLReposeNode {
  public:
@@ -26,6 +28,19 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeTransferMeshNode
   void SetCoordinatesFile(const std::string& path) { this->CoordinatesFile = path; }
   double GetSizeMm() const { return this->SizeMm; }  // 0: the automatic size
   void SetSizeMm(double mm) { this->SetField(this->SizeMm, mm); }
+  // A mesh refined for a pose's frame (the Logic's StartRefineMesh): the vertices of the mesh it
+  // was refined from, and per round its vertices and maximum error e^G. Empty for a mesh built
+  // whole. Saved with the scene.
+  struct Refinement {
+    int fromVertices = 0;
+    std::vector<int> vertices;
+    std::vector<double> maxErrors;
+    bool operator==(const Refinement& o) const {
+      return fromVertices == o.fromVertices && vertices == o.vertices && maxErrors == o.maxErrors;
+    }
+  };
+  const Refinement& GetRefinement() const { return this->RefinementRecord; }
+  void SetRefinement(const Refinement& r) { this->SetField(this->RefinementRecord, r); }
 
  protected:
   vtkMRMLReposeTransferMeshNode() = default;
@@ -37,4 +52,5 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeTransferMeshNode
   vtkSmartPointer<vtkUnstructuredGrid> Mesh;
   std::string FileName, CoordinatesFile;
   double SizeMm = 0;
+  Refinement RefinementRecord;
 };

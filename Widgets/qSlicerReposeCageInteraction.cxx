@@ -63,7 +63,9 @@ class qSlicerReposeCageInteractionPrivate {
   vtkMRMLReposeParametersNode* parameters() const {
     return this->Logic ? this->Logic->GetParameterNode() : nullptr;
   }
-  vtkPolyData* cage() const { return this->Logic ? this->Logic->GetLiveCage() : nullptr; }
+  vtkPolyData* cage() const {
+    return this->Logic ? this->Logic->GetLive()->GetLiveCage() : nullptr;
+  }
   void setSelection(std::vector<int> vertices, int part) {
     vtkMRMLReposeParametersNode* p = this->parameters();
     if (!p) return;
@@ -242,7 +244,7 @@ int qSlicerReposeCageInteraction::selectInRectangle(int x0, int y0, int x1, int 
 int qSlicerReposeCageInteraction::selectBodyPart(int label) {
   Q_D(qSlicerReposeCageInteraction);
   if (!d->Logic) return 0;
-  const std::vector<int> vertices = d->Logic->GetLiveCageVerticesOfPart(label);
+  const std::vector<int> vertices = d->Logic->GetLive()->GetLiveCageVerticesOfPart(label);
   d->setSelection(vertices, vertices.empty() ? 0 : label);
   return int(vertices.size());
 }
@@ -273,15 +275,16 @@ void qSlicerReposeCageInteraction::update() {
   if (d->Dragging) return;  // the box is where the user holds it
 
   // The transform widget around the active group's posed vertices.
-  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLivePose() : nullptr;
+  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLive()->GetLivePose() : nullptr;
   vtkNew<vtkMatrix4x4> unused;
   const std::string group = p ? p->GetActiveGroup() : std::string();
   // Only a group one matrix can move: a joint's group turning about several axes has its
   // sliders (SetPoseGroupMatrix refuses it).
-  const std::vector<int> vertices = pose && d->Logic->GetPoseGroupMatrix(pose, group, unused) &&
-                                            d->Logic->GetPoseGroupTurns(pose, group).size() == 1
-                                        ? d->Logic->GetLiveGroupVertices(group)
-                                        : std::vector<int>{};
+  const std::vector<int> vertices =
+      pose && d->Logic->GetPoseEdits()->GetPoseGroupMatrix(pose, group, unused) &&
+              d->Logic->GetPoseEdits()->GetPoseGroupTurns(pose, group).size() == 1
+          ? d->Logic->GetLive()->GetLiveGroupVertices(group)
+          : std::vector<int>{};
   if (vertices.empty() || !cage) {
     d->Box->SetEnabled(0);
     return;
@@ -303,33 +306,33 @@ void qSlicerReposeCageInteraction::update() {
 
 void qSlicerReposeCageInteraction::onWidgetStart() {
   Q_D(qSlicerReposeCageInteraction);
-  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLivePose() : nullptr;
+  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLive()->GetLivePose() : nullptr;
   vtkMRMLReposeParametersNode* p = d->parameters();
   if (!pose || !p) return;
   d->DragStart = vtkSmartPointer<vtkMatrix4x4>::New();
   d->DragGroup = p->GetActiveGroup();
-  if (!d->Logic->GetPoseGroupMatrix(pose, d->DragGroup, d->DragStart)) return;
+  if (!d->Logic->GetPoseEdits()->GetPoseGroupMatrix(pose, d->DragGroup, d->DragStart)) return;
   d->Dragging = true;
-  d->Logic->BeginPoseInteraction();
+  d->Logic->GetPoseEdits()->BeginPoseInteraction();
 }
 
 void qSlicerReposeCageInteraction::onWidgetInteraction() {
   Q_D(qSlicerReposeCageInteraction);
-  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLivePose() : nullptr;
+  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLive()->GetLivePose() : nullptr;
   if (!d->Dragging || !pose) return;
   // The box's motion since the drag began, after the group's motion at that moment.
   vtkNew<vtkTransform> box;
   d->BoxRep->GetTransform(box);
   vtkNew<vtkMatrix4x4> motion;
   vtkMatrix4x4::Multiply4x4(box->GetMatrix(), d->DragStart, motion);
-  d->Logic->SetPoseGroupMatrix(pose, d->DragGroup, motion);
+  d->Logic->GetPoseEdits()->SetPoseGroupMatrix(pose, d->DragGroup, motion);
 }
 
 void qSlicerReposeCageInteraction::onWidgetEnd() {
   Q_D(qSlicerReposeCageInteraction);
   if (!d->Dragging) return;
   d->Dragging = false;
-  d->Logic->EndPoseInteraction();
+  d->Logic->GetPoseEdits()->EndPoseInteraction();
   this->update();
   d->render();
 }

@@ -65,17 +65,17 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   std::vector<QSlider*> JointAxisSliders;
   std::vector<QSpinBox*> JointAxisSpinBoxes;
   QPushButton* SavePoseButton = nullptr;
-  std::vector<vtkSlicerReposeLogic::JointInfo> Joints;
+  std::vector<vtkSlicerReposePoseEditLogic::JointInfo> Joints;
   std::string JointsFor;  // the body-part map path they were read for
 
-  const vtkSlicerReposeLogic::JointInfo* joint(const std::string& name) const {
+  const vtkSlicerReposePoseEditLogic::JointInfo* joint(const std::string& name) const {
     for (const auto& j : this->Joints)
       if (j.name == name) return &j;
     return nullptr;
   }
 
   void showQuality(vtkSlicerReposeLogic* logic) {
-    const auto rows = logic->GetLastPoseQuality();
+    const auto rows = logic->GetJobs()->GetLastPoseQuality();
     this->QualityTable->setRowCount(int(rows.size()));
     for (int r = 0; r < int(rows.size()); ++r) {
       const auto& row = rows[std::size_t(r)];
@@ -96,7 +96,7 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
         this->QualityTable->horizontalScrollBar()->sizeHint().height() + 4);
     this->QualityTable->setVisible(!rows.empty());
     std::vector<std::pair<QString, double>> changes;
-    for (const auto& c : logic->GetLastPoseLabelChanges())
+    for (const auto& c : logic->GetJobs()->GetLastPoseLabelChanges())
       changes.push_back({QString::fromStdString(c.name.empty() ? std::to_string(c.value) : c.name),
                          c.changePercent});
     this->VolumeChangePlot->setChanges(changes);
@@ -248,10 +248,10 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
       pose->SetCurrentFrame(k);
   });
   connect(d->UndoButton, &QToolButton::clicked, this, [d] {
-    if (d->Logic) d->Logic->Undo();
+    if (d->Logic) d->Logic->GetPoseEdits()->Undo();
   });
   connect(d->RedoButton, &QToolButton::clicked, this, [d] {
-    if (d->Logic) d->Logic->Redo();
+    if (d->Logic) d->Logic->GetPoseEdits()->Redo();
   });
   connect(d->AddSeparationButton, &QPushButton::clicked, this, [this, d] {
     this->addSeparation(d->SeparatePartACombo->currentText(), d->SeparatePartBCombo->currentText(),
@@ -333,7 +333,8 @@ bool qSlicerReposeModuleWidget::setPosePath(const QString& path) {
   const int state = d->ParameterNode->StartModify();
   d->ParameterNode->SetPosePath(path.toStdString());
   d->ParameterNode->SetActivePoseNodeID(pose ? pose->GetID() : "");
-  const vtkSlicerReposeLogic::PoseSummary summary = d->Logic->GetPoseSummary(pose);
+  const vtkSlicerReposePoseEditLogic::PoseSummary summary =
+      d->Logic->GetPoseEdits()->GetPoseSummary(pose);
   d->ParameterNode->SetActiveGroup(summary.movableGroups.empty() ? std::string()
                                                                  : summary.movableGroups.front());
   d->ParameterNode->EndModify(state);
@@ -379,7 +380,7 @@ bool qSlicerReposeModuleWidget::buildRig() {
     if (!seg) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
     d->ParameterNode->SetInputSegmentationNodeID(seg->GetID());
   }
-  if (!d->Logic->StartBuildRig(seg, pose))
+  if (!d->Logic->GetJobs()->StartBuildRig(seg, pose))
     return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
   d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Rig;
   d->JobStatus = "Building the cage and the transfer mesh...";
@@ -391,7 +392,7 @@ bool qSlicerReposeModuleWidget::buildRig() {
 QString qSlicerReposeModuleWidget::rigFolder() const {
   Q_D(const qSlicerReposeModuleWidget);
   if (!d->ParameterNode) return {};
-  return QString::fromStdString(vtkSlicerReposeLogic::DefaultRigFolder(
+  return QString::fromStdString(vtkSlicerReposeJobsLogic::DefaultRigFolder(
       d->ParameterNode->GetInputSegmentationPath(), d->ParameterNode->GetOutputFolder()));
 }
 
@@ -401,7 +402,7 @@ bool qSlicerReposeModuleWidget::rigFromOrganMap() {
   const std::string labels = d->ParameterNode->GetInputSegmentationPath();
   const QString folder = this->rigFolder();
   const bool started = d->showJobStart(
-      !labels.empty() && d->Logic->StartRigFromOrganMap(labels, folder.toStdString()),
+      !labels.empty() && d->Logic->GetJobs()->StartRigFromOrganMap(labels, folder.toStdString()),
       labels.empty() ? "choose a segmentation first" : "",
       qSlicerReposeModuleWidgetPrivate::Step::OrganRig,
       "Rigging from the organ map into " + folder + "...");
@@ -427,7 +428,7 @@ bool qSlicerReposeModuleWidget::poseByJoint(const QString& joint) {
   if (joint.isEmpty()) return fail("choose a joint (the skeleton beside the body-part map)");
   if (!this->activePose() && !this->newPose())
     return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
-  const std::string group = d->Logic->SetPoseJoint(
+  const std::string group = d->Logic->GetPoseEdits()->SetPoseJoint(
       this->activePose(), d->ParameterNode->GetBodyPartMapPath(), joint.toStdString());
   if (group.empty()) return fail(QString::fromStdString(d->Logic->GetLastErrorMessage()));
   d->ParameterNode->SetActiveGroup(group);
@@ -442,8 +443,8 @@ bool qSlicerReposeModuleWidget::setJointAngle(const QString& axis, double angleD
   if (!d->Logic || !pose || !d->JointSliders->isVisibleTo(d->PoseGroupBox) ||
       at == d->JointSliderAxes.end())
     return false;
-  return d->Logic->SetPoseGroupTurnAngle(pose, d->ParameterNode->GetActiveGroup(),
-                                         int(at - d->JointSliderAxes.begin()), angleDeg);
+  return d->Logic->GetPoseEdits()->SetPoseGroupTurnAngle(
+      pose, d->ParameterNode->GetActiveGroup(), int(at - d->JointSliderAxes.begin()), angleDeg);
 }
 
 double qSlicerReposeModuleWidget::jointAngle(const QString& axis) const {
@@ -451,7 +452,8 @@ double qSlicerReposeModuleWidget::jointAngle(const QString& axis) const {
   const auto at = std::find(d->JointSliderAxes.begin(), d->JointSliderAxes.end(), axis);
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!d->Logic || !pose || at == d->JointSliderAxes.end()) return 0;
-  const auto turns = d->Logic->GetPoseGroupTurns(pose, d->ParameterNode->GetActiveGroup());
+  const auto turns =
+      d->Logic->GetPoseEdits()->GetPoseGroupTurns(pose, d->ParameterNode->GetActiveGroup());
   const std::size_t k = std::size_t(at - d->JointSliderAxes.begin());
   return k < turns.size() ? turns[k].angleDeg : 0;
 }
@@ -469,10 +471,10 @@ void qSlicerReposeModuleWidget::updateJointSliders(const std::string& group) {
   // A joint's group (named after the joint) whose every turn is about one of the joint's axes
   // gets a slider per turn; a group of one axis ("elbow_left.flexion", from a pose file) or one
   // turned otherwise keeps the Angle row.
-  const vtkSlicerReposeLogic::JointInfo* joint = d->joint(group);
+  const vtkSlicerReposePoseEditLogic::JointInfo* joint = d->joint(group);
   vtkMRMLReposePoseNode* pose = this->activePose();
-  const auto turns = joint && pose ? d->Logic->GetPoseGroupTurns(pose, group)
-                                   : std::vector<vtkSlicerReposeLogic::GroupTurn>{};
+  const auto turns = joint && pose ? d->Logic->GetPoseEdits()->GetPoseGroupTurns(pose, group)
+                                   : std::vector<vtkSlicerReposePoseEditLogic::GroupTurn>{};
   // Each turn's axis by name: the one it names, or the joint's axis it equals (once resolved).
   std::vector<QString> axes;
   for (const auto& turn : turns) {
@@ -558,8 +560,8 @@ bool qSlicerReposeModuleWidget::savePose(const QString& path) {
   if (!d->Logic || !d->ParameterNode) return false;
   const bool ok =
       this->activePose() &&
-      d->Logic->WritePoseFile(this->activePose(), d->ParameterNode->GetBodyPartMapPath(),
-                              path.toStdString());
+      d->Logic->GetPoseEdits()->WritePoseFile(
+          this->activePose(), d->ParameterNode->GetBodyPartMapPath(), path.toStdString());
   d->JobStatus =
       ok ? "Pose saved to " + path
          : "Error: " + (this->activePose() ? QString::fromStdString(d->Logic->GetLastErrorMessage())
@@ -573,7 +575,8 @@ bool qSlicerReposeModuleWidget::exportPose() {
   if (!d->Logic || !d->ParameterNode) return false;
   const std::string folder = d->ParameterNode->GetOutputFolder();
   const bool started = d->showJobStart(
-      !folder.empty() && this->activePose() && d->Logic->StartApplyPose(this->activePose(), folder),
+      !folder.empty() && this->activePose() &&
+          d->Logic->GetJobs()->StartApplyPose(this->activePose(), folder),
       folder.empty() ? "choose an output folder first" : "",
       qSlicerReposeModuleWidgetPrivate::Step::Export, "Exporting at full resolution...");
   this->updateWidgetFromMRML();
@@ -582,7 +585,7 @@ bool qSlicerReposeModuleWidget::exportPose() {
 
 void qSlicerReposeModuleWidget::cancelJob() {
   Q_D(qSlicerReposeModuleWidget);
-  if (d->Logic && d->Logic->IsJobRunning()) d->Logic->CancelJob();
+  if (d->Logic && d->Logic->GetJobs()->IsJobRunning()) d->Logic->GetJobs()->CancelJob();
 }
 
 void qSlicerReposeModuleWidget::waitForJobs() {
@@ -606,38 +609,39 @@ void qSlicerReposeModuleWidget::onJobTimer() {
     d->JobTimer.stop();
     return;
   }
-  const int status = d->Logic->PollJob();
-  if (status == vtkSlicerReposeLogic::JobRunning) {
-    d->JobProgressBar->setValue(int(std::lround(100 * d->Logic->GetJobProgress())));
-    d->JobStatusLabel->setText(QString::fromStdString(d->Logic->GetJobStage()) + "...");
+  const int status = d->Logic->GetJobs()->PollJob();
+  if (status == vtkSlicerReposeJobsLogic::JobRunning) {
+    d->JobProgressBar->setValue(int(std::lround(100 * d->Logic->GetJobs()->GetJobProgress())));
+    d->JobStatusLabel->setText(QString::fromStdString(d->Logic->GetJobs()->GetJobStage()) + "...");
     return;
   }
   const Step finished = d->RunningStep;
   d->RunningStep = Step::None;
   d->JobTimer.stop();
-  if (status == vtkSlicerReposeLogic::JobSucceeded &&
+  if (status == vtkSlicerReposeJobsLogic::JobSucceeded &&
       (finished == Step::Rig || finished == Step::Refine)) {
     // The rig is there: prepare live posing at once, so the views follow the pose.
-    if (d->Logic->StartLivePose(this->activePose())) {
+    if (d->Logic->GetLive()->StartLivePose(this->activePose())) {
       d->RunningStep = Step::Live;
-      d->JobStatus = finished == Step::Refine
-                         ? "Transfer mesh " +
-                               QString::fromStdString(d->Logic->GetLastRefinementSummary()) +
-                               "; preparing live posing..."
-                         : QString("Preparing live posing...");
+      d->JobStatus =
+          finished == Step::Refine
+              ? "Transfer mesh " +
+                    QString::fromStdString(d->Logic->GetJobs()->GetLastRefinementSummary()) +
+                    "; preparing live posing..."
+              : QString("Preparing live posing...");
       d->JobTimer.start();
     } else {
       d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
     }
-  } else if (status == vtkSlicerReposeLogic::JobSucceeded && finished == Step::OrganRig) {
-    d->JobStatus = "Rigged (" + QString::fromStdString(d->Logic->GetLastRigSummary()) +
+  } else if (status == vtkSlicerReposeJobsLogic::JobSucceeded && finished == Step::OrganRig) {
+    d->JobStatus = "Rigged (" + QString::fromStdString(d->Logic->GetJobs()->GetLastRigSummary()) +
                    "): body parts from " +
                    QString::fromStdString(d->ParameterNode->GetBodyPartMapPath()) +
                    "; build the cage and mesh next.";
-  } else if (status == vtkSlicerReposeLogic::JobSucceeded && finished == Step::Export) {
+  } else if (status == vtkSlicerReposeJobsLogic::JobSucceeded && finished == Step::Export) {
     // The report's quality on screen, and the job's warnings in the message line.
     d->showQuality(d->Logic);
-    const auto rows = d->Logic->GetLastPoseQuality();
+    const auto rows = d->Logic->GetJobs()->GetLastPoseQuality();
     const auto failed =
         std::count_if(rows.begin(), rows.end(), [](const auto& r) { return !r.met; });
     d->JobStatus = "Exported to " + QString::fromStdString(d->ParameterNode->GetOutputFolder()) +
@@ -645,11 +649,11 @@ void qSlicerReposeModuleWidget::onJobTimer() {
                                 : QString("; %1 of %2 quality targets missed (table below)")
                                       .arg(failed)
                                       .arg(rows.size()));
-    for (const std::string& w : d->Logic->GetLastPoseWarnings())
+    for (const std::string& w : d->Logic->GetJobs()->GetLastPoseWarnings())
       d->JobStatus += "\nWarning: " + QString::fromStdString(w);
-  } else if (status == vtkSlicerReposeLogic::JobSucceeded) {
+  } else if (status == vtkSlicerReposeJobsLogic::JobSucceeded) {
     d->JobStatus = "Live: drag a handle in the 3D view or the angle; the views follow.";
-  } else if (status == vtkSlicerReposeLogic::JobCancelled) {
+  } else if (status == vtkSlicerReposeJobsLogic::JobCancelled) {
     d->JobStatus = "Cancelled; nothing was written.";
   } else {
     d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
@@ -662,16 +666,17 @@ bool qSlicerReposeModuleWidget::setActiveGroupAngle(double angleDeg) {
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!pose || !d->Logic) return false;
   const std::string group = d->ParameterNode->GetActiveGroup();
-  const auto t = d->Logic->GetPoseGroupTransform(pose, group);
-  return t &&
-         d->Logic->SetPoseGroupTransform(pose, group, t->axis, angleDeg, t->pivot, t->translation);
+  const auto t = d->Logic->GetPoseEdits()->GetPoseGroupTransform(pose, group);
+  return t && d->Logic->GetPoseEdits()->SetPoseGroupTransform(pose, group, t->axis, angleDeg,
+                                                              t->pivot, t->translation);
 }
 
 double qSlicerReposeModuleWidget::activeGroupAngle() const {
   Q_D(const qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!pose || !d->ParameterNode || !d->Logic) return 0;
-  const auto t = d->Logic->GetPoseGroupTransform(pose, d->ParameterNode->GetActiveGroup());
+  const auto t =
+      d->Logic->GetPoseEdits()->GetPoseGroupTransform(pose, d->ParameterNode->GetActiveGroup());
   return t ? t->angleDeg : 0;
 }
 
@@ -679,7 +684,7 @@ bool qSlicerReposeModuleWidget::newPose() {
   Q_D(qSlicerReposeModuleWidget);
   if (!d->Logic || !d->ParameterNode) return false;
   vtkMRMLReposePoseNode* previous = this->activePose();
-  vtkMRMLReposePoseNode* pose = d->Logic->NewPose("pose");
+  vtkMRMLReposePoseNode* pose = d->Logic->GetPoseEdits()->NewPose("pose");
   if (!pose) return false;
   // The rig of the pose posed so far (segmentation, cage, transfer mesh) serves the new one.
   if (previous)
@@ -692,7 +697,7 @@ bool qSlicerReposeModuleWidget::newPose() {
   d->ParameterNode->SetSelectedBodyPart(0);
   d->ParameterNode->EndModify(state);
   // A rig already built serves the new pose too (its groups need no separation): go live.
-  if (d->Logic->StartLivePose(pose)) {
+  if (d->Logic->GetLive()->StartLivePose(pose)) {
     d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Live;
     d->JobStatus = "Preparing live posing...";
     d->JobTimer.start();
@@ -704,7 +709,7 @@ bool qSlicerReposeModuleWidget::newPose() {
 int qSlicerReposeModuleWidget::selectBodyPart(int label) {
   Q_D(qSlicerReposeModuleWidget);
   if (!d->Logic || !d->ParameterNode) return 0;
-  const std::vector<int> vertices = d->Logic->GetLiveCageVerticesOfPart(label);
+  const std::vector<int> vertices = d->Logic->GetLive()->GetLiveCageVerticesOfPart(label);
   const int state = d->ParameterNode->StartModify();
   d->ParameterNode->SetSelectedCageVertices(vertices);
   d->ParameterNode->SetSelectedBodyPart(vertices.empty() ? 0 : label);
@@ -725,10 +730,10 @@ bool qSlicerReposeModuleWidget::addSeparation(const QString& partA, const QStrin
                                               const QString& region) {
   Q_D(qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
-  const bool ok =
-      d->Logic && pose &&
-      d->Logic->AddPoseSeparation(pose, partA.trimmed().toStdString(),
-                                  partB.trimmed().toStdString(), region.trimmed().toStdString());
+  const bool ok = d->Logic && pose &&
+                  d->Logic->GetPoseEdits()->AddPoseSeparation(pose, partA.trimmed().toStdString(),
+                                                              partB.trimmed().toStdString(),
+                                                              region.trimmed().toStdString());
   d->JobStatus = ok ? QString("Separation added: build the cage and mesh to apply it.")
                     : "Error: " + (pose ? QString::fromStdString(d->Logic->GetLastErrorMessage())
                                         : QString("no pose to add the separation to"));
@@ -738,7 +743,7 @@ bool qSlicerReposeModuleWidget::addSeparation(const QString& partA, const QStrin
 
 bool qSlicerReposeModuleWidget::refineMesh() {
   Q_D(qSlicerReposeModuleWidget);
-  if (!d->Logic || !d->Logic->StartRefineMesh(this->activePose())) {
+  if (!d->Logic || !d->Logic->GetJobs()->StartRefineMesh(this->activePose())) {
     d->JobStatus = "Error: " + (d->Logic ? QString::fromStdString(d->Logic->GetLastErrorMessage())
                                          : QString("no logic"));
     this->updateWidgetFromMRML();
@@ -755,7 +760,7 @@ QString qSlicerReposeModuleWidget::newGroupFromSelection() {
   Q_D(qSlicerReposeModuleWidget);
   vtkMRMLReposePoseNode* pose = this->activePose();
   if (!d->Logic || !d->ParameterNode || !pose) return {};
-  const std::string group = d->Logic->AddPoseGroup(
+  const std::string group = d->Logic->GetPoseEdits()->AddPoseGroup(
       pose, d->ParameterNode->GetSelectedCageVertices(), d->ParameterNode->GetSelectedBodyPart());
   if (group.empty()) {
     d->JobStatus = "Error: " + QString::fromStdString(d->Logic->GetLastErrorMessage());
@@ -772,12 +777,12 @@ QString qSlicerReposeModuleWidget::newGroupFromSelection() {
 
 void qSlicerReposeModuleWidget::onAngleSliderPressed() {
   Q_D(qSlicerReposeModuleWidget);
-  if (d->Logic) d->Logic->BeginPoseInteraction();
+  if (d->Logic) d->Logic->GetPoseEdits()->BeginPoseInteraction();
 }
 
 void qSlicerReposeModuleWidget::onAngleSliderReleased() {
   Q_D(qSlicerReposeModuleWidget);
-  if (d->Logic) d->Logic->EndPoseInteraction();
+  if (d->Logic) d->Logic->GetPoseEdits()->EndPoseInteraction();
 }
 
 void qSlicerReposeModuleWidget::onAngleChanged(int angle) {
@@ -838,8 +843,9 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
 
   // Pose: the groups that can turn, the active one's angle, keyframes, undo/redo.
   vtkMRMLReposePoseNode* pose = this->activePose();
-  // Parsed once per change of the pose node (the Logic keeps the summary).
-  const vtkSlicerReposeLogic::PoseSummary summary = d->Logic->GetPoseSummary(pose);
+  const vtkSlicerReposePoseEditLogic::PoseSummary summary =
+      d->Logic ? d->Logic->GetPoseEdits()->GetPoseSummary(pose)
+               : vtkSlicerReposePoseEditLogic::PoseSummary();
   QStringList groups;
   for (const std::string& g : summary.movableGroups) groups << QString::fromStdString(g);
   const int keyframes = summary.keyframes;
@@ -854,7 +860,7 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   const std::string partsPath = node ? node->GetBodyPartMapPath() : "";
   if (partsPath != d->JointsFor) {
     d->JointsFor = partsPath;
-    d->Joints = vtkSlicerReposeLogic::GetJointsBeside(partsPath);
+    d->Joints = vtkSlicerReposePoseEditLogic::GetJointsBeside(partsPath);
     const QString was = d->JointComboBox->currentText();
     d->JointComboBox->clear();  // its signal fills the axes of the first joint
     for (const auto& j : d->Joints) d->JointComboBox->addItem(QString::fromStdString(j.name));
@@ -880,9 +886,9 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   d->KeyframeSpinBox->setMaximum(std::max(0, keyframes - 1));
   d->KeyframeSpinBox->setValue(pose ? pose->GetCurrentFrame() : 0);
   d->KeyframeSpinBox->setEnabled(keyframes > 1);
-  d->UndoButton->setEnabled(d->Logic && d->Logic->CanUndo());
-  d->RedoButton->setEnabled(d->Logic && d->Logic->CanRedo());
-  const bool live = d->Logic && pose && d->Logic->GetLivePose() == pose;
+  d->UndoButton->setEnabled(d->Logic && d->Logic->GetPoseEdits()->CanUndo());
+  d->RedoButton->setEnabled(d->Logic && d->Logic->GetPoseEdits()->CanRedo());
+  const bool live = d->Logic && pose && d->Logic->GetLive()->GetLivePose() == pose;
   // Selection and body parts (of the live rig's S).
   const std::size_t selected = node ? node->GetSelectedCageVertices().size() : 0;
   d->SelectionInfoLabel->setText(
@@ -891,7 +897,7 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
           ? QString("%1 cage vertices of part %2").arg(selected).arg(node->GetSelectedBodyPart())
           : QString("%1 cage vertices").arg(selected));
   std::vector<std::pair<int, std::string>> parts;
-  if (live) parts = d->Logic->GetLiveBodyParts();
+  if (live) parts = d->Logic->GetLive()->GetLiveBodyParts();
   if (d->PartComboBox->count() != int(parts.size()) ||
       (!parts.empty() && d->PartComboBox->itemData(0).toInt() != parts.front().first)) {
     const QSignalBlocker blocker(d->PartComboBox);
@@ -941,11 +947,13 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   if (live) {
     // What the export will show, predicted from the live frame's transfer mesh: after a drag,
     // not during it (it costs about as much as the frame and the three slices together).
-    const bool dragging = d->AngleSlider->isSliderDown() || d->Logic->IsPoseInteractionActive();
-    const vtkSlicerReposeLogic::LivePrediction p =
-        dragging ? vtkSlicerReposeLogic::LivePrediction{} : d->Logic->GetLivePrediction();
-    liveText =
-        QString("Live: frame solved in %1 ms").arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1);
+    const bool dragging =
+        d->AngleSlider->isSliderDown() || d->Logic->GetPoseEdits()->IsPoseInteractionActive();
+    const vtkSlicerReposeLiveLogic::LivePrediction p =
+        dragging ? vtkSlicerReposeLiveLogic::LivePrediction{}
+                 : d->Logic->GetLive()->GetLivePrediction();
+    liveText = QString("Live: frame solved in %1 ms")
+                   .arg(d->Logic->GetLive()->GetLiveFrameMilliseconds(), 0, 'f', 1);
     if (p.valid) {
       liveText += QString("; body volume %1%2 % (predicted)")
                       .arg(p.bodyChangePercent >= 0 ? "+" : "")
@@ -953,21 +961,21 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
       // A part stretched by another it is tied to (tissue dragged along a contact), or folded:
       // the export will be written, but it will miss its targets, said before it is made.
       if (!p.met)
-        liveText += QString("; the export will MISS its targets: %1%2")
-                        .arg(QString::fromStdString(p.missed))
-                        .arg(p.draggedBy.empty()
-                                 ? QString()
-                                 : ", dragged by " + QString::fromStdString(p.draggedBy));
+        liveText +=
+            QString("; the export will MISS its targets: %1%2")
+                .arg(QString::fromStdString(p.missed))
+                .arg(p.draggedBy.empty() ? QString()
+                                         : ", dragged by " + QString::fromStdString(p.draggedBy));
     }
   }
   d->LiveStatusLabel->setText(liveText);
 
   // Jobs: progress, status, what can be pressed. A job someone else started (the module opening
   // a scene) is polled here too, so it commits and the views follow.
-  const bool running = d->Logic && d->Logic->IsJobRunning();
+  const bool running = d->Logic && d->Logic->GetJobs()->IsJobRunning();
   if (running && d->RunningStep == qSlicerReposeModuleWidgetPrivate::Step::None) {
     d->RunningStep = qSlicerReposeModuleWidgetPrivate::Step::Live;
-    d->JobStatus = QString::fromStdString(d->Logic->GetJobStage()) + "...";
+    d->JobStatus = QString::fromStdString(d->Logic->GetJobs()->GetJobStage()) + "...";
     d->JobTimer.start();
   }
   d->BuildRigButton->setEnabled(ready && !running);

@@ -182,8 +182,8 @@ qSlicerReposeViewsWidget::qSlicerReposeViewsWidget(QWidget* parent)
     d->Slices[o] = new qSlicerReposeSliceView(o, this);
     // The wheel steps the slice by one of its pixels, within the live body's box.
     connect(d->Slices[o], &qSlicerReposeSliceView::scrolled, this, [this, d, o](int steps) {
-      if (!d->Logic || !d->Logic->GetLivePose() || std::isnan(d->Positions[o])) return;
-      const std::array<double, 6> box = d->Logic->GetLiveBounds();
+      if (!d->Logic || !d->Logic->GetLive()->GetLivePose() || std::isnan(d->Positions[o])) return;
+      const std::array<double, 6> box = d->Logic->GetLive()->GetLiveBounds();
       const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;
       const double lo = box[std::size_t(2 * axis)], hi = box[std::size_t(2 * axis + 1)];
       const double larger = std::max({box[1] - box[0], box[3] - box[2], box[5] - box[4]});
@@ -280,7 +280,7 @@ double qSlicerReposeViewsWidget::lastSliceMilliseconds() const {
 
 void qSlicerReposeViewsWidget::refresh() {
   Q_D(qSlicerReposeViewsWidget);
-  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLivePose() : nullptr;
+  vtkMRMLReposePoseNode* pose = d->Logic ? d->Logic->GetLive()->GetLivePose() : nullptr;
   d->BodyActor->SetVisibility(pose != nullptr);
   d->CageActor->SetVisibility(pose != nullptr);
   d->CageVertexActor->SetVisibility(pose != nullptr);
@@ -298,9 +298,9 @@ void qSlicerReposeViewsWidget::refresh() {
     d->RenderWindow->Render();
     return;
   }
-  d->BodyMapper->SetInputData(d->Logic->GetLiveBodySurface());
-  d->CageMapper->SetInputData(d->Logic->GetLiveCage());
-  d->CageVertexMapper->SetInputData(d->Logic->GetLiveCage());
+  d->BodyMapper->SetInputData(d->Logic->GetLive()->GetLiveBodySurface());
+  d->CageMapper->SetInputData(d->Logic->GetLive()->GetLiveCage());
+  d->CageVertexMapper->SetInputData(d->Logic->GetLive()->GetLiveCage());
   // Label colours of G, once per live pose.
   if (d->LookupFor != pose) {
     d->LookupFor = pose;
@@ -315,35 +315,33 @@ void qSlicerReposeViewsWidget::refresh() {
     d->PartColorsFor = pose;
     d->PartColors.clear();
     int i = 0;
-    for (const auto& [label, name] : d->Logic->GetLiveBodyParts())
+    for (const auto& [label, name] : d->Logic->GetLive()->GetLiveBodyParts())
       d->PartColors.insert(label, QColor::fromHsvF(std::fmod(0.13 + 0.618034 * i++, 1.0), 0.85, 1));
   }
-  const std::array<double, 3> centre = d->Logic->GetLiveRestCenter();
-  std::array<double, 3> sliceMs{};
+  const std::array<double, 3> centre = d->Logic->GetLive()->GetLiveRestCenter();
   for (int o = 0; o < 3; ++o) {
     const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;  // axial: S, coronal: A, sagittal: R
     if (std::isnan(d->Positions[o])) d->Positions[o] = centre[std::size_t(axis)];
-    vtkSmartPointer<vtkImageData> slice = d->Logic->ComputeLiveSlice(o, d->Positions[o], d->Pixels);
-    const double ms = d->Logic->GetLiveSliceMilliseconds();
-    d->SliceMilliseconds += ms;
-    sliceMs[std::size_t(o)] = ms;
-    vtkSmartPointer<vtkImageData> image =
-        d->Logic->ComputeLiveImageSlice(o, d->Positions[o], d->Pixels);
-    const auto window = d->Logic->GetLiveImageWindow();
+  }
+  // Every slice the three views show, in one call: labels, the image, S's outlines when asked.
+  const vtkSlicerReposeLiveLogic::LiveSlices slices = d->Logic->GetLive()->ComputeLiveSlices(
+      {d->Positions[0], d->Positions[1], d->Positions[2]}, d->Pixels, showParts);
+  const auto window = d->Logic->GetLive()->GetLiveImageWindow();
+  const std::array<double, 3>& sliceMs = slices.labelMilliseconds;
+  for (int o = 0; o < 3; ++o) {
+    d->SliceMilliseconds += sliceMs[std::size_t(o)];
     d->Slices[o]->setWindowLevel(window ? window->window : 0, window ? window->level : 0);
     d->Slices[o]->setPositionMm(d->Positions[o]);
     if (vtkMRMLReposeParametersNode* p = d->Logic->GetParameterNode())
       d->Slices[o]->setLabelOpacity(p->GetLabelOpacity());
-    d->Slices[o]->setPartsOverlay(
-        showParts ? d->Logic->ComputeLivePartsSlice(o, d->Positions[o], d->Pixels) : nullptr,
-        d->PartColors);
-    d->Slices[o]->setSlice(slice, d->Lookup, image);
+    d->Slices[o]->setPartsOverlay(slices.parts[std::size_t(o)], d->PartColors);
+    d->Slices[o]->setSlice(slices.labels[std::size_t(o)], d->Lookup, slices.images[std::size_t(o)]);
   }
   // What a drag costs, by the stages ReposeLiveBench reports (docs/PERFORMANCE.md): the frame's
   // solve (posed cage, Green coordinates, rigidity) and each slice's labels; short enough for
   // the 3D view of a 1280 x 800 window.
   d->Timing->SetInput(QString("frame %1 ms + slices %2 ms (ax %3, cor %4, sag %5)")
-                          .arg(d->Logic->GetLiveFrameMilliseconds(), 0, 'f', 1)
+                          .arg(d->Logic->GetLive()->GetLiveFrameMilliseconds(), 0, 'f', 1)
                           .arg(d->SliceMilliseconds, 0, 'f', 1)
                           .arg(sliceMs[0], 0, 'f', 1)
                           .arg(sliceMs[1], 0, 'f', 1)
@@ -372,8 +370,9 @@ void qSlicerReposeViewsWidget::refresh() {
 
 void qSlicerReposeViewsWidget::updateJoints(bool show) {
   Q_D(qSlicerReposeViewsWidget);
-  const std::vector<vtkSlicerReposeLogic::LiveJoint> joints =
-      show && d->Logic ? d->Logic->GetLiveJoints() : std::vector<vtkSlicerReposeLogic::LiveJoint>{};
+  const std::vector<vtkSlicerReposeLiveLogic::LiveJoint> joints =
+      show && d->Logic ? d->Logic->GetLive()->GetLiveJoints()
+                       : std::vector<vtkSlicerReposeLiveLogic::LiveJoint>{};
   const bool visible = !joints.empty();
   d->JointActor->SetVisibility(visible);
   d->JointAxisActor->SetVisibility(visible);
@@ -390,7 +389,8 @@ void qSlicerReposeViewsWidget::updateJoints(bool show) {
   axisColors->SetNumberOfComponents(3);
   axisColors->SetName("axis");
   // Sized to the body: a sphere about 1.5 % of its largest side, an axis four times as long.
-  const std::array<double, 6> box = d->Logic ? d->Logic->GetLiveBounds() : std::array<double, 6>{};
+  const std::array<double, 6> box =
+      d->Logic ? d->Logic->GetLive()->GetLiveBounds() : std::array<double, 6>{};
   const double larger = std::max({box[1] - box[0], box[3] - box[2], box[5] - box[4]});
   const double radius = std::max(2.0, 0.015 * larger), length = 4 * radius;
   d->JointSphere->SetRadius(radius);
@@ -489,7 +489,7 @@ QString rasText(double r, double a, double s) {
 
 QString qSlicerReposeViewsWidget::probe(int orientation, double r, double a, double s) {
   Q_D(qSlicerReposeViewsWidget);
-  if (orientation < 0 || orientation > 2 || !d->Logic || !d->Logic->GetLivePose()) {
+  if (orientation < 0 || orientation > 2 || !d->Logic || !d->Logic->GetLive()->GetLivePose()) {
     d->ProbeView = -1;
     d->Probe->clear();
     return {};
@@ -500,19 +500,20 @@ QString qSlicerReposeViewsWidget::probe(int orientation, double r, double a, dou
     if (value < 0) return QString("outside");
     if (value == 0) return QString("0 (background)");
     return QString("%1 %2").arg(value).arg(
-        QString::fromStdString(d->Logic->GetLiveLabelName(value)));
+        QString::fromStdString(d->Logic->GetLive()->GetLiveLabelName(value)));
   };
   const qSlicerReposeSliceView* view = d->Slices[orientation];
-  QString text =
-      QString("%1 (%2)  %3   posed: %4   input: %5")
-          .arg(view->viewName(), view->orientationName().toLower(), rasText(r, a, s),
-               label(view->labelAtRas(r, a, s)), label(d->Logic->GetLiveRestLabelAt(r, a, s)));
+  QString text = QString("%1 (%2)  %3   posed: %4   input: %5")
+                     .arg(view->viewName(), view->orientationName().toLower(), rasText(r, a, s),
+                          label(view->labelAtRas(r, a, s)),
+                          label(d->Logic->GetLive()->GetLiveRestLabelAt(r, a, s)));
   // With the body-part outlines shown, the part drawn there too.
   if (const int part = view->partAtRas(r, a, s); part >= 0)
-    text += part == 0 ? QString("   part: none")
-                      : QString("   part: %1 %2")
-                            .arg(part)
-                            .arg(QString::fromStdString(d->Logic->GetLivePartName(part)));
+    text += part == 0
+                ? QString("   part: none")
+                : QString("   part: %1 %2")
+                      .arg(part)
+                      .arg(QString::fromStdString(d->Logic->GetLive()->GetLivePartName(part)));
   d->Probe->setText(text);
   return text;
 }

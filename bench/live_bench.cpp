@@ -95,45 +95,46 @@ int main(int argc, char** argv) {
     pose->SetPoseJSON(std::string(std::istreambuf_iterator<char>(in), {}));
   }
   const auto prepareStart = Clock::now();
-  if (!logic->StartLivePose(pose) || logic->WaitForJob() != vtkSlicerReposeLogic::JobSucceeded)
+  if (!logic->GetLive()->StartLivePose(pose) ||
+      logic->GetJobs()->WaitForJob() != vtkSlicerReposeJobsLogic::JobSucceeded)
     fail("live pose: " + logic->GetLastErrorMessage());
   const double prepareMs = ms(prepareStart, Clock::now());
 
   // The group to drag: the one named, else the first the pose moves.
   if (group.empty()) {
     for (const std::string candidate : {"left forearm and hand", "left arm", "left leg"})
-      if (logic->GetPoseGroupTransform(pose, candidate)) {
+      if (logic->GetPoseEdits()->GetPoseGroupTransform(pose, candidate)) {
         group = candidate;
         break;
       }
   }
-  const auto rest = logic->GetPoseGroupTransform(pose, group);
+  const auto rest = logic->GetPoseEdits()->GetPoseGroupTransform(pose, group);
   if (group.empty() || !rest)
     fail("no movable group \"" + group + "\" in the scene's pose (--group NAME)");
   const std::array<double, 3> axis = rest->axis, pivot = rest->pivot,
                               translation = rest->translation;
 
-  const std::array<double, 6> box = logic->GetLiveBounds();
+  const std::array<double, 6> box = logic->GetLive()->GetLiveBounds();
   const std::array<double, 3> centre{(box[0] + box[1]) / 2, (box[2] + box[3]) / 2,
                                      (box[4] + box[5]) / 2};
   std::map<std::string, std::vector<double>> stages;
-  logic->BeginPoseInteraction();
+  logic->GetPoseEdits()->BeginPoseInteraction();
   for (int e = 0; e < events; ++e) {
     // A steady drag from rest to `degrees` about the group's own axis and pivot.
     const double angle = degrees * double(e + 1) / double(events);
     const auto t0 = Clock::now();
-    if (!logic->SetPoseGroupTransform(pose, group, axis, angle, pivot, translation))
+    if (!logic->GetPoseEdits()->SetPoseGroupTransform(pose, group, axis, angle, pivot, translation))
       fail("drag: " + logic->GetLastErrorMessage());
     const auto t1 = Clock::now();
-    const double frame = logic->GetLiveFrameMilliseconds();
+    const double frame = logic->GetLive()->GetLiveFrameMilliseconds();
     double slices = 0;
     for (int o = 0; o < 3; ++o) {
       const auto s0 = Clock::now();
-      vtkSmartPointer<vtkImageData> slice = logic->ComputeLiveSlice(o,
-                                                                    centre[o == 0   ? 2
-                                                                           : o == 1 ? 1
-                                                                                    : 0],
-                                                                    pixels);
+      vtkSmartPointer<vtkImageData> slice = logic->GetLive()->ComputeLiveSlice(o,
+                                                                               centre[o == 0   ? 2
+                                                                                      : o == 1 ? 1
+                                                                                               : 0],
+                                                                               pixels);
       if (!slice) fail("slice: " + logic->GetLastErrorMessage());
       const double t = ms(s0, Clock::now());
       slices += t;
@@ -149,10 +150,11 @@ int main(int argc, char** argv) {
     // computes when a drag ends (vtkSlicerReposeLogic::IsPoseInteractionActive); timed here on
     // every frame for its cost.
     const auto p0 = Clock::now();
-    if (!logic->GetLivePrediction().valid) fail("prediction: " + logic->GetLastErrorMessage());
+    if (!logic->GetLive()->GetLivePrediction().valid)
+      fail("prediction: " + logic->GetLastErrorMessage());
     stages["prediction"].push_back(ms(p0, Clock::now()));
   }
-  logic->EndPoseInteraction();
+  logic->GetPoseEdits()->EndPoseInteraction();
 
   nlohmann::json out = {
       {"scene", sceneDir},
@@ -162,7 +164,7 @@ int main(int argc, char** argv) {
       {"pixels", pixels},
       {"prepare_ms", prepareMs},
       {"tm_vertices", meshNode->GetMesh()->GetNumberOfPoints()},
-      {"cage_vertices", logic->GetLiveRestCage().size()},
+      {"cage_vertices", logic->GetLive()->GetLiveRestCage().size()},
   };
   for (const auto& [name, values] : stages) out["stages"][name] = statistics(values);
   std::cout << out.dump(2) << "\n";

@@ -168,9 +168,10 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(panel->setPosePath(QString(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json"));
     QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("left forearm and hand"));
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
-    QVERIFY(logic->IsJobRunning());  // on the worker: the window is free meanwhile
+    QVERIFY(logic->GetJobs()->IsJobRunning());  // on the worker: the window is free meanwhile
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
     QCOMPARE(panel->activeGroupAngle(), 90.0);
     // The 3D view opens from the front, as Slicer's: towards the face (along -A), S up, so a
     // pair of left and right joints stands apart across the view.
@@ -223,7 +224,8 @@ class qSlicerReposeViewsTest : public QObject {
     qInfo(
         "forearm pixels in the coronal view: %d turned, %d straight; live frame %.1f ms, "
         "three slices %.1f ms",
-        bent, straight, logic->GetLiveFrameMilliseconds(), views->lastSliceMilliseconds());
+        bent, straight, logic->GetLive()->GetLiveFrameMilliseconds(),
+        views->lastSliceMilliseconds());
     QVERIFY2(straight > 3 * bent + 10, qPrintable(QString("%1 vs %2").arg(straight).arg(bent)));
     const QImage after = views->renderViews();
     QVERIFY(after.save(artifact("views_elbow0.png")));
@@ -243,7 +245,7 @@ class qSlicerReposeViewsTest : public QObject {
     undo->click();
     QCOMPARE(panel->activeGroupAngle(), 90.0);
     QCOMPARE(forearmPixels(coronal), bent);
-    QVERIFY(!logic->CanUndo());
+    QVERIFY(!logic->GetPoseEdits()->CanUndo());
 
     // Export: cancelled, nothing is written; finished, the posed files are there.
     const QString out = dir.filePath("out");
@@ -254,7 +256,8 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY2(panel->jobStatusText().startsWith("Cancelled"), qPrintable(panel->jobStatusText()));
     QVERIFY(!QFileInfo::exists(out + "/posed_G.nii.gz"));
     // Before it, the live frame's prediction of the body's volume is on the panel.
-    const vtkSlicerReposeLogic::LivePrediction predicted = logic->GetLivePrediction();
+    const vtkSlicerReposeLiveLogic::LivePrediction predicted =
+        logic->GetLive()->GetLivePrediction();
     QVERIFY(predicted.valid);
     auto* liveStatus = panel->findChild<QLabel*>("LiveStatusLabel");
     QVERIFY2(liveStatus->text().contains("(predicted)"), qPrintable(liveStatus->text()));
@@ -335,7 +338,7 @@ class qSlicerReposeViewsTest : public QObject {
     auto* rigButton = panel->findChild<QPushButton*>("RigFromOrganMapButton");
     QVERIFY(rigButton && rigButton->isEnabled());
     rigButton->click();
-    QVERIFY(logic->IsJobRunning());
+    QVERIFY(logic->GetJobs()->IsJobRunning());
     panel->waitForJobs();
     QVERIFY2(panel->jobStatusText().startsWith("Rigged (icrp110"),
              qPrintable(panel->jobStatusText()));
@@ -345,9 +348,10 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(session.window.grab().save(artifact("guide_own_2_rigged.png")));
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose(), qPrintable(panel->jobStatusText()));
     bool handNamed = false;
-    for (const auto& [label, name] : logic->GetLiveBodyParts()) handNamed |= name == "hand_left";
+    for (const auto& [label, name] : logic->GetLive()->GetLiveBodyParts())
+      handNamed |= name == "hand_left";
     QVERIFY(handNamed);
 
     // An interior voxel of the chest (its 27 neighbours share its label), and the coronal view
@@ -393,7 +397,7 @@ class qSlicerReposeViewsTest : public QObject {
     const QPointF point = coronal->widgetPointOfRas(at.x(), at.y(), at.z());
     QMouseEvent move(QEvent::MouseMove, point, Qt::NoButton, Qt::NoButton, Qt::NoModifier);
     QApplication::sendEvent(coronal, &move);
-    const QString name = QString::fromStdString(logic->GetLiveLabelName(value));
+    const QString name = QString::fromStdString(logic->GetLive()->GetLiveLabelName(value));
     QVERIFY2(name != QString::number(value), qPrintable(name));  // named, not numbered
     const QString text = views->probeText();
     qInfo("probe: %s", qPrintable(text));
@@ -417,7 +421,8 @@ class qSlicerReposeViewsTest : public QObject {
     // cut between the arm and the trunk it rests on).
     QVERIFY2(panel->poseByJoint("shoulder_left"), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
     auto* slider = panel->findChild<QSlider*>("JointSlider_abduction");
     QVERIFY(slider && slider->isVisible());
     slider->setSliderDown(true);
@@ -443,10 +448,11 @@ class qSlicerReposeViewsTest : public QObject {
     QCOMPARE(quality->item(0, 0)->text(), QString("Body volume"));
     QVERIFY2(quality->item(0, 3)->text() == "pass", qPrintable(quality->item(0, 1)->text()));
     const double exportedBody = quality->item(0, 1)->text().split(' ').front().toDouble();
-    QVERIFY2(std::fabs(logic->GetLivePrediction().bodyChangePercent - exportedBody) < 0.5,
-             qPrintable(QString("%1 predicted, %2 exported")
-                            .arg(logic->GetLivePrediction().bodyChangePercent)
-                            .arg(exportedBody)));
+    QVERIFY2(
+        std::fabs(logic->GetLive()->GetLivePrediction().bodyChangePercent - exportedBody) < 0.5,
+        qPrintable(QString("%1 predicted, %2 exported")
+                       .arg(logic->GetLive()->GetLivePrediction().bodyChangePercent)
+                       .arg(exportedBody)));
     QVERIFY(session.window.grab().save(artifact("guide_own_5_exported.png")));
     // The phantom's own S, its part names dropped from the file: named as the rig names them.
     vtkMRMLReposeSegmentationNode* unnamedParts =
@@ -473,7 +479,8 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(session.openWithParts());
     QVERIFY2(panel->poseByJoint("elbow_left"), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
     const repose::Skeleton skeleton =
         repose::readSkeleton(session.dir.filePath("skeleton.json").toStdString());
     QStringList names;
@@ -517,7 +524,7 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY((shownAt("wrist_right") - skeleton.find("wrist_right")->centre).norm() < 2.0);
     // The wrist's own axes turned with the forearm: its flexion axis stays the elbow's (the
     // rotation's axis), its rotation axis along the forearm points where the forearm does now.
-    for (const auto& joint : logic->GetLiveJoints())
+    for (const auto& joint : logic->GetLive()->GetLiveJoints())
       if (joint.name == "wrist_left")
         for (const auto& [name, a] : joint.axes)
           if (name == "rotation") {
@@ -537,7 +544,7 @@ class qSlicerReposeViewsTest : public QObject {
     const Eigen::Vector3d middle = (shownAt("elbow_left") + shownAt("wrist_left")) / 2;
     views->setSlicePosition(2, middle.x());
     int forearmPart = 0;
-    for (const auto& [label, name] : logic->GetLiveBodyParts())
+    for (const auto& [label, name] : logic->GetLive()->GetLiveBodyParts())
       if (name == "forearm_left") forearmPart = label;
     QVERIFY(forearmPart > 0);
     QCOMPARE(sagittal->partAtRas(middle.x(), middle.y(), middle.z()), forearmPart);
@@ -595,7 +602,8 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(panel->setJointAngle("abduction", 90));
     QVERIFY2(panel->poseByJoint("elbow_left"), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
     QCOMPARE(QString::fromStdString(session.node->GetActiveGroup()), QString("elbow_left"));
     QVERIFY2(panel->jointAxesShown().contains("flexion"),
              qPrintable(panel->jointAxesShown().join(",")));
@@ -634,7 +642,7 @@ class qSlicerReposeViewsTest : public QObject {
     qInfo("elbow %.2f mm, wrist %.2f mm from the chain's; body %+.2f %% predicted",
           (shownAt("elbow_left") - arm * elbow.centre).norm(),
           (shownAt("wrist_left") - forearm * wrist.centre).norm(),
-          logic->GetLivePrediction().bodyChangePercent);
+          logic->GetLive()->GetLivePrediction().bodyChangePercent);
     QVERIFY((shownAt("elbow_left") - arm * elbow.centre).norm() < 0.05 * forearmMm);
     QVERIFY((shownAt("wrist_left") - forearm * wrist.centre).norm() < 0.05 * forearmMm);
     QVERIFY((shownAt("shoulder_left") - shoulder.centre).norm() < 2.0);
@@ -653,7 +661,8 @@ class qSlicerReposeViewsTest : public QObject {
     QVERIFY(panel->setPosePath(saved));
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
     // Built again on the same files: the same segmentation node, G not read into another one.
     int inputs = 0;
     for (vtkMRMLReposeNode* n : logic->GetScene()->GetNodesByClass("vtkMRMLReposeSegmentationNode"))
@@ -681,8 +690,9 @@ class qSlicerReposeViewsTest : public QObject {
     joint->setCurrentText("shoulder_left");
     panel->findChild<QPushButton*>("PoseJointButton")->click();
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() && logic->GetLivePose() == panel->activePose(),
-             qPrintable(panel->jobStatusText()));
+    QVERIFY2(
+        logic->GetLive()->GetLivePose() && logic->GetLive()->GetLivePose() == panel->activePose(),
+        qPrintable(panel->jobStatusText()));
     QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("shoulder_left"));
     // A slider per axis of the joint, each in its anatomical range; the Angle row gives way.
     QVERIFY2(panel->jointAxesShown().contains("flexion") &&
@@ -700,9 +710,9 @@ class qSlicerReposeViewsTest : public QObject {
     QCOMPARE(panel->jointAngle("abduction"), 90.0);
     QCOMPARE(panel->jointAngle("flexion"), 0.0);
     // The drag is one undo step.
-    QVERIFY(logic->Undo());
+    QVERIFY(logic->GetPoseEdits()->Undo());
     QCOMPARE(panel->jointAngle("abduction"), 0.0);
-    QVERIFY(logic->Redo());
+    QVERIFY(logic->GetPoseEdits()->Redo());
     QCOMPARE(panel->jointAngle("abduction"), 90.0);
     QVERIFY(session.window.grab().save(artifact("guide_joint_slider.png")));
 
@@ -765,17 +775,18 @@ class qSlicerReposeViewsTest : public QObject {
     node->SetImagePath(CT.toStdString());
     QVERIFY2(panel->buildRig(), qPrintable(panel->jobStatusText()));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() && logic->GetLivePose() == panel->activePose(),
-             qPrintable(panel->jobStatusText()));
+    QVERIFY2(
+        logic->GetLive()->GetLivePose() && logic->GetLive()->GetLivePose() == panel->activePose(),
+        qPrintable(panel->jobStatusText()));
     qSlicerReposeCageInteraction* cage = views->cageInteraction();
     QVERIFY(!cage->transformWidget()->GetEnabled());  // no movable group yet
     QVERIFY(window.grab().save(artifact("guide_1_rig_built.png")));
 
     int hand = 0;
-    for (const auto& [label, name] : logic->GetLiveBodyParts())
+    for (const auto& [label, name] : logic->GetLive()->GetLiveBodyParts())
       if (name == "hand_left") hand = label;
     QVERIFY(hand > 0);
-    const std::vector<int> handVertices = logic->GetLiveCageVerticesOfPart(hand);
+    const std::vector<int> handVertices = logic->GetLive()->GetLiveCageVerticesOfPart(hand);
     QVERIFY(handVertices.size() >= 3);
 
     // Shift+click on a hand vertex as drawn: one vertex selected, drawn within a few pixels.
@@ -818,13 +829,14 @@ class qSlicerReposeViewsTest : public QObject {
     panel->findChild<QPushButton*>("NewGroupButton")->click();
     QCOMPARE(QString::fromStdString(node->GetActiveGroup()), QString("group 1"));
     panel->waitForJobs();
-    QVERIFY2(logic->GetLivePose() == panel->activePose(), qPrintable(panel->jobStatusText()));
+    QVERIFY2(logic->GetLive()->GetLivePose() == panel->activePose(),
+             qPrintable(panel->jobStatusText()));
     QVERIFY(node->GetSelectedCageVertices().empty());
     vtkBoxWidget2* box = cage->transformWidget();
     QVERIFY(box->GetEnabled());
 
     // Where the hand will go: 60 mm further out to the patient's left (-R), in air at rest.
-    const auto rest = logic->GetLiveRestCage();
+    const auto rest = logic->GetLive()->GetLiveRestCage();
     double lo[3] = {1e9, 1e9, 1e9}, hi[3] = {-1e9, -1e9, -1e9};
     for (int v : handVertices)
       for (int k = 0; k < 3; ++k) {
@@ -856,10 +868,10 @@ class qSlicerReposeViewsTest : public QObject {
     box->InvokeEvent(vtkCommand::EndInteractionEvent);
     const int moved = outside();
     qInfo("hand labels beside the hand in the coronal view: %d at rest, %d moved; frame %.1f ms",
-          before, moved, logic->GetLiveFrameMilliseconds());
+          before, moved, logic->GetLive()->GetLiveFrameMilliseconds());
     QVERIFY2(moved > before + 10, qPrintable(QString("%1 vs %2").arg(moved).arg(before)));
     vtkNew<vtkMatrix4x4> m;
-    QVERIFY(logic->GetPoseGroupMatrix(panel->activePose(), "group 1", m));
+    QVERIFY(logic->GetPoseEdits()->GetPoseGroupMatrix(panel->activePose(), "group 1", m));
     QVERIFY(std::abs(m->GetElement(0, 3) + 60) < 1e-6);
     QVERIFY(views->renderViews().save(artifact("views_hand_moved.png")));
     QVERIFY(window.grab().save(artifact("guide_3_hand_moved.png")));

@@ -1,5 +1,5 @@
 """repose.average_sar (IEC/IEEE 62704-1 cube rules; Core's dosimetry/SarAveraging.h, checked
-cell by cell against a plain reference in Testing/Cxx/Core/SarAveragingTest.cpp): the binding
+cell by cell against a plain reference in Testing/Cxx/Core/dosimetry/SarAveragingTest.cpp): the binding
 keeps the axes of [x, y, z] arrays, all beyond the grid is air, and a callback can cancel."""
 import numpy as np
 import pytest

@@ -185,8 +185,8 @@ int main(int argc, char** argv) {
     auto* pose =
         rigging->AddPose(std::string(REPOSE_SOURCE_DIR) + "/bench/poses/elbow90.pose.json");
     if (!seg || !pose) fail(rigging->GetLastErrorMessage());
-    if (!rigging->StartBuildRig(seg, pose) ||
-        rigging->WaitForJob() != vtkSlicerReposeLogic::JobSucceeded)
+    if (!rigging->GetJobs()->StartBuildRig(seg, pose) ||
+        rigging->GetJobs()->WaitForJob() != vtkSlicerReposeJobsLogic::JobSucceeded)
       fail("rig: " + rigging->GetLastErrorMessage());
     if (!rigging->SaveScene(sceneDir.string())) fail(rigging->GetLastErrorMessage());
   }
@@ -200,33 +200,33 @@ int main(int argc, char** argv) {
   int refused = 0;
   for (int cycle = 0; cycle < cycles; ++cycle) {
     if (!logic->OpenScene(sceneDir.string())) fail("open: " + logic->GetLastErrorMessage());
-    if (logic->WaitForJob() != vtkSlicerReposeLogic::JobSucceeded)
+    if (logic->GetJobs()->WaitForJob() != vtkSlicerReposeJobsLogic::JobSucceeded)
       fail("live pose: " + logic->GetLastErrorMessage());
-    vtkMRMLReposePoseNode* pose = logic->GetLivePose();
+    vtkMRMLReposePoseNode* pose = logic->GetLive()->GetLivePose();
     if (!pose) fail("the opened scene's pose did not go live");
     const std::string group = parameters->GetActiveGroup();
-    const auto rest = logic->GetPoseGroupTransform(pose, group);
+    const auto rest = logic->GetPoseEdits()->GetPoseGroupTransform(pose, group);
     if (!rest) fail("no movable group " + group);
-    const std::array<double, 6> box = logic->GetLiveBounds();
-    logic->BeginPoseInteraction();
+    const std::array<double, 6> box = logic->GetLive()->GetLiveBounds();
+    logic->GetPoseEdits()->BeginPoseInteraction();
     for (int e = 0; e < edits; ++e) {
       const double angle = rest->angleDeg + 30.0 * double(e + 1) / double(edits);
-      if (!logic->SetPoseGroupTransform(pose, group, rest->axis, angle, rest->pivot,
-                                        rest->translation))
+      if (!logic->GetPoseEdits()->SetPoseGroupTransform(pose, group, rest->axis, angle, rest->pivot,
+                                                        rest->translation))
         fail("edit: " + logic->GetLastErrorMessage());
       for (int o = 0; o < 3; ++o) {
         const int axis = o == 0 ? 2 : o == 1 ? 1 : 0;
-        if (!logic->ComputeLiveSlice(o, (box[2 * axis] + box[2 * axis + 1]) / 2, pixels))
+        if (!logic->GetLive()->ComputeLiveSlice(o, (box[2 * axis] + box[2 * axis + 1]) / 2, pixels))
           fail("slice: " + logic->GetLastErrorMessage());
       }
     }
-    logic->EndPoseInteraction();
-    if (!logic->StartApplyPose(pose, out.string()) ||
-        logic->WaitForJob() != vtkSlicerReposeLogic::JobSucceeded)
+    logic->GetPoseEdits()->EndPoseInteraction();
+    if (!logic->GetJobs()->StartApplyPose(pose, out.string()) ||
+        logic->GetJobs()->WaitForJob() != vtkSlicerReposeJobsLogic::JobSucceeded)
       fail("export: " + logic->GetLastErrorMessage());
     if (!fs::exists(out / "posed_G.nii.gz")) fail("the export wrote no posed_G.nii.gz");
     // Close: the live pose stopped, the volume cleared, the scene replaced by an empty one.
-    logic->StopLivePose();
+    logic->GetLive()->StopLivePose();
     logic->ClearVolume();
     logic->SetScene(vtkNew<vtkMRMLReposeScene>());
     // Every tenth cycle (from the first, so warm-up has seen every reader's error path): each

@@ -76,26 +76,26 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
   auto* pose = logic->AddPose(kElbow);
   ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
   // Before the rig there is nothing to prepare; without a live pose no slice.
-  EXPECT_FALSE(logic->StartLivePose(pose));
-  EXPECT_FALSE(logic->ComputeLiveSlice(1, 0, 64));
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
-  EXPECT_EQ(logic->GetLivePose(), nullptr);  // committed only by WaitForJob
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  ASSERT_EQ(logic->GetLivePose(), pose);
-  ASSERT_TRUE(logic->GetLiveCage() && logic->GetLiveBodySurface());
-  EXPECT_GT(logic->GetLiveBodySurface()->GetNumberOfCells(), 100);
-  EXPECT_GT(logic->GetLiveFrameMilliseconds(), 0.0);
+  EXPECT_FALSE(logic->GetLive()->StartLivePose(pose));
+  EXPECT_FALSE(logic->GetLive()->ComputeLiveSlice(1, 0, 64));
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  ASSERT_TRUE(logic->GetLive()->StartLivePose(pose)) << logic->GetLastErrorMessage();
+  EXPECT_EQ(logic->GetLive()->GetLivePose(), nullptr);  // committed only by WaitForJob
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  ASSERT_EQ(logic->GetLive()->GetLivePose(), pose);
+  ASSERT_TRUE(logic->GetLive()->GetLiveCage() && logic->GetLive()->GetLiveBodySurface());
+  EXPECT_GT(logic->GetLive()->GetLiveBodySurface()->GetNumberOfCells(), 100);
+  EXPECT_GT(logic->GetLive()->GetLiveFrameMilliseconds(), 0.0);
 
   // The coronal plane through the elbow's pivot (A = -14 mm).
   const double y = -14;
-  EXPECT_EQ(logic->GetLiveSliceMilliseconds(), 0.0);  // before the first slice
+  EXPECT_EQ(logic->GetLive()->GetLiveSliceMilliseconds(), 0.0);  // before the first slice
   const auto start = std::chrono::steady_clock::now();
-  vtkSmartPointer<vtkImageData> bent = logic->ComputeLiveSlice(1, y, 128);
+  vtkSmartPointer<vtkImageData> bent = logic->GetLive()->ComputeLiveSlice(1, y, 128);
   const double wall =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  const double ms = logic->GetLiveSliceMilliseconds();
+  const double ms = logic->GetLive()->GetLiveSliceMilliseconds();
   ASSERT_TRUE(bent);
   // The time shown in the views is this call's, in milliseconds: within the call's wall time
   // and most of it (not seconds, not microseconds, not a stale figure of another call).
@@ -110,11 +110,11 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
 
   // Straighten the elbow: the pose node changes, the frame re-solves by itself.
   const unsigned long before = logic->GetMTime();
-  ASSERT_TRUE(logic->SetPoseGroupTransform(pose, "left forearm and hand", {1, 0, 0}, 0,
-                                           {-176, -14, 806}, {0, 0, 0}))
+  ASSERT_TRUE(logic->GetPoseEdits()->SetPoseGroupTransform(pose, "left forearm and hand", {1, 0, 0},
+                                                           0, {-176, -14, 806}, {0, 0, 0}))
       << logic->GetLastErrorMessage();
   EXPECT_GT(logic->GetMTime(), before);
-  vtkSmartPointer<vtkImageData> straight = logic->ComputeLiveSlice(1, y, 128);
+  vtkSmartPointer<vtkImageData> straight = logic->GetLive()->ComputeLiveSlice(1, y, 128);
   ASSERT_TRUE(straight);
   const std::vector<std::uint8_t> b = voxels(bent), s = voxels(straight);
   ASSERT_EQ(b.size(), s.size());
@@ -145,11 +145,11 @@ TEST(vtkSlicerReposeLogicLive, EditsResolveTheFrameAndTheSlicesFollow) {
   EXPECT_GE(double(agree), 0.9 * double(body));
 
   // Undo: the bent elbow again, voxel for voxel.
-  ASSERT_TRUE(logic->Undo());
-  EXPECT_EQ(voxels(logic->ComputeLiveSlice(1, y, 128)), b);
-  logic->StopLivePose();
-  EXPECT_EQ(logic->GetLivePose(), nullptr);
-  EXPECT_FALSE(logic->ComputeLiveSlice(1, y, 128));
+  ASSERT_TRUE(logic->GetPoseEdits()->Undo());
+  EXPECT_EQ(voxels(logic->GetLive()->ComputeLiveSlice(1, y, 128)), b);
+  logic->GetLive()->StopLivePose();
+  EXPECT_EQ(logic->GetLive()->GetLivePose(), nullptr);
+  EXPECT_FALSE(logic->GetLive()->ComputeLiveSlice(1, y, 128));
 }
 
 // A pose made in the 3D view: a new pose (everything fixed), a group from the cage vertices
@@ -161,24 +161,39 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
   vtkNew<vtkSlicerReposeLogic> logic;
   auto* seg = logic->AddSegmentation(phantom.G, phantom.S, phantom.CT);
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
-  vtkMRMLReposePoseNode* pose = logic->NewPose("from the view");
+  vtkMRMLReposePoseNode* pose = logic->GetPoseEdits()->NewPose("from the view");
   ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
-  EXPECT_TRUE(logic->AddPoseGroup(pose, {0, 1}).empty());  // not live yet
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  ASSERT_EQ(logic->GetLivePose(), pose);
-  EXPECT_FALSE(logic->GetPoseGroupMatrix(pose, "rest", vtkNew<vtkMatrix4x4>()));  // fixed
+  EXPECT_TRUE(logic->GetPoseEdits()->AddPoseGroup(pose, {0, 1}).empty());  // not live yet
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  ASSERT_TRUE(logic->GetLive()->StartLivePose(pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  ASSERT_EQ(logic->GetLive()->GetLivePose(), pose);
+  EXPECT_FALSE(
+      logic->GetPoseEdits()->GetPoseGroupMatrix(pose, "rest", vtkNew<vtkMatrix4x4>()));  // fixed
 
   // The image under the labels: the same plane and grid, CT values that agree with the labels
   // (air -1000 exactly, lung dark, bone bright), and a soft-tissue window for it.
   {
-    vtkSmartPointer<vtkImageData> labels = logic->ComputeLiveSlice(1, 0, 96);
-    vtkSmartPointer<vtkImageData> image = logic->ComputeLiveImageSlice(1, 0, 96);
+    // The views' one call: every orientation's labels, image and (asked for) S's outlines.
+    const std::array<double, 3> centre = logic->GetLive()->GetLiveRestCenter();
+    const vtkSlicerReposeLiveLogic::LiveSlices all =
+        logic->GetLive()->ComputeLiveSlices({centre[2], 0, centre[0]}, 96, true);
+    for (int o = 0; o < 3; ++o) {
+      ASSERT_TRUE(all.labels[o] && all.images[o] && all.parts[o]) << "orientation " << o;
+      EXPECT_EQ(all.parts[o]->GetNumberOfPoints(), all.labels[o]->GetNumberOfPoints());
+    }
+    vtkSmartPointer<vtkImageData> labels = all.labels[1];
+    vtkSmartPointer<vtkImageData> image = all.images[1];
+    // The same plane's labels asked for alone are the same voxels.
+    vtkSmartPointer<vtkImageData> alone = logic->GetLive()->ComputeLiveSlice(1, 0, 96);
+    ASSERT_TRUE(alone && alone->GetNumberOfPoints() == labels->GetNumberOfPoints());
+    for (vtkIdType p = 0; p < labels->GetNumberOfPoints(); ++p)
+      ASSERT_EQ(alone->GetPointData()->GetScalars()->GetTuple1(p),
+                labels->GetPointData()->GetScalars()->GetTuple1(p));
     ASSERT_TRUE(labels && image);
     ASSERT_EQ(image->GetNumberOfPoints(), labels->GetNumberOfPoints());
-    const auto window = logic->GetLiveImageWindow();
+    const auto window = logic->GetLive()->GetLiveImageWindow();
     ASSERT_TRUE(window);
     EXPECT_EQ(window->window, 400);
     EXPECT_EQ(window->level, 40);
@@ -208,31 +223,31 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
 
   // The cage vertices of the left hand part, found by name among S's parts.
   int hand = 0;
-  for (const auto& [label, name] : logic->GetLiveBodyParts())
+  for (const auto& [label, name] : logic->GetLive()->GetLiveBodyParts())
     if (name == "hand_left") hand = label;
   ASSERT_GT(hand, 0);
-  const std::vector<int> selection = logic->GetLiveCageVerticesOfPart(hand);
+  const std::vector<int> selection = logic->GetLive()->GetLiveCageVerticesOfPart(hand);
   ASSERT_FALSE(selection.empty());
-  const auto rest = logic->GetLiveRestCage();
+  const auto rest = logic->GetLive()->GetLiveRestCage();
   std::array<double, 3> handCentre{0, 0, 0};
   for (int v : selection)
     for (int k = 0; k < 3; ++k) handCentre[k] += rest[std::size_t(v)][k] / double(selection.size());
   const double handZ = handCentre[2];
 
-  const std::string group = logic->AddPoseGroup(pose, selection);
+  const std::string group = logic->GetPoseEdits()->AddPoseGroup(pose, selection);
   ASSERT_EQ(group, "group 1") << logic->GetLastErrorMessage();
   // The groups changed: the live pose re-prepares on the worker, then serves the new group.
-  ASSERT_TRUE(logic->IsJobRunning());
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  ASSERT_EQ(logic->GetLivePose(), pose);
-  EXPECT_EQ(logic->GetLiveGroupVertices(group), selection);
+  ASSERT_TRUE(logic->GetJobs()->IsJobRunning());
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  ASSERT_EQ(logic->GetLive()->GetLivePose(), pose);
+  EXPECT_EQ(logic->GetLive()->GetLiveGroupVertices(group), selection);
 
   // Lift the hand 60 mm and turn it 30 degrees about A, as one drag of the transform widget.
   vtkNew<vtkMatrix4x4> start;
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, group, start));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(pose, group, start));
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) EXPECT_NEAR(start->GetElement(i, j), i == j ? 1 : 0, 1e-12);
-  vtkPolyData* body = logic->GetLiveBodySurface();
+  vtkPolyData* body = logic->GetLive()->GetLiveBodySurface();
   std::vector<std::array<double, 3>> before(std::size_t(body->GetNumberOfPoints()));
   for (vtkIdType i = 0; i < body->GetNumberOfPoints(); ++i)
     body->GetPoint(i, before[std::size_t(i)].data());
@@ -241,17 +256,17 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
   motion->Translate(-handCentre[0], -handCentre[1], -handCentre[2]);
   motion->RotateY(30);
   motion->Translate(handCentre[0], handCentre[1], handCentre[2] + 60);
-  logic->BeginPoseInteraction();
-  ASSERT_TRUE(logic->SetPoseGroupMatrix(pose, group, motion->GetMatrix()))
+  logic->GetPoseEdits()->BeginPoseInteraction();
+  ASSERT_TRUE(logic->GetPoseEdits()->SetPoseGroupMatrix(pose, group, motion->GetMatrix()))
       << logic->GetLastErrorMessage();
-  logic->EndPoseInteraction();
+  logic->GetPoseEdits()->EndPoseInteraction();
   vtkNew<vtkMatrix4x4> after;
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, group, after));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(pose, group, after));
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       EXPECT_NEAR(after->GetElement(i, j), motion->GetMatrix()->GetElement(i, j), 1e-9);
   // The body surface moved near the hand and stayed put far from it (the head).
-  body = logic->GetLiveBodySurface();
+  body = logic->GetLive()->GetLiveBodySurface();
   double movedNearHand = 0, movedAtHead = 0;
   for (vtkIdType i = 0; i < body->GetNumberOfPoints(); ++i) {
     double p[3];
@@ -267,28 +282,28 @@ TEST(vtkSlicerReposeLogicLive, AGroupFromASelectionMovesWhatItHolds) {
   // A non-rigid matrix is refused with a message, and changes nothing.
   vtkNew<vtkMatrix4x4> scaled;
   scaled->SetElement(0, 0, 2);
-  EXPECT_FALSE(logic->SetPoseGroupMatrix(pose, group, scaled));
+  EXPECT_FALSE(logic->GetPoseEdits()->SetPoseGroupMatrix(pose, group, scaled));
   EXPECT_NE(logic->GetLastErrorMessage().find("not a rigid"), std::string::npos);
 
   // A group by body part over the same hand overlaps group 1 (listed vertices): it takes them,
   // and group 1, left empty, goes. A further selection overlapping that part group is refused.
-  const std::string byPart = logic->AddPoseGroup(pose, {}, hand);
+  const std::string byPart = logic->GetPoseEdits()->AddPoseGroup(pose, {}, hand);
   ASSERT_EQ(byPart, "group 1") << logic->GetLastErrorMessage();  // the name is free again
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  EXPECT_TRUE(logic->AddPoseGroup(pose, {selection.front()}).empty());
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  EXPECT_TRUE(logic->GetPoseEdits()->AddPoseGroup(pose, {selection.front()}).empty());
   EXPECT_NE(logic->GetLastErrorMessage().find("by region or body part"), std::string::npos)
       << logic->GetLastErrorMessage();
 
   // Undo twice: the part group, then the move; three times: the selection group too.
-  ASSERT_TRUE(logic->Undo());
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  ASSERT_TRUE(logic->Undo());
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, group, after));
+  ASSERT_TRUE(logic->GetPoseEdits()->Undo());
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  ASSERT_TRUE(logic->GetPoseEdits()->Undo());
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(pose, group, after));
   EXPECT_NEAR(after->GetElement(2, 3), 0, 1e-12);
-  ASSERT_TRUE(logic->Undo());
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  EXPECT_TRUE(logic->GetLiveGroupVertices(group).empty());
-  EXPECT_EQ(logic->GetLivePose(), pose);
+  ASSERT_TRUE(logic->GetPoseEdits()->Undo());
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  EXPECT_TRUE(logic->GetLive()->GetLiveGroupVertices(group).empty());
+  EXPECT_EQ(logic->GetLive()->GetLivePose(), pose);
 }
 
 // The Transfer mesh section's Refine: the live pose's mesh refined for its current frame (the
@@ -302,13 +317,13 @@ TEST(vtkSlicerReposeLogicLive, RefiningForTheFrameAndAddingASeparation) {
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
   auto* pose = logic->AddPose(kElbow);
   ASSERT_TRUE(pose);
-  EXPECT_FALSE(logic->StartRefineMesh(pose));  // nothing to refine before the rig
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  EXPECT_FALSE(logic->StartRefineMesh(pose));  // not live yet: no frame to adapt to
+  EXPECT_FALSE(logic->GetJobs()->StartRefineMesh(pose));  // nothing to refine before the rig
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  EXPECT_FALSE(logic->GetJobs()->StartRefineMesh(pose));  // not live yet: no frame to adapt to
   EXPECT_NE(logic->GetLastErrorMessage().find("live"), std::string::npos);
-  ASSERT_TRUE(logic->StartLivePose(pose));
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  ASSERT_TRUE(logic->GetLive()->StartLivePose(pose));
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
 
   auto meshOf = [&] {
     return vtkMRMLReposeTransferMeshNode::SafeDownCast(
@@ -317,8 +332,8 @@ TEST(vtkSlicerReposeLogicLive, RefiningForTheFrameAndAddingASeparation) {
   vtkMRMLReposeTransferMeshNode* first = meshOf();
   ASSERT_TRUE(first);
   const vtkIdType firstVertices = first->GetMesh()->GetNumberOfPoints();
-  ASSERT_TRUE(logic->StartRefineMesh(pose, 2)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartRefineMesh(pose, 2)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   vtkMRMLReposeTransferMeshNode* refined = meshOf();
   ASSERT_TRUE(refined);
@@ -327,43 +342,41 @@ TEST(vtkSlicerReposeLogicLive, RefiningForTheFrameAndAddingASeparation) {
   // by at most 1), so the last round's mesh, the one the node holds, has at least as many
   // vertices. (Whether its maximum error is lower depends on the mesh: on this 8 mm phantom the
   // maximum of a finer mesh can be higher; Refinement.* compares the loop with uniform meshes.)
-  const std::vector<double>& errors = logic->GetLastRefinementMaxErrors();
+  const std::vector<double>& errors = logic->GetJobs()->GetLastRefinementMaxErrors();
   ASSERT_EQ(errors.size(), 2u);
   for (const double e : errors) EXPECT_TRUE(std::isfinite(e) && e > 0) << e;
-  const std::vector<int>& counts = logic->GetLastRefinementVertices();
+  const std::vector<int>& counts = logic->GetJobs()->GetLastRefinementVertices();
   EXPECT_GE(counts.back(), counts.front());
   // The node holds the last round's mesh with the pose's cuts made in it (a cut duplicates the
   // vertices the two parts share): the summary gives its final count.
   EXPECT_LE(counts.back(), refined->GetMesh()->GetNumberOfPoints());
-  EXPECT_NE(logic->GetLastRefinementSummary().find(
+  EXPECT_NE(logic->GetJobs()->GetLastRefinementSummary().find(
                 "-> " + std::to_string(refined->GetMesh()->GetNumberOfPoints()) + " vertices"),
             std::string::npos)
-      << logic->GetLastRefinementSummary();
+      << logic->GetJobs()->GetLastRefinementSummary();
   EXPECT_GT(firstVertices, 0);
-  std::cout << logic->GetLastRefinementSummary() << "\n";
-  EXPECT_NE(logic->GetLastRefinementSummary().find("vertices"), std::string::npos);
+  std::cout << logic->GetJobs()->GetLastRefinementSummary() << "\n";
+  EXPECT_NE(logic->GetJobs()->GetLastRefinementSummary().find("vertices"), std::string::npos);
   vtkDataArray* rigid = refined->GetMesh()->GetCellData()->GetArray("rigid");
   ASSERT_TRUE(rigid);
   int pieces = 0;
   for (vtkIdType c = 0; c < rigid->GetNumberOfTuples(); ++c) pieces += rigid->GetTuple1(c) != 0;
   EXPECT_GT(pieces, 0);
-  ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
-  EXPECT_EQ(logic->GetLiveBodySurface()->GetNumberOfPoints(),
+  ASSERT_TRUE(logic->GetLive()->StartLivePose(pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
+  EXPECT_EQ(logic->GetLive()->GetLiveBodySurface()->GetNumberOfPoints(),
             refined->GetMesh()->GetNumberOfPoints());
 
   // Separations: recorded, undone; refused with the reason.
-  ASSERT_TRUE(
-      logic->AddPoseSeparation(pose, "hand_left", "torso", "box:-300,-100,600,-150,100,900"))
+  ASSERT_TRUE(logic->GetPoseEdits()->AddPoseSeparation(pose, "hand_left", "torso",
+                                                       "box:-300,-100,600,-150,100,900"))
       << logic->GetLastErrorMessage();
-  auto separations = [&] {
-    return repose::parsePose(pose->GetPoseJSON(), "pose").separations.size();
-  };
+  auto separations = [&] { return pose->GetPose()->separations.size(); };
   EXPECT_EQ(separations(), 1u);
-  EXPECT_FALSE(logic->AddPoseSeparation(pose, "hand_left", "torso", "cube:1,2"));
+  EXPECT_FALSE(logic->GetPoseEdits()->AddPoseSeparation(pose, "hand_left", "torso", "cube:1,2"));
   EXPECT_FALSE(logic->GetLastErrorMessage().empty());
-  EXPECT_FALSE(logic->AddPoseSeparation(pose, "torso", "torso", "sphere:0,0,0,10"));
-  ASSERT_TRUE(logic->Undo());
+  EXPECT_FALSE(logic->GetPoseEdits()->AddPoseSeparation(pose, "torso", "torso", "sphere:0,0,0,10"));
+  ASSERT_TRUE(logic->GetPoseEdits()->Undo());
   EXPECT_EQ(separations(), 0u);
 }
 
@@ -378,31 +391,31 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
   vtkNew<vtkSlicerReposeLogic> logic;
   auto* seg = logic->AddSegmentation(phantom.G, phantom.S);
   ASSERT_TRUE(seg) << logic->GetLastErrorMessage();
-  auto* pose = logic->NewPose("joints");
+  auto* pose = logic->GetPoseEdits()->NewPose("joints");
   ASSERT_TRUE(pose);
-  ASSERT_EQ(logic->SetPoseJoint(pose, phantom.S, "shoulder_left"), "shoulder_left")
+  ASSERT_EQ(logic->GetPoseEdits()->SetPoseJoint(pose, phantom.S, "shoulder_left"), "shoulder_left")
       << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->SetPoseJoint(pose, phantom.S, "elbow_left"), "elbow_left");
-  EXPECT_EQ(logic->SetPoseJoint(pose, phantom.S, "tail"), "");
+  ASSERT_EQ(logic->GetPoseEdits()->SetPoseJoint(pose, phantom.S, "elbow_left"), "elbow_left");
+  EXPECT_EQ(logic->GetPoseEdits()->SetPoseJoint(pose, phantom.S, "tail"), "");
   EXPECT_NE(logic->GetLastErrorMessage().find("tail"), std::string::npos);
-  const auto joints = vtkSlicerReposeLogic::GetJointsBeside(phantom.S);
+  const auto joints = vtkSlicerReposePoseEditLogic::GetJointsBeside(phantom.S);
   const auto shoulder = std::find_if(joints.begin(), joints.end(),
                                      [](const auto& j) { return j.name == "shoulder_left"; });
   ASSERT_NE(shoulder, joints.end());
-  const auto turns = logic->GetPoseGroupTurns(pose, "shoulder_left");
+  const auto turns = logic->GetPoseEdits()->GetPoseGroupTurns(pose, "shoulder_left");
   ASSERT_EQ(turns.size(), shoulder->axes.size());
   for (std::size_t k = 0; k < turns.size(); ++k)  // named until the rig resolves them
     EXPECT_EQ(turns[k].axisName, "shoulder_left." + shoulder->axes[k]);
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
-  if (logic->GetLivePose() != pose) {
-    ASSERT_TRUE(logic->StartLivePose(pose)) << logic->GetLastErrorMessage();
-    ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  if (logic->GetLive()->GetLivePose() != pose) {
+    ASSERT_TRUE(logic->GetLive()->StartLivePose(pose)) << logic->GetLastErrorMessage();
+    ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
   }
-  ASSERT_EQ(logic->GetLivePose(), pose);
+  ASSERT_EQ(logic->GetLive()->GetLivePose(), pose);
   auto jointAt = [&](const std::string& name) {
-    for (const auto& j : logic->GetLiveJoints())
+    for (const auto& j : logic->GetLive()->GetLiveJoints())
       if (j.name == name) return Eigen::Vector3d(j.centre[0], j.centre[1], j.centre[2]);
     ADD_FAILURE() << "no joint " << name;
     return Eigen::Vector3d(0, 0, 0);
@@ -412,14 +425,16 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
       std::size_t(std::find(shoulder->axes.begin(), shoulder->axes.end(), "abduction") -
                   shoulder->axes.begin());
   ASSERT_LT(abduction, shoulder->axes.size());
-  EXPECT_FALSE(logic->SetPoseGroupTurnAngle(pose, "shoulder_left", 9, 10));
-  ASSERT_TRUE(logic->SetPoseGroupTurnAngle(pose, "shoulder_left", int(abduction), 90))
+  EXPECT_FALSE(logic->GetPoseEdits()->SetPoseGroupTurnAngle(pose, "shoulder_left", 9, 10));
+  ASSERT_TRUE(
+      logic->GetPoseEdits()->SetPoseGroupTurnAngle(pose, "shoulder_left", int(abduction), 90))
       << logic->GetLastErrorMessage();
-  EXPECT_EQ(logic->GetPoseGroupTurns(pose, "shoulder_left")[abduction].angleDeg, 90);
+  EXPECT_EQ(logic->GetPoseEdits()->GetPoseGroupTurns(pose, "shoulder_left")[abduction].angleDeg,
+            90);
   // The elbow's group (its own turns at 0) moves with the shoulder's.
   vtkNew<vtkMatrix4x4> shoulderMotion, elbowMotion;
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, "shoulder_left", shoulderMotion));
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(pose, "elbow_left", elbowMotion));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(pose, "shoulder_left", shoulderMotion));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(pose, "elbow_left", elbowMotion));
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       EXPECT_NEAR(elbowMotion->GetElement(i, j), shoulderMotion->GetElement(i, j), 1e-9);
@@ -429,9 +444,9 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
   const Eigen::Vector3d wristExpected = (m * wristRest.homogeneous()).head<3>();
   EXPECT_LT((jointAt("wrist_left") - wristExpected).norm(), 1.0);
   EXPECT_GT((jointAt("wrist_left") - wristRest).norm(), 100.0);
-  EXPECT_FALSE(logic->SetPoseGroupMatrix(pose, "shoulder_left", shoulderMotion));
+  EXPECT_FALSE(logic->GetPoseEdits()->SetPoseGroupMatrix(pose, "shoulder_left", shoulderMotion));
   EXPECT_NE(logic->GetLastErrorMessage().find("several axes"), std::string::npos);
-  ASSERT_TRUE(logic->Undo());
+  ASSERT_TRUE(logic->GetPoseEdits()->Undo());
   EXPECT_LT((jointAt("wrist_left") - wristRest).norm(), 1.0);
 
   // A chain of single-axis groups in a pose file: the widget's matrix is the follower's motion.
@@ -446,8 +461,8 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
   auto* chained = logic->AddPose(chain);
   ASSERT_TRUE(chained) << logic->GetLastErrorMessage();
   vtkNew<vtkMatrix4x4> upper, lower;
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "upper", upper));
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "lower", lower));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(chained, "upper", upper));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(chained, "lower", lower));
   const repose::Pose parsed = repose::readPoseFile(chain);
   const Eigen::Matrix4d expectedLower =
       (parsed.groups[0].transform.isometry() * parsed.groups[1].transform.isometry()).matrix();
@@ -457,11 +472,11 @@ TEST(vtkSlicerReposeLogicLive, JointGroupsChainAndAFollowerIsMovedInTheWorld) {
   drag->PostMultiply();
   drag->SetMatrix(lower);
   drag->Translate(0, 0, 30);
-  ASSERT_TRUE(logic->SetPoseGroupMatrix(chained, "lower", drag->GetMatrix()))
+  ASSERT_TRUE(logic->GetPoseEdits()->SetPoseGroupMatrix(chained, "lower", drag->GetMatrix()))
       << logic->GetLastErrorMessage();
   vtkNew<vtkMatrix4x4> after, upperAfter;
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "lower", after));
-  ASSERT_TRUE(logic->GetPoseGroupMatrix(chained, "upper", upperAfter));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(chained, "lower", after));
+  ASSERT_TRUE(logic->GetPoseEdits()->GetPoseGroupMatrix(chained, "upper", upperAfter));
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) {
       EXPECT_NEAR(after->GetElement(i, j), drag->GetMatrix()->GetElement(i, j), 1e-9);
@@ -488,12 +503,12 @@ TEST(vtkSlicerReposeLogicLive, AScenePoseTurningAboutNamedJointsGoesLive) {
   vtkNew<vtkMRMLReposeParametersNode> parameters;
   logic->SetParameterNode(parameters);
   ASSERT_TRUE(logic->OpenScene(scene)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
-  auto* pose = logic->GetLivePose();
+  auto* pose = logic->GetLive()->GetLivePose();
   ASSERT_NE(pose, nullptr) << logic->GetLastErrorMessage();
-  EXPECT_GT(logic->GetLiveFrameMilliseconds(), 0.0) << logic->GetLastErrorMessage();
-  EXPECT_TRUE(logic->ComputeLiveSlice(1, -14, 64)) << logic->GetLastErrorMessage();
+  EXPECT_GT(logic->GetLive()->GetLiveFrameMilliseconds(), 0.0) << logic->GetLastErrorMessage();
+  EXPECT_TRUE(logic->GetLive()->ComputeLiveSlice(1, -14, 64)) << logic->GetLastErrorMessage();
   // The node now holds the joints in numbers, as a rig built in the workbench writes them.
-  EXPECT_FALSE(repose::poseNamesJoints(repose::parsePose(pose->GetPoseJSON(), "node")));
+  EXPECT_FALSE(repose::poseNamesJoints(*pose->GetPose()));
 }

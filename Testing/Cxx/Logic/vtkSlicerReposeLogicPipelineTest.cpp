@@ -83,16 +83,17 @@ TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
   EXPECT_EQ(scene->GetNumberOfNodes(), 2);
 
   // Posing before the rig exists is refused with a message, nothing starts.
-  EXPECT_FALSE(logic->StartApplyPose(pose));
+  EXPECT_FALSE(logic->GetJobs()->StartApplyPose(pose));
   EXPECT_NE(logic->GetLastErrorMessage().find("build the rig"), std::string::npos);
 
   // The rig on the worker; progress is visible while it runs; nodes appear only at commit.
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  EXPECT_FALSE(logic->StartBuildRig(seg, pose));  // one job at a time
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  EXPECT_FALSE(logic->GetJobs()->StartBuildRig(seg, pose));  // one job at a time
   double last = 0;
-  while (logic->IsJobRunning() && logic->PollJob() == vtkSlicerReposeLogic::JobRunning) {
+  while (logic->GetJobs()->IsJobRunning() &&
+         logic->GetJobs()->PollJob() == vtkSlicerReposeJobsLogic::JobRunning) {
     EXPECT_EQ(scene->GetNumberOfNodes(), 2);
-    last = std::max(last, logic->GetJobProgress());
+    last = std::max(last, logic->GetJobs()->GetJobProgress());
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   EXPECT_EQ(scene->GetNodesByClass("vtkMRMLReposeCageNode").size(), 1u);
@@ -107,19 +108,19 @@ TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
 
   // A cancelled pose job: no new node, no output folder.
   const std::string cancelledOut = files.dir.file("cancelled");
-  ASSERT_TRUE(logic->StartApplyPose(pose, cancelledOut));
-  logic->CancelJob();
-  EXPECT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobCancelled);
+  ASSERT_TRUE(logic->GetJobs()->StartApplyPose(pose, cancelledOut));
+  logic->GetJobs()->CancelJob();
+  EXPECT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobCancelled);
   EXPECT_EQ(scene->GetNumberOfNodes(), 4);
   EXPECT_FALSE(std::filesystem::exists(cancelledOut));
-  EXPECT_EQ(logic->GetLastPosedSegmentation(), nullptr);
+  EXPECT_EQ(logic->GetJobs()->GetLastPosedSegmentation(), nullptr);
 
   // The pose: a posed segmentation node and the files.
   const std::string out = files.dir.file("posed");
-  ASSERT_TRUE(logic->StartApplyPose(pose, out));
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartApplyPose(pose, out));
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
-  vtkMRMLReposeSegmentationNode* posed = logic->GetLastPosedSegmentation();
+  vtkMRMLReposeSegmentationNode* posed = logic->GetJobs()->GetLastPosedSegmentation();
   ASSERT_TRUE(posed);
   EXPECT_EQ(scene->GetReferencedNode(posed, "source"), seg);
   for (const char* f : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd"})
@@ -129,21 +130,23 @@ TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
 
   // Undo and redo of a pose edit.
   const std::string original = pose->GetPoseJSON();
-  EXPECT_FALSE(logic->CanUndo());
-  ASSERT_TRUE(logic->SetPoseGroupTransform(pose, "left forearm and hand", {1, 0, 0}, 45,
-                                           {-176, -14, 806}, {0, 0, 0}));
+  EXPECT_FALSE(logic->GetPoseEdits()->CanUndo());
+  ASSERT_TRUE(logic->GetPoseEdits()->SetPoseGroupTransform(pose, "left forearm and hand", {1, 0, 0},
+                                                           45, {-176, -14, 806}, {0, 0, 0}));
   const std::string edited = pose->GetPoseJSON();
   EXPECT_NE(edited, original);
   EXPECT_NE(edited.find("45"), std::string::npos);
-  EXPECT_TRUE(logic->Undo());
+  EXPECT_TRUE(logic->GetPoseEdits()->Undo());
   EXPECT_EQ(pose->GetPoseJSON(), original);
-  EXPECT_TRUE(logic->CanRedo());
-  EXPECT_TRUE(logic->Redo());
+  EXPECT_TRUE(logic->GetPoseEdits()->CanRedo());
+  EXPECT_TRUE(logic->GetPoseEdits()->Redo());
   EXPECT_EQ(pose->GetPoseJSON(), edited);
-  EXPECT_TRUE(logic->Undo());
-  EXPECT_FALSE(logic->SetPoseGroupTransform(pose, "body", {1, 0, 0}, 10, {0, 0, 0}, {0, 0, 0}));
+  EXPECT_TRUE(logic->GetPoseEdits()->Undo());
+  EXPECT_FALSE(logic->GetPoseEdits()->SetPoseGroupTransform(pose, "body", {1, 0, 0}, 10, {0, 0, 0},
+                                                            {0, 0, 0}));
   EXPECT_NE(logic->GetLastErrorMessage().find("fixed"), std::string::npos);
-  EXPECT_FALSE(logic->SetPoseGroupTransform(pose, "tail", {1, 0, 0}, 10, {0, 0, 0}, {0, 0, 0}));
+  EXPECT_FALSE(logic->GetPoseEdits()->SetPoseGroupTransform(pose, "tail", {1, 0, 0}, 10, {0, 0, 0},
+                                                            {0, 0, 0}));
   EXPECT_EQ(pose->GetPoseJSON(), original);
 
   // Save, load into a new logic, pose again: bit-identical.
@@ -181,12 +184,13 @@ TEST(vtkSlicerReposeLogicPipeline, RigPoseCancelUndoAndSceneRoundTrip) {
   auto* loadedPose =
       vtkMRMLReposePoseNode::SafeDownCast(other->GetScene()->GetNodeByID(pose->GetID()));
   ASSERT_TRUE(loadedPose);
-  ASSERT_TRUE(other->StartApplyPose(loadedPose));
-  ASSERT_EQ(other->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(other->GetJobs()->StartApplyPose(loadedPose));
+  ASSERT_EQ(other->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << other->GetLastErrorMessage();
-  EXPECT_TRUE(sameVoxels(other->GetLastPosedSegmentation()->GetLabelMap(), posed->GetLabelMap()));
-  EXPECT_TRUE(
-      sameVoxels(other->GetLastPosedSegmentation()->GetBodyPartMap(), posed->GetBodyPartMap()));
+  EXPECT_TRUE(sameVoxels(other->GetJobs()->GetLastPosedSegmentation()->GetLabelMap(),
+                         posed->GetLabelMap()));
+  EXPECT_TRUE(sameVoxels(other->GetJobs()->GetLastPosedSegmentation()->GetBodyPartMap(),
+                         posed->GetBodyPartMap()));
 
   // A scene folder with a missing data file is refused and the scene kept.
   const int nodesBefore = other->GetScene()->GetNumberOfNodes();
@@ -214,11 +218,12 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
       logic->GetScene()->GetNodesByClass("vtkMRMLReposeCageNode").at(0));
   EXPECT_EQ(cage->GetHandleGroups().size(), 2u);
   const std::string logicOut = files.dir.file("logic");
-  ASSERT_TRUE(logic->StartApplyPose(vtkMRMLReposePoseNode::SafeDownCast(poses[0]), logicOut));
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(
+      logic->GetJobs()->StartApplyPose(vtkMRMLReposePoseNode::SafeDownCast(poses[0]), logicOut));
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   const repose::Volume expected = repose::readVolume(out + "/posed_G.nii.gz");
-  vtkImageData* got = logic->GetLastPosedSegmentation()->GetLabelMap();
+  vtkImageData* got = logic->GetJobs()->GetLastPosedSegmentation()->GetLabelMap();
   int dims[3];
   got->GetDimensions(dims);
   ASSERT_EQ(dims[0], expected.dims()[0]);
@@ -266,18 +271,17 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
     EXPECT_EQ(read.geometry.cage.vertices.rows(), cageNode->GetMesh()->GetNumberOfPoints());
     EXPECT_EQ(read.geometry.mesh.tets.rows(), mesh->GetMesh()->GetNumberOfCells());
     EXPECT_EQ(read.geometry.coordinatesFile, mesh->GetCoordinatesFile());
-    EXPECT_EQ(read.pose.groups.size(),
-              repose::parsePose(poseNode->GetPoseJSON(), poseNode->GetName()).groups.size());
+    EXPECT_EQ(read.pose.groups.size(), poseNode->GetPose()->groups.size());
     EXPECT_EQ(read.key, "");  // the workbench records no command-line rig key
   }
   vtkNew<vtkSlicerReposeLogic> reloaded;
   ASSERT_TRUE(reloaded->LoadScene(saved)) << reloaded->GetLastErrorMessage();
   const std::string reloadedOut = files.dir.file("reloaded");
-  ASSERT_TRUE(reloaded->StartApplyPose(
+  ASSERT_TRUE(reloaded->GetJobs()->StartApplyPose(
       vtkMRMLReposePoseNode::SafeDownCast(
           reloaded->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode").at(0)),
       reloadedOut));
-  ASSERT_EQ(reloaded->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_EQ(reloaded->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << reloaded->GetLastErrorMessage();
   std::ifstream reloadedReport(reloadedOut + "/report.json");
   EXPECT_TRUE(nlohmann::json::parse(reloadedReport)["green_coordinates"]["read"].get<bool>());
@@ -295,10 +299,11 @@ TEST(vtkSlicerReposeLogicPipeline, LoadsTheSceneTheCommandLineWrote) {
   EXPECT_TRUE(std::filesystem::exists(parameters->GetPosePath())) << parameters->GetPosePath();
   EXPECT_TRUE(std::filesystem::exists(parameters->GetBodyPartMapPath()))
       << parameters->GetBodyPartMapPath();
-  EXPECT_EQ(parameters->GetActiveGroup(), opened->GetPoseSummary(openedPose).movableGroups.at(0));
-  ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  EXPECT_EQ(parameters->GetActiveGroup(),
+            opened->GetPoseEdits()->GetPoseSummary(openedPose).movableGroups.at(0));
+  ASSERT_EQ(opened->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << opened->GetLastErrorMessage();
-  EXPECT_EQ(opened->GetLivePose(), openedPose);
+  EXPECT_EQ(opened->GetLive()->GetLivePose(), openedPose);
   vtkNew<vtkSlicerReposeLogic> fromFile;
   ASSERT_TRUE(fromFile->LoadVolume(parameters->GetInputSegmentationPath()))
       << fromFile->GetLastErrorMessage();
@@ -324,15 +329,15 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportAboveTheMemoryBudgetIsRefusedWithTheN
   auto* seg = logic->AddSegmentation(coarse.G, coarse.S);
   auto* pose = logic->AddPose(suite("elbow90"));
   ASSERT_TRUE(seg && pose);
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded);
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded);
   auto* fine = logic->AddSegmentation(G3, S3);
   ASSERT_TRUE(fine);
   pose->SetNodeReferenceID("segmentation", fine->GetID());
 
   parameters->SetOutputMemoryBudgetMB(64);  // the 3 mm posed maps need about 84 MiB
   const std::string out = coarse.dir.file("out");
-  EXPECT_FALSE(logic->StartApplyPose(pose, out));
+  EXPECT_FALSE(logic->GetJobs()->StartApplyPose(pose, out));
   const std::string message = logic->GetLastErrorMessage();
   // The rule `repose pose` has (repose::checkFrameMemory): the posed volumes beside what the
   // process holds.
@@ -342,12 +347,12 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportAboveTheMemoryBudgetIsRefusedWithTheN
             std::string::npos)
       << message;
   EXPECT_EQ(message.find('\n'), std::string::npos);
-  EXPECT_FALSE(logic->IsJobRunning());
+  EXPECT_FALSE(logic->GetJobs()->IsJobRunning());
   EXPECT_FALSE(std::filesystem::exists(out));
 
   parameters->SetOutputMemoryBudgetMB(0);  // half the physical memory
-  ASSERT_TRUE(logic->StartApplyPose(pose, out)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartApplyPose(pose, out)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   EXPECT_TRUE(std::filesystem::exists(out + "/posed_G.nii.gz"));
 }
@@ -387,12 +392,12 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportsReportKeepsWhatTheReaderSaidAboutG) 
   EXPECT_EQ(seg->GetLabelMapReadNotes()[0].rfind(said, 0), 0u) << seg->GetLabelMapReadNotes()[0];
   auto* pose = logic->AddPose(suite("elbow90"));
   ASSERT_TRUE(pose) << logic->GetLastErrorMessage();
-  ASSERT_TRUE(logic->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartBuildRig(seg, pose)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   const std::string out = files.dir.file("posed");
-  ASSERT_TRUE(logic->StartApplyPose(pose, out));
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartApplyPose(pose, out));
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   EXPECT_EQ(notesOf(out + "/report.json"), seg->GetLabelMapReadNotes());
 
@@ -410,7 +415,7 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportsReportKeepsWhatTheReaderSaidAboutG) 
   vtkNew<vtkMRMLReposeParametersNode> openedParameters;
   opened->SetParameterNode(openedParameters);
   ASSERT_TRUE(opened->OpenScene(saved)) << opened->GetLastErrorMessage();
-  ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_EQ(opened->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << opened->GetLastErrorMessage();
   auto* openedSeg = vtkMRMLReposeSegmentationNode::SafeDownCast(
       opened->GetScene()->GetNodesByClass("vtkMRMLReposeSegmentationNode").at(0));
@@ -419,11 +424,11 @@ TEST(vtkSlicerReposeLogicPipeline, AnExportsReportKeepsWhatTheReaderSaidAboutG) 
   EXPECT_EQ(opened->GetVolumeSummary().find("Note: "), std::string::npos)
       << opened->GetVolumeSummary();
   const std::string reposed = files.dir.file("reposed");
-  ASSERT_TRUE(opened->StartApplyPose(
+  ASSERT_TRUE(opened->GetJobs()->StartApplyPose(
       vtkMRMLReposePoseNode::SafeDownCast(
           opened->GetScene()->GetNodesByClass("vtkMRMLReposePoseNode").at(0)),
       reposed));
-  ASSERT_EQ(opened->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_EQ(opened->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << opened->GetLastErrorMessage();
   EXPECT_TRUE(notesOf(reposed + "/report.json").empty());
 }
@@ -552,7 +557,7 @@ TEST(vtkSlicerReposeLogicPipeline, ASegmentationOfTheFileTheInputBoxShowsSharesI
   EXPECT_EQ(again->GetLabelMap(), logic->GetVolumeImageData());
   const std::string tissues = files.dir.file("tissues.csv");
   repose::writeTextFileAtomically(tissues, "label,name,density,rigid,bone\n1,skin,1100,0,0\n");
-  logic->SetTissueTablePath(tissues);
+  logic->GetParameterNode()->SetTissueTablePath(tissues);
   auto* named = logic->AddSegmentation(files.G, files.S);
   ASSERT_TRUE(named) << logic->GetLastErrorMessage();
   EXPECT_NE(named->GetLabelMap(), logic->GetVolumeImageData());
@@ -573,14 +578,14 @@ TEST(vtkSlicerReposeLogicPipeline, RigFromOrganMapWritesTheRigAndNamesTheLabels)
   logic->SetParameterNode(node);
 
   const std::string rig = dir.file("AF_rig");
-  ASSERT_TRUE(logic->StartRigFromOrganMap(G, rig)) << logic->GetLastErrorMessage();
-  ASSERT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobSucceeded)
+  ASSERT_TRUE(logic->GetJobs()->StartRigFromOrganMap(G, rig)) << logic->GetLastErrorMessage();
+  ASSERT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobSucceeded)
       << logic->GetLastErrorMessage();
   for (const char* f : {"S.nii.gz", "skeleton.json", "tissues.csv", "rig.json"})
     EXPECT_TRUE(std::filesystem::exists(rig + "/" + f)) << f;
   EXPECT_EQ(node->GetBodyPartMapPath(), rig + "/S.nii.gz");
-  EXPECT_EQ(logic->GetLastRigSummary().rfind("icrp110 (AF) convention, ", 0), 0u)
-      << logic->GetLastRigSummary();
+  EXPECT_EQ(logic->GetJobs()->GetLastRigSummary().rfind("icrp110 (AF) convention, ", 0), 0u)
+      << logic->GetJobs()->GetLastRigSummary();
 
   vtkMRMLReposeSegmentationNode* seg = logic->AddSegmentation(G, node->GetBodyPartMapPath());
   ASSERT_NE(seg, nullptr) << logic->GetLastErrorMessage();
@@ -595,15 +600,15 @@ TEST(vtkSlicerReposeLogicPipeline, RigFromOrganMapWritesTheRigAndNamesTheLabels)
   // A folder under a file cannot be made: the job fails, naming it; nothing else changes.
   node->SetBodyPartMapPath("");
   const std::string bad = G + "/rig";
-  ASSERT_TRUE(logic->StartRigFromOrganMap(G, bad)) << logic->GetLastErrorMessage();
-  EXPECT_EQ(logic->WaitForJob(), vtkSlicerReposeLogic::JobFailed);
+  ASSERT_TRUE(logic->GetJobs()->StartRigFromOrganMap(G, bad)) << logic->GetLastErrorMessage();
+  EXPECT_EQ(logic->GetJobs()->WaitForJob(), vtkSlicerReposeJobsLogic::JobFailed);
   EXPECT_NE(logic->GetLastErrorMessage().find(bad), std::string::npos)
       << logic->GetLastErrorMessage();
   EXPECT_EQ(logic->GetLastErrorMessage().find('\n'), std::string::npos);
   EXPECT_EQ(node->GetBodyPartMapPath(), "");
   // An image is no organ map.
   repose::writeVolume(repose::syntheticCT(organs), dir.file("CT.nii.gz"));
-  EXPECT_FALSE(logic->StartRigFromOrganMap(dir.file("CT.nii.gz"), dir.file("ct_rig")));
+  EXPECT_FALSE(logic->GetJobs()->StartRigFromOrganMap(dir.file("CT.nii.gz"), dir.file("ct_rig")));
   EXPECT_NE(logic->GetLastErrorMessage().find("not a label map"), std::string::npos)
       << logic->GetLastErrorMessage();
   EXPECT_FALSE(std::filesystem::exists(dir.file("ct_rig")));

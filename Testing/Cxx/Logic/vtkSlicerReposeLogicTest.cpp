@@ -179,9 +179,14 @@ TEST(vtkSlicerReposeLogic, FollowsParameterNode) {
   ASSERT_TRUE(logic->LoadVolume(nifti));
   EXPECT_EQ(node->GetInputSegmentationPath(), nifti);
 
+  // Without a node given, the logic takes a new one of its own (its state lives in a node) and
+  // follows it: the old node is no longer observed.
   logic->SetParameterNode(nullptr);
-  node->SetInputSegmentationPath(path);  // no longer observed
-  EXPECT_EQ(logic->GetVolumePath(), nifti);
+  ASSERT_NE(logic->GetParameterNode(), nullptr);
+  EXPECT_NE(logic->GetParameterNode(), node.GetPointer());
+  EXPECT_EQ(logic->GetVolumePath(), "");  // the new node names no input
+  node->SetInputSegmentationPath(path);   // no longer observed
+  EXPECT_EQ(logic->GetVolumePath(), "");
 }
 
 // A label map with no colour table (a NIfTI from another tool): every label present gets its own

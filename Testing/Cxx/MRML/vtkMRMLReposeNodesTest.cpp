@@ -23,6 +23,12 @@
 
 namespace {
 
+// A pose file's text (docs/POSES.md): one group turned, the rest fixed.
+constexpr const char* kPoseText = R"({"format": "repose-pose", "version": 1, "name": "p",
+  "groups": [{"name": "raise", "select": {"cage_vertices": [0, 1]},
+              "rotation": {"axis": [1, 0, 0], "angle_deg": 30, "pivot": [0, 0, 0]}},
+             {"name": "body", "select": {"rest": true}, "fixed": true}]})";
+
 struct ModifiedCounter {
   explicit ModifiedCounter(vtkObject* object) {
     callback->SetClientData(&count);
@@ -129,11 +135,21 @@ std::vector<NodeCase> cases() {
          auto* p = vtkMRMLReposePoseNode::SafeDownCast(n);
          p->SetFileName("elbow.pose.json");
          p->SetCurrentFrame(3);
-         p->SetPoseJSON(R"({"format": "repose-pose"})");
+         std::string error;
+         ASSERT_TRUE(p->SetPoseJSON(kPoseText, &error)) << error;
+         // Text that is no pose is refused with the parser's line; the pose stays.
+         const auto before = p->GetPose();
+         EXPECT_FALSE(p->SetPoseJSON(R"({"format": "repose-pose"})", &error));
+         EXPECT_NE(error.find("version"), std::string::npos) << error;
+         EXPECT_EQ(p->GetPose(), before);
        },
        [](vtkMRMLReposeNode* a, vtkMRMLReposeNode* b) {
-         EXPECT_EQ(vtkMRMLReposePoseNode::SafeDownCast(a)->GetPoseJSON(),
-                   vtkMRMLReposePoseNode::SafeDownCast(b)->GetPoseJSON());
+         auto *x = vtkMRMLReposePoseNode::SafeDownCast(a),
+              *y = vtkMRMLReposePoseNode::SafeDownCast(b);
+         ASSERT_TRUE(x->GetPose());
+         EXPECT_EQ(x->GetPose(), y->GetPose());  // one immutable snapshot, shared
+         EXPECT_EQ(x->GetPoseJSON(), y->GetPoseJSON());
+         EXPECT_NE(y->GetPoseJSON().find("\"raise\""), std::string::npos);
        },
        R"({"CurrentFrame": 1.5})", "CurrentFrame"},
   };

@@ -21,6 +21,10 @@ inline constexpr char kBuiltFor[] = "built_for";
 // rig files the command line wrote, so a file replaced or edited by hand later is noticed; a
 // scene the workbench saved has none, and its files are taken as they are.
 inline constexpr char kFileStamps[] = "file_stamps";
+// The module's parameter node (vtkMRMLReposeParametersNode's JSON: the panel's inputs, settings
+// and results), so a scene the workbench saved reopens with the panel as it was. Core's scene
+// folders neither write nor read it.
+inline constexpr char kParameters[] = "parameters";
 
 // Members of every node. Files are relative to the scene folder unless absolute.
 inline constexpr char kClass[] = "class";
@@ -40,6 +44,9 @@ inline constexpr char kLabelMapFile[] = "LabelMapFileName";        // G
 inline constexpr char kBodyPartMapFile[] = "BodyPartMapFileName";  // S
 inline constexpr char kImageFile[] = "ImageFileName";              // optional, on G's grid
 inline constexpr char kSkeleton[] = "SkeletonJSON";                // the rig's joints, as text
+// A posed segmentation's export: its report.json (text) and the job's warnings (array of text).
+inline constexpr char kPoseReport[] = "PoseReportJSON";
+inline constexpr char kPoseWarnings[] = "PoseWarnings";
 }  // namespace segmentation
 
 namespace cage {
@@ -56,6 +63,11 @@ namespace transfer_mesh {
 inline constexpr char kClassName[] = "vtkMRMLReposeTransferMeshNode";
 inline constexpr char kFile[] = "FileName";  // .vtu; its Green coordinates beside it (.green)
 inline constexpr char kSizeMm[] = "SizeMm";
+// A mesh refined for a pose (seed section 4.2): the vertices of the mesh it was refined from, and
+// per round its vertices and maximum error e^G (arrays); absent for a mesh built whole.
+inline constexpr char kRefinedFromVertices[] = "RefinedFromVertices";
+inline constexpr char kRefinementVertices[] = "RefinementVertices";
+inline constexpr char kRefinementMaxErrors[] = "RefinementMaxErrors";
 }  // namespace transfer_mesh
 
 namespace pose {

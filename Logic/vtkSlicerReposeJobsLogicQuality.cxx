@@ -1,7 +1,10 @@
-// The last export's quality as the panel shows it: report.json's "quality" checks turned into
+// The last export's quality as the panel shows it (from the report its segmentation node keeps):
+// report.json's "quality" checks turned into
 // rows (what was measured, the target, met or not) and its per-label volume changes. The report
 // is the one `repose pose` writes (Core pose/PoseReport.cpp); the rows say the same in words.
-#include "vtkSlicerReposeLogic.h"
+#include "vtkSlicerReposeJobsLogic.h"
+
+#include "vtkMRMLReposeSegmentationNode.h"
 
 #include <nlohmann/json.hpp>
 
@@ -19,10 +22,12 @@ std::string percent(double v) {
 
 }  // namespace
 
-std::vector<vtkSlicerReposeLogic::QualityCheck> vtkSlicerReposeLogic::GetLastPoseQuality() const {
+std::vector<vtkSlicerReposeJobsLogic::QualityCheck> vtkSlicerReposeJobsLogic::GetLastPoseQuality()
+    const {
   std::vector<QualityCheck> rows;
-  if (this->LastPoseReport.empty()) return rows;
-  const nlohmann::json report = nlohmann::json::parse(this->LastPoseReport, nullptr, false);
+  const vtkMRMLReposeSegmentationNode* posed = this->GetLastPosedSegmentation();
+  if (!posed || posed->GetPoseReportJSON().empty()) return rows;
+  const nlohmann::json report = nlohmann::json::parse(posed->GetPoseReportJSON(), nullptr, false);
   if (report.is_discarded() || !report.contains("quality")) return rows;
   const nlohmann::json& q = report["quality"];
   auto met = [&](const char* key) { return q[key].value("met", false); };
@@ -68,11 +73,12 @@ std::vector<vtkSlicerReposeLogic::QualityCheck> vtkSlicerReposeLogic::GetLastPos
   return rows;
 }
 
-std::vector<vtkSlicerReposeLogic::LabelChange> vtkSlicerReposeLogic::GetLastPoseLabelChanges()
-    const {
+std::vector<vtkSlicerReposeJobsLogic::LabelChange>
+vtkSlicerReposeJobsLogic::GetLastPoseLabelChanges() const {
   std::vector<LabelChange> out;
-  if (this->LastPoseReport.empty()) return out;
-  const nlohmann::json report = nlohmann::json::parse(this->LastPoseReport, nullptr, false);
+  const vtkMRMLReposeSegmentationNode* posed = this->GetLastPosedSegmentation();
+  if (!posed || posed->GetPoseReportJSON().empty()) return out;
+  const nlohmann::json report = nlohmann::json::parse(posed->GetPoseReportJSON(), nullptr, false);
   if (report.is_discarded() || !report.contains("labels")) return out;
   for (const nlohmann::json& row : report["labels"]) {
     // The change the deformation makes beyond resampling, as the quality check counts it.

@@ -78,10 +78,16 @@ TEST(RigidHandles, CageGroupsReachThroughTheBodyWithAWeightBetweenZeroAndOne) {
     EXPECT_GE(m, 0.0);
     EXPECT_LE(m, 1.0);
     EXPECT_EQ(w, handleBlendWeight(m));
-    if (x >= 90) EXPECT_EQ(w, 1.0) << x;
-    if (x <= 30) EXPECT_EQ(w, 0.0) << x;
+    if (x >= 90) {
+      EXPECT_EQ(w, 1.0) << x;
+    }
+    if (x <= 30) {
+      EXPECT_EQ(w, 0.0) << x;
+    }
     rigid += m == 1.0, none += w == 0.0;
-    if (x >= 95) EXPECT_GT(m, 0.9) << x;
+    if (x >= 95) {
+      EXPECT_GT(m, 0.9) << x;
+    }
   }
   EXPECT_EQ(rigid, inf.rigidVertices());
   EXPECT_GT(none, 0);
@@ -104,8 +110,12 @@ TEST(RigidHandles, BlendedMotionsTurnAboutTheSameJoint) {
     EXPECT_LT((m * joint - joint).norm(), 1e-12) << t;
     const Eigen::AngleAxisd turn(m.linear());
     const double angle = turn.angle() * (turn.axis().dot(axis) < 0 ? -1 : 1);
-    if (angle != 0) EXPECT_LT((turn.axis().cwiseAbs() - axis.cwiseAbs()).norm(), 1e-9) << t;
-    if (t == 0 || t == 0.5 || t == 1) EXPECT_NEAR(angle, t * M_PI / 2, 1e-12) << t;
+    if (angle != 0) {
+      EXPECT_LT((turn.axis().cwiseAbs() - axis.cwiseAbs()).norm(), 1e-9) << t;
+    }
+    if (t == 0 || t == 0.5 || t == 1) {
+      EXPECT_NEAR(angle, t * M_PI / 2, 1e-12) << t;
+    }
     EXPECT_GT(angle, previous);
     previous = angle;
   }
@@ -173,8 +183,12 @@ TEST(RigidHandles, JointRingsWidenTheTransitionOnly) {
       EXPECT_GE(m, 0.0);
       EXPECT_LE(m, 1.0);
       if (m > 0 && m < 1) lo = std::min(lo, x), hi = std::max(hi, x);
-      if (x >= 50 + 5 * (rings + 1)) EXPECT_EQ(m, 1.0) << rings << " " << x;
-      if (x <= 50 - 5 * (rings + 1)) EXPECT_EQ(m, 0.0) << rings << " " << x;
+      if (x >= 50 + 5 * (rings + 1)) {
+        EXPECT_EQ(m, 1.0) << rings << " " << x;
+      }
+      if (x <= 50 - 5 * (rings + 1)) {
+        EXPECT_EQ(m, 0.0) << rings << " " << x;
+      }
     }
     EXPECT_NEAR(lo, 50 - 5 * rings, 1e-9) << rings;
     EXPECT_NEAR(hi, 50 + 5 * rings, 1e-9) << rings;
@@ -224,6 +238,7 @@ TEST(RigidHandles, WholePiecesMoveWithTheGroupCarryingMostOfThem) {
   bar.mesh.rigid.clear();
   const HandleInfluence plain = computeHandleInfluence(bar.mesh, bar.cage, {limb, body});
   for (Eigen::Index v = 0; v < bar.mesh.vertices.rows(); ++v)
-    if (bar.mesh.vertices(v, 0) > 40.1 && bar.mesh.vertices(v, 0) < 49.9)
+    if (bar.mesh.vertices(v, 0) > 40.1 && bar.mesh.vertices(v, 0) < 49.9) {
       EXPECT_EQ(plain.membership(v, 0), 0.0);
+    }
 }

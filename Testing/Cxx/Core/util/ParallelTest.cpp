@@ -84,7 +84,9 @@ TEST(Parallel, AnExceptionComesBackAfterEveryWorkerHasFinished) {
       FAIL() << "no exception";
     } catch (const std::runtime_error& e) {
       EXPECT_EQ(finished.load(), callerThrows ? 3 : 1);
-      if (callerThrows) EXPECT_STREQ(e.what(), "chunk 0");
+      if (callerThrows) {
+        EXPECT_STREQ(e.what(), "chunk 0");
+      }
     }
   }
 }
