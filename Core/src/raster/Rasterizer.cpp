@@ -968,30 +968,29 @@ VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d&
   return g;
 }
 
-Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
-                       const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
-                       const RasterOptions& options, RasterReport* report) {
-  checkDeformation(mesh, deformed);
-  output.validate("rasterizer output grid");
-  const ScanInput in = raster::makeScanInput(mesh, deformed, labels.geometry(), output);
-  Volume out(output, labels.scalarType(), labels.layers());
-  out.setLabelMap(true);
-  out.labels() = labels.labels();
-  const auto d = labels.dims();
-  const std::int64_t nx = output.dims[0], ny = output.dims[1], plane = nx * ny;
-  Shell shell = makeShell(mesh, labels.geometry(), output, options);
-  shell.claimsBackground = false;
-  // The voxels the pieces carry (this map holds the pieces' labels). Soft tissue that samples
-  // one of them (a piece's rim lying in a soft tet) where it has moved away from that piece
-  // (a bend beside the piece) would copy the piece beside the place the piece itself puts it,
-  // so it takes the tissue around instead; where it moves with the piece it keeps it.
-  const std::vector<std::int32_t> owner = options.pieceLabels == &labels
-                                              ? pieceOwnerTets(mesh, labels.geometry(), options)
-                                              : std::vector<std::int32_t>();
-  // Each piece tet's map back from output IJK to rest (input IJK): where the piece itself would
-  // sample an output voxel.
+namespace {
+
+// What the label scan of one map, mesh, frame and grid sets up once: the scan's input, the shell
+// and the pieces' rims, and for a map that holds the pieces (RasterOptions::pieceLabels) each rest
+// voxel's piece tet and each piece tet's map back from output IJK to rest (input IJK).
+struct LabelScanSetup {
+  ScanInput in;
+  Shell shell;
+  std::vector<std::int32_t> owner;
   std::vector<Eigen::Matrix<double, 3, 4>> pieceBack;
-  if (!owner.empty()) {
+
+  LabelScanSetup(const Volume& labels, const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                 const VolumeGeometry& output, const RasterOptions& options)
+      : in(raster::makeScanInput(mesh, deformed, labels.geometry(), output)),
+        shell(makeShell(mesh, labels.geometry(), output, options)) {
+    shell.claimsBackground = false;
+    // The voxels the pieces carry (this map holds the pieces' labels). Soft tissue that samples
+    // one of them (a piece's rim lying in a soft tet) where it has moved away from that piece
+    // (a bend beside the piece) would copy the piece beside the place the piece itself puts it,
+    // so it takes the tissue around instead; where it moves with the piece it keeps it.
+    if (options.pieceLabels == &labels && !mesh.rigid.empty())
+      owner = pieceOwnerTets(mesh, labels.geometry(), options);
+    if (owner.empty()) return;
     pieceBack.resize(std::size_t(mesh.tets.rows()));
     for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
       if (!mesh.rigid[std::size_t(t)]) continue;
@@ -1007,110 +1006,144 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
           in.rest[std::size_t(mesh.tets(t, 0))] - B * in.out[std::size_t(mesh.tets(t, 0))];
     }
   }
+};
+
+// The rest voxel output voxel (i,j,k) samples, at rest position p in tet `tet`: the nearest one,
+// or, where soft tissue would copy a piece's voxel the piece has moved away from, the most common
+// value around it that no piece owns.
+template <class T>
+struct LabelSource {
+  const LabelScanSetup& setup;
+  const TransferMesh& mesh;
+  const T* src;  // layer 0: what the votes count
+  std::array<std::int64_t, 3> d;
+
   // Whether the piece owning rest voxel `at` would sample another rest voxel at output voxel
   // (i,j,k): then the piece does not put `at` here (its own tets and rim put it where it does),
   // and a soft tet that samples `at` here would copy the piece beside itself. Decided in the
   // input's voxels, whatever the output grid (a thick-slice map posed onto 1 mm).
-  auto movedAway = [&](std::int64_t at, std::int64_t i, std::int64_t j, std::int64_t k) {
-    const std::int32_t p = owner[std::size_t(at)];
+  bool movedAway(std::int64_t at, std::int64_t i, std::int64_t j, std::int64_t k) const {
+    const std::int32_t p = setup.owner[std::size_t(at)];
     if (p < 0) return false;
     const Eigen::Vector3d x(double(at % d[0]), double((at / d[0]) % d[1]),
                             double(at / (d[0] * d[1])));
+    const Eigen::Matrix<double, 3, 4>& back = setup.pieceBack[std::size_t(p)];
     const Eigen::Vector3d r =
-        pieceBack[std::size_t(p)].leftCols<3>() * Eigen::Vector3d(double(i), double(j), double(k)) +
-        pieceBack[std::size_t(p)].col(3);
+        back.leftCols<3>() * Eigen::Vector3d(double(i), double(j), double(k)) + back.col(3);
     return (r - x).cwiseAbs().maxCoeff() > 0.5;
+  }
+  // The most common value around `at` that no piece owns (`at` itself if there is none), looking
+  // one voxel around first, then two.
+  std::int64_t aroundPiece(std::int64_t at) const {
+    const std::int64_t x = at % d[0], y = (at / d[0]) % d[1], z = at / (d[0] * d[1]);
+    for (int r = 1; r <= 2; ++r) {
+      std::map<double, int> votes;
+      std::map<double, std::int64_t> where;
+      for (int c = -r; c <= r; ++c)
+        for (int b = -r; b <= r; ++b)
+          for (int a = -r; a <= r; ++a) {
+            const std::int64_t u = x + a, v = y + b, w = z + c;
+            if (u < 0 || v < 0 || w < 0 || u >= d[0] || v >= d[1] || w >= d[2]) continue;
+            const std::int64_t n = u + d[0] * (v + d[1] * w);
+            if (setup.owner[std::size_t(n)] >= 0) continue;
+            const double value = double(src[n]);
+            if (++votes[value] == 1) where[value] = n;
+          }
+      std::int64_t best = -1;
+      int most = 0;
+      for (const auto& [value, n] : votes)
+        if (n > most) most = n, best = where[value];
+      if (best >= 0) return best;
+    }
+    return at;
+  }
+  std::int64_t operator()(std::int64_t i, std::int64_t j, std::int64_t k, const Eigen::Vector3d& p,
+                          std::int32_t tet) const {
+    std::int64_t at = nearestVoxel(p, d);
+    if (at >= 0 && !setup.owner.empty() && !mesh.rigid[std::size_t(tet)] && movedAway(at, i, j, k))
+      at = aroundPiece(at);
+    return at;
+  }
+};
+
+// Output slices [k0, k1) of the labels into `dst` (per layer, (k1 - k0) slices from slice k0).
+// Each thread notes (output voxel, input voxel) pairs and copies them in batches, the input
+// voxels prefetched a few copies ahead: the voxels a slice or a slab samples lie scattered over
+// G, and copying each as it is found waits on memory once per voxel.
+template <class T>
+void scanLabels(const LabelScanSetup& setup, const RasterOptions& options,
+                const LabelSource<T>& source, const std::vector<const T*>& src,
+                const std::vector<T*>& dst, const VolumeGeometry& output, std::int64_t k0,
+                std::int64_t k1, RasterReport* report) {
+  constexpr std::size_t kBatch = 4096;
+  const std::int64_t nx = output.dims[0], plane = nx * output.dims[1];
+  struct Copies {
+    const LabelSource<T>& source;
+    const std::vector<const T*>& src;
+    const std::vector<T*>& dst;
+    std::int64_t plane, nx, k0;
+    std::vector<std::int64_t> to, from;
+    void operator()(std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                    Eigen::Vector3d p, const Eigen::Vector3d& step, std::int32_t tet) {
+      const std::int64_t row = (k - k0) * plane + j * nx;
+      for (std::int64_t i = i0; i <= i1; ++i, p += step) {
+        to.push_back(row + i);
+        from.push_back(source(i, j, k, p, tet));
+      }
+      if (to.size() >= kBatch) flush();
+    }
+    void flush() {
+      constexpr std::size_t kAhead = 16;
+      const std::size_t n = to.size();
+      for (std::size_t c = 0; c < std::min(n, kAhead); ++c)
+        if (from[c] >= 0) __builtin_prefetch(src[0] + from[c]);
+      for (std::size_t c = 0; c < n; ++c) {
+        if (c + kAhead < n && from[c + kAhead] >= 0) __builtin_prefetch(src[0] + from[c + kAhead]);
+        for (std::size_t l = 0; l < src.size(); ++l)
+          dst[l][to[c]] = from[c] >= 0 ? src[l][from[c]] : T(0);
+      }
+      to.clear(), from.clear();
+    }
   };
+  struct LabelWriter {
+    const LabelSource<T>& source;
+    const std::vector<const T*>& src;
+    const std::vector<T*>& dst;
+    std::int64_t plane, nx, k0;
+    Copies worker() const {
+      Copies c{source, src, dst, plane, nx, k0, {}, {}};
+      c.to.reserve(kBatch + 1024), c.from.reserve(kBatch + 1024);
+      return c;
+    }
+  };
+  runScan(setup.in, setup.shell, options, "rasterize labels", report, frameSign(output),
+          LabelWriter{source, src, dst, plane, nx, k0}, k0, k1);
+}
+
+}  // namespace
+
+Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
+                       const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                       const RasterOptions& options, RasterReport* report) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  const LabelScanSetup setup(labels, mesh, deformed, output, options);
+  Volume out(output, labels.scalarType(), labels.layers());
+  out.setLabelMap(true);
+  out.labels() = labels.labels();
   dispatchScalar(labels.scalarType(), [&](auto* tag) {
     using T = std::remove_pointer_t<decltype(tag)>;
     const int layers = labels.layers();
     std::vector<const T*> src(layers);
     std::vector<T*> dst(layers);
     for (int l = 0; l < layers; ++l) src[l] = labels.data<T>(l), dst[l] = out.data<T>(l);
-    // The most common value around `at` that no piece owns (`at` itself if there is none),
-    // looking one voxel around first, then two.
-    auto aroundPiece = [&](std::int64_t at) {
-      const std::int64_t x = at % d[0], y = (at / d[0]) % d[1], z = at / (d[0] * d[1]);
-      for (int r = 1; r <= 2; ++r) {
-        std::map<double, int> votes;
-        std::map<double, std::int64_t> where;
-        for (int c = -r; c <= r; ++c)
-          for (int b = -r; b <= r; ++b)
-            for (int a = -r; a <= r; ++a) {
-              const std::int64_t u = x + a, v = y + b, w = z + c;
-              if (u < 0 || v < 0 || w < 0 || u >= d[0] || v >= d[1] || w >= d[2]) continue;
-              const std::int64_t n = u + d[0] * (v + d[1] * w);
-              if (owner[std::size_t(n)] >= 0) continue;
-              const double value = double(src[0][n]);
-              if (++votes[value] == 1) where[value] = n;
-            }
-        std::int64_t best = -1;
-        int most = 0;
-        for (const auto& [value, n] : votes)
-          if (n > most) most = n, best = where[value];
-        if (best >= 0) return best;
-      }
-      return at;
-    };
-    // The rest voxel output voxel (i,j,k) samples, at rest position p in tet `tet`.
-    auto sourceOf = [&](std::int64_t i, std::int64_t j, std::int64_t k, const Eigen::Vector3d& p,
-                        std::int32_t tet) {
-      std::int64_t at = nearestVoxel(p, d);
-      if (at >= 0 && !owner.empty() && !mesh.rigid[std::size_t(tet)] && movedAway(at, i, j, k))
-        at = aroundPiece(at);
-      return at;
-    };
-    // Each thread notes (output voxel, input voxel) pairs and copies them in batches, the input
-    // voxels prefetched a few copies ahead: the voxels a slice or a slab samples lie scattered
-    // over G, and copying each as it is found waits on memory once per voxel.
-    constexpr std::size_t kBatch = 4096;
-    struct Copies {
-      decltype(sourceOf)& source;
-      const std::vector<const T*>& src;
-      const std::vector<T*>& dst;
-      std::int64_t plane, nx;
-      std::vector<std::int64_t> to, from;
-      void operator()(std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
-                      Eigen::Vector3d p, const Eigen::Vector3d& step, std::int32_t tet) {
-        const std::int64_t row = k * plane + j * nx;
-        for (std::int64_t i = i0; i <= i1; ++i, p += step) {
-          to.push_back(row + i);
-          from.push_back(source(i, j, k, p, tet));
-        }
-        if (to.size() >= kBatch) flush();
-      }
-      void flush() {
-        constexpr std::size_t kAhead = 16;
-        const std::size_t n = to.size();
-        for (std::size_t c = 0; c < std::min(n, kAhead); ++c)
-          if (from[c] >= 0) __builtin_prefetch(src[0] + from[c]);
-        for (std::size_t c = 0; c < n; ++c) {
-          if (c + kAhead < n && from[c + kAhead] >= 0)
-            __builtin_prefetch(src[0] + from[c + kAhead]);
-          for (std::size_t l = 0; l < src.size(); ++l)
-            dst[l][to[c]] = from[c] >= 0 ? src[l][from[c]] : T(0);
-        }
-        to.clear(), from.clear();
-      }
-    };
-    struct LabelWriter {
-      decltype(sourceOf)& source;
-      const std::vector<const T*>& src;
-      const std::vector<T*>& dst;
-      std::int64_t plane, nx;
-      Copies worker() const {
-        Copies c{source, src, dst, plane, nx, {}, {}};
-        c.to.reserve(kBatch + 1024), c.from.reserve(kBatch + 1024);
-        return c;
-      }
-    };
-    runScan(in, shell, options, "rasterize labels", report, frameSign(output),
-            LabelWriter{sourceOf, src, dst, plane, nx});
+    const LabelSource<T> source{setup, mesh, src[0], labels.dims()};
+    scanLabels<T>(setup, options, source, src, dst, output, 0, output.dims[2], report);
     if (options.preserveLabelVolumes) {
       if constexpr (std::is_integral_v<T>) {
         if (layers == 1)
-          roundLabelVolumes<T>(labels, mesh, deformed, in, shell, options, output, dst[0], sourceOf,
-                               report);
+          roundLabelVolumes<T>(labels, mesh, deformed, setup.in, setup.shell, options, output,
+                               dst[0], source, report);
         else if (report)
           report->roundingSkipped = "a map of " + std::to_string(layers) + " layers";
       } else if (report) {
@@ -1119,6 +1152,63 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
     }
   });
   return out;
+}
+
+struct LabelSlabs::Impl {
+  const Volume& labels;
+  const TransferMesh& mesh;
+  VolumeGeometry output;
+  RasterOptions options;
+  LabelScanSetup setup;
+  Impl(const Volume& l, const TransferMesh& m, const Eigen::MatrixX3d& deformed,
+       const VolumeGeometry& grid, const RasterOptions& o)
+      : labels(l), mesh(m), output(grid), options(o), setup(l, m, deformed, grid, o) {
+    options.progress = nullptr;  // per slab (rasterize)
+  }
+};
+
+LabelSlabs::LabelSlabs(const Volume& labels, const TransferMesh& mesh,
+                       const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
+                       const RasterOptions& options) {
+  checkDeformation(mesh, deformed);
+  output.validate("rasterizer output grid");
+  impl_ = std::make_unique<Impl>(labels, mesh, deformed, output, options);
+}
+
+LabelSlabs::~LabelSlabs() = default;
+
+std::int64_t LabelSlabs::sliceBytes() const {
+  return impl_->output.dims[0] * impl_->output.dims[1] * impl_->labels.layers() *
+         static_cast<std::int64_t>(scalarSize(impl_->labels.scalarType()));
+}
+
+void LabelSlabs::rasterize(std::int64_t k0, std::int64_t k1, void* slab, RasterReport& report,
+                           const ProgressFn& progress) const {
+  const Impl& r = *impl_;
+  if (k0 < 0 || k1 > r.output.dims[2] || k0 >= k1)
+    throw Error("rasterizer: slab [" + std::to_string(k0) + ", " + std::to_string(k1) +
+                ") is not within the output's " + std::to_string(r.output.dims[2]) + " slices");
+  const std::int64_t plane = r.output.dims[0] * r.output.dims[1], values = plane * (k1 - k0);
+  RasterOptions options = r.options;
+  options.progress = progress;
+  dispatchScalar(r.labels.scalarType(), [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    const int layers = r.labels.layers();
+    std::vector<const T*> src(layers);
+    std::vector<T*> dst(layers);
+    for (int l = 0; l < layers; ++l)
+      src[l] = r.labels.data<T>(l), dst[l] = static_cast<T*>(slab) + l * values;
+    std::fill(dst[0], dst[0] + layers * values, T(0));
+    const LabelSource<T> source{r.setup, r.mesh, src[0], r.labels.dims()};
+    RasterReport part;
+    scanLabels<T>(r.setup, options, source, src, dst, r.output, k0, k1, &part);
+    report.voxelWrites += part.voxelWrites;
+    report.shellVoxels += part.shellVoxels;
+    report.invertedTets = part.invertedTets;
+    report.flatTets = part.flatTets;
+    for (std::int64_t v = 0; v < values; ++v)
+      if (dst[0][v] != T(0)) ++report.labelVoxels[static_cast<int>(dst[0][v])];
+  });
 }
 
 struct LabelSlabRasterizer::Impl {

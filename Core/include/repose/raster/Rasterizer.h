@@ -105,6 +105,32 @@ Volume rasterizeLabels(const Volume& labels, const TransferMesh& mesh,
                        const Eigen::MatrixX3d& deformed, const VolumeGeometry& output,
                        const RasterOptions& options = {}, RasterReport* report = nullptr);
 
+// The in-core label scan's step on its own: output slices [k0, k1) of `labels` (in memory) into a
+// caller's buffer, voxel for voxel what rasterizeLabels writes there before any label-volume
+// rounding (the shell, the pieces' rims and ghosts, soft tissue that does not copy a piece beside
+// it), on options.threads threads. Slabs are independent, so a frame too large for memory is
+// made slab by slab. Set-up (the scan's input, the shell, the pieces' owners) is done once;
+// `labels`, `mesh` and what `options` points to must outlive it. The buffer holds each layer's
+// (k1 - k0) slices one after the other (sliceBytes() per slice of all layers).
+class LabelSlabs {
+ public:
+  LabelSlabs(const Volume& labels, const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+             const VolumeGeometry& output, const RasterOptions& options = {});
+  ~LabelSlabs();
+  LabelSlabs(const LabelSlabs&) = delete;
+  LabelSlabs& operator=(const LabelSlabs&) = delete;
+
+  std::int64_t sliceBytes() const;
+  // Fills `slab` and adds its counts (voxel writes, shell voxels, layer 0's labelVoxels) to
+  // `report`. `progress` gets the fraction of this slab; false cancels.
+  void rasterize(std::int64_t k0, std::int64_t k1, void* slab, RasterReport& report,
+                 const ProgressFn& progress = {}) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // The out-of-core path's step on its own: output slices [k0, k1) of the same labels into a
 // caller's buffer. Slabs are independent, so callers can write them in any order: the file writer
 // (raster/RasterFile.h) in order, `repose warp --mpi` a rank's share of them. Set-up (the deformed

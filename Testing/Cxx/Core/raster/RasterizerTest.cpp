@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <cstring>
 #include <map>
 #include <numeric>
 #include <random>
@@ -73,6 +74,38 @@ const PhantomScene& phantomScene() {
     return p;
   }();
   return *s;
+}
+
+// A bone (label 5) filling a box meshed as tets: those beyond x = 14 are soft, and their far
+// vertices follow a shear (the other side of a bent joint) instead of the bone's turn `motion`.
+struct BoneEnd {
+  TransferMesh mesh;
+  Eigen::Isometry3d motion;
+  Eigen::MatrixX3d deformed;
+  int softTets = 0;
+};
+BoneEnd boneEndInSoftTets() {
+  BoneEnd b;
+  b.mesh = tetBox({2, 2, 2}, {20, 11, 11}, {6, 3, 3});
+  b.mesh.rigid.assign(std::size_t(b.mesh.tets.rows()), 0);
+  for (Eigen::Index t = 0; t < b.mesh.tets.rows(); ++t) {
+    double x = 0;
+    for (int c = 0; c < 4; ++c) x += b.mesh.vertices(b.mesh.tets(t, c), 0) / 4;
+    if (x < 14)
+      b.mesh.rigid[std::size_t(t)] = 5;
+    else
+      ++b.softTets;
+  }
+  b.motion = Eigen::Translation3d(14, 12, 6) * Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()) *
+             Eigen::Translation3d(-2, -6, -6);
+  b.deformed = b.mesh.vertices;
+  for (Eigen::Index v = 0; v < b.deformed.rows(); ++v) {
+    const Eigen::Vector3d p = b.mesh.vertices.row(v).transpose();
+    Eigen::Vector3d q = b.motion * p;
+    if (p.x() > 14) q.y() -= 0.8 * (p.x() - 14);  // the joint's side: sheared
+    b.deformed.row(v) = q.transpose();
+  }
+  return b;
 }
 
 // Expected output: the label of G at the rest position rest(c) of each output voxel centre c.
@@ -634,6 +667,84 @@ TEST(Rasterizer, OutOfCoreEqualsInCoreVoxelForVoxel) {
   EXPECT_THROW(SliceCache(dir.file("G.nii"), 10), Error);  // cannot hold two slices
 }
 
+// In-core slabs (LabelSlabs, what a frame too large for memory is made of): every slab size and
+// thread count gives the whole grid's voxels and counts, with whole pieces, their rims and ghosts
+// and soft tissue kept from copying a piece (a bone end in soft tets, pieces' map given), and on
+// the 4 mm phantom's elbow flexion, a map of two layers included.
+TEST(Rasterizer, InCoreSlabsEqualTheWholeGridWithPiecesAndRims) {
+  auto check = [](const Volume& G, const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                  const VolumeGeometry& grid, RasterOptions options, const std::string& what) {
+    for (const int threads : {1, 2}) {
+      options.threads = threads;
+      RasterReport whole;
+      const Volume expected = rasterizeLabels(G, mesh, deformed, grid, options, &whole);
+      const LabelSlabs slabs(G, mesh, deformed, grid, options);
+      const std::int64_t plane = grid.dims[0] * grid.dims[1], nz = grid.dims[2];
+      ASSERT_EQ(slabs.sliceBytes(), plane * G.layers() * std::int64_t(scalarSize(G.scalarType())));
+      for (const std::int64_t size : {1, 3, 7}) {
+        Volume assembled(grid, G.scalarType(), G.layers());
+        RasterReport sum;
+        std::vector<std::uint8_t> slab(std::size_t(slabs.sliceBytes() * size));
+        const std::int64_t valueBytes = std::int64_t(scalarSize(G.scalarType()));
+        for (std::int64_t k0 = 0; k0 < nz; k0 += size) {
+          const std::int64_t k1 = std::min(nz, k0 + size);
+          slabs.rasterize(k0, k1, slab.data(), sum);
+          for (int l = 0; l < G.layers(); ++l)
+            std::memcpy(
+                static_cast<std::uint8_t*>(assembled.layerData(l)) + k0 * plane * valueBytes,
+                slab.data() + l * (k1 - k0) * plane * valueBytes,
+                std::size_t((k1 - k0) * plane * valueBytes));
+        }
+        const std::string at = what + ", slabs of " + std::to_string(size) + ", " +
+                               std::to_string(threads) + " thread(s)";
+        for (int l = 0; l < G.layers(); ++l)
+          EXPECT_EQ(std::memcmp(assembled.layerData(l), expected.layerData(l),
+                                std::size_t(grid.numVoxels() * valueBytes)),
+                    0)
+              << at << ", layer " << l;
+        EXPECT_EQ(sum.voxelWrites, whole.voxelWrites) << at;
+        EXPECT_EQ(sum.shellVoxels, whole.shellVoxels) << at;
+        EXPECT_GT(sum.voxelWrites, 0) << at;
+      }
+    }
+    RasterReport unused;
+    EXPECT_THROW(LabelSlabs(G, mesh, deformed, grid, options).rasterize(3, 2, nullptr, unused),
+                 Error);  // an empty slab
+  };
+
+  // A bone whose end lies in soft tets, sheared beyond the joint (ABoneEndInSoftTetsMovesWith
+  // TheBone): pieces, rims, ghosts and the soft tissue around them.
+  {
+    const BoneEnd b = boneEndInSoftTets();
+    const TransferMesh& mesh = b.mesh;
+    const Eigen::MatrixX3d& deformed = b.deformed;
+    const VolumeGeometry grid = unitGrid({36, 36, 14});
+    Volume G(grid, ScalarType::UInt8), S(grid, ScalarType::UInt8);
+    for (std::int64_t k = 2; k < 11; ++k)
+      for (std::int64_t j = 2; j < 11; ++j)
+        for (std::int64_t i = 2; i < 20; ++i)
+          G.data<std::uint8_t>()[G.index(i, j, k)] = i < 6 ? 7 : 5,
+                                               S.data<std::uint8_t>()[S.index(i, j, k)] = 1;
+    RasterOptions options;
+    options.pieceLabels = &G;
+    options.restParts = &S;
+    check(G, mesh, deformed, grid, options, "a bone end in soft tets");
+  }
+  // The phantom's elbow flexed 60 degrees, on the grid `repose pose` makes for it; G and S as
+  // the two layers of one map.
+  {
+    const PhantomScene& s = phantomScene();
+    const Eigen::MatrixX3d deformed =
+        s.deformation->deform(phantomElbowFlexion(s.phantom, s.cage, 60));
+    const VolumeGeometry grid = deformedGrid(s.organs.geometry(), deformed);
+    check(s.organs, s.mesh, deformed, grid, {}, "the phantom's elbow");
+    Volume both(s.organs.geometry(), ScalarType::UInt8, 2);
+    std::memcpy(both.layerData(0), s.organs.layerData(0), std::size_t(s.organs.numVoxels()));
+    std::memcpy(both.layerData(1), s.parts.layerData(0), std::size_t(s.parts.numVoxels()));
+    check(both, s.mesh, deformed, grid, {}, "two layers");
+  }
+}
+
 // Two boxes of tets from different rest places (label 1 and label 2 of G) deformed onto the same
 // place: the later box wins, unless the earlier one is a whole piece (a bone), which always does.
 TEST(Rasterizer, AWholePieceKeepsItsVoxelsWhereSoftTissueFoldsOverIt) {
@@ -667,28 +778,11 @@ TEST(Rasterizer, AWholePieceKeepsItsVoxelsWhereSoftTissueFoldsOverIt) {
 // voxel lands where the bone's own motion puts it; without the pieces' label map the soft end
 // bends with the joint.
 TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
-  TransferMesh mesh = tetBox({2, 2, 2}, {20, 11, 11}, {6, 3, 3});
-  mesh.rigid.assign(std::size_t(mesh.tets.rows()), 0);
-  int soft = 0;
-  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
-    double x = 0;
-    for (int c = 0; c < 4; ++c) x += mesh.vertices(mesh.tets(t, c), 0) / 4;
-    if (x < 14)
-      mesh.rigid[std::size_t(t)] = 5;
-    else
-      ++soft;
-  }
-  ASSERT_GT(soft, 0);
-  const Eigen::Isometry3d motion = Eigen::Translation3d(14, 12, 6) *
-                                   Eigen::AngleAxisd(0.35, Eigen::Vector3d::UnitZ()) *
-                                   Eigen::Translation3d(-2, -6, -6);
-  Eigen::MatrixX3d deformed = mesh.vertices;
-  for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
-    const Eigen::Vector3d p = mesh.vertices.row(v).transpose();
-    Eigen::Vector3d q = motion * p;
-    if (p.x() > 14) q.y() -= 0.8 * (p.x() - 14);  // the joint's side: sheared
-    deformed.row(v) = q.transpose();
-  }
+  const BoneEnd b = boneEndInSoftTets();
+  ASSERT_GT(b.softTets, 0);
+  const TransferMesh& mesh = b.mesh;
+  const Eigen::Isometry3d& motion = b.motion;
+  const Eigen::MatrixX3d& deformed = b.deformed;
   const VolumeGeometry grid = unitGrid({36, 36, 14});
   Volume G(grid, ScalarType::UInt8), S(grid, ScalarType::UInt8);
   for (std::int64_t k = 2; k < 11; ++k)
