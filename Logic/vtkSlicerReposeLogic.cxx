@@ -33,9 +33,7 @@ vtkSlicerReposeLogic::vtkSlicerReposeLogic()
       Jobs(vtkSmartPointer<vtkSlicerReposeJobsLogic>::New()),
       Live(vtkSmartPointer<vtkSlicerReposeLiveLogic>::New()),
       PoseEdits(vtkSmartPointer<vtkSlicerReposePoseEditLogic>::New()) {
-  this->Context->Jobs = this->Jobs;
   this->Context->Live = this->Live;
-  this->Context->Edits = this->PoseEdits;
   this->Jobs->SetContext(this->Context);
   this->Live->SetContext(this->Context);
   this->PoseEdits->SetContext(this->Context);
@@ -55,9 +53,7 @@ vtkSlicerReposeLogic::~vtkSlicerReposeLogic() {
                           static_cast<vtkObject*>(this->PoseEdits)})
     part->RemoveObservers(vtkCommand::ModifiedEvent);
   this->Live->ReleaseLivePose();
-  this->Context->Jobs = nullptr;
   this->Context->Live = nullptr;
-  this->Context->Edits = nullptr;
 }
 
 vtkMRMLReposeParametersNode* vtkSlicerReposeLogic::GetParameterNode() const {

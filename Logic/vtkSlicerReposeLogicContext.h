@@ -14,19 +14,17 @@
 #include <new>
 #include <string>
 
-class vtkSlicerReposeJobsLogic;
 class vtkSlicerReposeLiveLogic;
-class vtkSlicerReposePoseEditLogic;
 
 struct vtkSlicerReposeLogicContext {
   vtkSmartPointer<vtkMRMLReposeScene> Scene = vtkSmartPointer<vtkMRMLReposeScene>::New();
   vtkSmartPointer<vtkMRMLReposeParametersNode> ParameterNode;
   std::unique_ptr<vtkSlicerReposeJob> Job = std::make_unique<vtkSlicerReposeJob>();
   std::string LastErrorMessage;
-  // The parts, owned by the module's logic (null once it is gone).
-  vtkSlicerReposeJobsLogic* Jobs = nullptr;
+  // The live part, which the jobs (a refinement adapts to its frame) and the pose edits (a group
+  // from the live cage; a joint stops live posing) consult. Owned by the module's logic; null
+  // once it is gone.
   vtkSlicerReposeLiveLogic* Live = nullptr;
-  vtkSlicerReposePoseEditLogic* Edits = nullptr;
 
   std::string TissueTablePath() const {
     return this->ParameterNode ? this->ParameterNode->GetTissueTablePath() : std::string();

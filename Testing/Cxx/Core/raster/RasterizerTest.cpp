@@ -83,6 +83,9 @@ struct BoneEnd {
   Eigen::Isometry3d motion;
   Eigen::MatrixX3d deformed;
   int softTets = 0;
+  // The bone's labels (G, label `bone`) and its body part (S, label 1) on a 36 x 36 x 14 grid.
+  VolumeGeometry grid;
+  Volume G, S;
 };
 BoneEnd boneEndInSoftTets() {
   BoneEnd b;
@@ -105,6 +108,13 @@ BoneEnd boneEndInSoftTets() {
     if (p.x() > 14) q.y() -= 0.8 * (p.x() - 14);  // the joint's side: sheared
     b.deformed.row(v) = q.transpose();
   }
+  b.grid = unitGrid({36, 36, 14});
+  b.G = Volume(b.grid, ScalarType::UInt8), b.S = Volume(b.grid, ScalarType::UInt8);
+  for (std::int64_t k = 2; k < 11; ++k)
+    for (std::int64_t j = 2; j < 11; ++j)
+      for (std::int64_t i = 2; i < 20; ++i)
+        b.G.data<std::uint8_t>()[b.G.index(i, j, k)] = 5,
+                                                 b.S.data<std::uint8_t>()[b.S.index(i, j, k)] = 1;
   return b;
 }
 
@@ -716,15 +726,14 @@ TEST(Rasterizer, InCoreSlabsEqualTheWholeGridWithPiecesAndRims) {
   // TheBone): pieces, rims, ghosts and the soft tissue around them.
   {
     const BoneEnd b = boneEndInSoftTets();
-    const TransferMesh& mesh = b.mesh;
-    const Eigen::MatrixX3d& deformed = b.deformed;
-    const VolumeGeometry grid = unitGrid({36, 36, 14});
-    Volume G(grid, ScalarType::UInt8), S(grid, ScalarType::UInt8);
+    Volume G = b.G;  // two labels in the bone: its end beyond x = 6 another
     for (std::int64_t k = 2; k < 11; ++k)
       for (std::int64_t j = 2; j < 11; ++j)
-        for (std::int64_t i = 2; i < 20; ++i)
-          G.data<std::uint8_t>()[G.index(i, j, k)] = i < 6 ? 7 : 5,
-                                               S.data<std::uint8_t>()[S.index(i, j, k)] = 1;
+        for (std::int64_t i = 2; i < 6; ++i) G.data<std::uint8_t>()[G.index(i, j, k)] = 7;
+    const TransferMesh& mesh = b.mesh;
+    const Eigen::MatrixX3d& deformed = b.deformed;
+    const VolumeGeometry& grid = b.grid;
+    const Volume& S = b.S;
     RasterOptions options;
     options.pieceLabels = &G;
     options.restParts = &S;
@@ -783,12 +792,8 @@ TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
   const TransferMesh& mesh = b.mesh;
   const Eigen::Isometry3d& motion = b.motion;
   const Eigen::MatrixX3d& deformed = b.deformed;
-  const VolumeGeometry grid = unitGrid({36, 36, 14});
-  Volume G(grid, ScalarType::UInt8), S(grid, ScalarType::UInt8);
-  for (std::int64_t k = 2; k < 11; ++k)
-    for (std::int64_t j = 2; j < 11; ++j)
-      for (std::int64_t i = 2; i < 20; ++i)
-        G.data<std::uint8_t>()[G.index(i, j, k)] = 5, S.data<std::uint8_t>()[S.index(i, j, k)] = 1;
+  const VolumeGeometry& grid = b.grid;
+  const Volume &G = b.G, &S = b.S;
   const Volume expected =
       mapDirectly(G, grid, [&](const Eigen::Vector3d& ras) { return motion.inverse() * ras; });
   auto dice = [&](const Volume& posed) {
