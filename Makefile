@@ -76,12 +76,14 @@ clean:
 .PHONY: bench bench-large bench-micro bench-sweep bench-warp-mpi
 # Benchmarks: speed is measured here, never in unit tests (docs/PERFORMANCE.md).
 # `make bench`: every figure against its baseline at three sizes (< 15 min); results and plot in
-# $(BUILD_DIR)/bench. `make bench-large` adds the seed's scales (~120M, ~260M, ~860M out of core).
+# $(BUILD_DIR)/bench. `make bench-large` adds the seed's scales (~120M, ~260M, ~860M out of core)
+# and the whole pose job on the reference grid at 1 mm and 0.5 mm, in core and slab by slab.
 bench: build
 	/usr/bin/python3 bench/run_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench
 
 bench-large: build
 	/usr/bin/python3 bench/run_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench --large
+	/usr/bin/python3 bench/pose_large_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench-pose-large
 
 # Posture-sweep throughput in one process and on 2 MPI ranks (docs/PERFORMANCE.md).
 bench-sweep: build

@@ -188,16 +188,28 @@ int runPose(const Args& args) {
               "(name = value lines)")
       .option("processinformationaddress", "ADDRESS",
               "passed by 3D Slicer to in-process modules; ignored")
+      .flag("out-of-core",
+            "make every frame slab by slab and write it as it goes, slabs sized to --memory "
+            "(what a frame whose posed volumes exceed --memory gets anyway): the same files "
+            "and report")
       .flag("slicer-progress",
             "progress as the <filter-progress> lines 3D Slicer's CLI modules print on stdout "
             "(the installed ReposePose module sets it)");
-  declareMemoryOption(p, "a pose that would need more is refused before the work");
+  declareMemoryOption(p,
+                      "a frame whose posed volumes need more is made slab by slab and written as "
+                      "it goes (the same files and report), unless --posed-labels, --posed-parts, "
+                      "--posed-image or --transform ask for it whole");
   if (!p.parse(args)) return 0;
   FrameOutputs single;
   single.labels = p.get("posed-labels"), single.parts = p.get("posed-parts");
   single.image = p.get("posed-image"), single.transform = p.get("transform");
   single.returnParameters = p.get("returnparameterfile");
   if (p.getInt("frame") < 0) throw UsageError{"--frame must be >= 0"};
+  if (p.has("out-of-core") && !(single.labels.empty() && single.parts.empty() &&
+                                single.image.empty() && single.transform.empty()))
+    throw UsageError{
+        "--out-of-core writes the frames into --out only: not with --posed-labels, "
+        "--posed-parts, --posed-image or --transform"};
   single.frame = static_cast<std::size_t>(p.getInt("frame"));
   for (const char* required : {"input", "parts", "pose"})
     if (!p.has(required)) throw UsageError{std::string("--") + required + " is required"};
@@ -328,7 +340,14 @@ int runPose(const Args& args) {
   run.preserveLabelVolumes = p.get("label-volumes") == "preserve";
   run.labelMapFiles = labelMapFiles;
   run.memoryBudget = budget;
-  run.budgetHint = "--memory; out of core: `repose warp`";
+  // A frame beyond the budget is made slab by slab into its folder (Core's poseFrameToFolder),
+  // unless a single-file output asks for the frame whole in memory.
+  run.outOfCore = single.labels.empty() && single.parts.empty() && single.image.empty() &&
+                  single.transform.empty();
+  run.alwaysOutOfCore = p.has("out-of-core");
+  run.budgetHint =
+      "--memory; without --posed-labels, --posed-parts, --posed-image and "
+      "--transform the frame is made slab by slab";
   run.sceneReused = reused;
   if (labelMapFiles == LabelMapFiles::DicomSeg)
     run.write.sourceDicom = dicomSourceOf(p.get("input"));
@@ -362,6 +381,11 @@ int runPose(const Args& args) {
       writeFrameOutputs(single, posed);
       if (!single.returnParameters.empty()) writeReturnParameters(single.returnParameters, report);
     }
+    if (outcome.streamed)
+      say(std::string("  made slab by slab") +
+          (run.alwaysOutOfCore ? " (--out-of-core): " : " (its posed volumes exceed --memory): ") +
+          std::to_string(report["streamed"]["slabs"].get<std::int64_t>()) + " slabs of " +
+          std::to_string(report["streamed"]["slab_slices"].get<std::int64_t>()) + " slices");
     const json& q = report["quality"];
     say("  body volume " + std::to_string(report["body"]["volume_change_percent"].get<double>()) +
         " %, worst label " +

@@ -250,6 +250,7 @@ void runJob(Worker& worker, std::int64_t t, std::size_t f, const TaskPlan& plan,
   run.memoryBudget = settings.budget;
   run.budgetWhat = record.folder;
   run.budgetHint = "--memory";
+  run.outOfCore = true;  // a frame beyond the budget is made slab by slab into its folder
   run.sceneReused = reused;
   if (run.labelMapFiles == LabelMapFiles::DicomSeg)
     run.write.sourceDicom = dicomSourceOf(worker.subject(t).organs);

@@ -173,6 +173,26 @@ Eigen::MatrixX3d verticesOf(const Eigen::MatrixX3d& v) {
   return v;
 }
 
+// A frame's run from the keyword arguments pose_frame and pose_frame_to_folder share.
+FrameRun frameRunOf(const Rig& r, const py::object& image, std::optional<double> background,
+                    double spacingMm, bool fillPockets, const std::string& labelVolumes,
+                    double memoryBytes, const std::string& call) {
+  FrameRun run;
+  run.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
+  run.background = background;
+  run.fillPockets = fillPockets;
+  if (labelVolumes != "preserve" && labelVolumes != "nearest")
+    throw Error("label_volumes must be 'preserve' or 'nearest', not '" + labelVolumes + "'");
+  run.preserveLabelVolumes = labelVolumes == "preserve";
+  run.spacingMm = spacingMm;
+  if (!(memoryBytes >= 0)) throw Error(call + ": memory_bytes must be >= 0");
+  run.memoryBudget = memoryBytes;
+  run.budgetWhat = call;
+  run.budgetHint = "memory_bytes=";
+  run.sceneReused = r.sceneReused;
+  return run;
+}
+
 }  // namespace
 
 void bindPoses(py::module_& m) {
@@ -470,20 +490,9 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
              bool fillPockets, const std::string& labelVolumes, double memoryBytes,
              const py::object& progress) {
             // The frame step is Core's (pose/PoseRun.h), as for `repose pose`.
-            FrameRun run;
-            run.image = image.is_none() ? nullptr : &image.cast<const Volume&>();
-            run.background = background;
-            run.fillPockets = fillPockets;
-            if (labelVolumes != "preserve" && labelVolumes != "nearest")
-              throw Error("label_volumes must be 'preserve' or 'nearest', not '" + labelVolumes +
-                          "'");
-            run.preserveLabelVolumes = labelVolumes == "preserve";
-            run.spacingMm = spacingMm;
-            if (!(memoryBytes >= 0)) throw Error("pose_frame: memory_bytes must be >= 0");
-            run.memoryBudget = memoryBytes;
-            run.budgetWhat = "pose_frame";
-            run.budgetHint = "memory_bytes=; out of core: pose_labels_to_file";
-            run.sceneReused = r.sceneReused;
+            FrameRun run = frameRunOf(r, image, background, spacingMm, fillPockets, labelVolumes,
+                                      memoryBytes, "pose_frame");
+            run.budgetHint = "memory_bytes=; or pose_frame_to_folder, which makes it slab by slab";
             std::vector<std::string> warnings;
             run.warn = [&](const std::string& line) { warnings.push_back(line); };
             FrameOutcome outcome = withProgress(progress, [&](const ProgressFn& fn) {
@@ -511,6 +520,43 @@ volume the deformation gives it, "nearest" leaves plain nearest-neighbour sampli
 image's minimum, air in a CT, as `repose pose --background min`). memory_bytes: the posed
 volumes beside what the process holds must fit in it (0: half the physical memory, as
 `repose pose --memory`), else an error with the numbers before anything is allocated.)doc")
+      .def(
+          "pose_frame_to_folder",
+          [](const Rig& r, const Volume& organs, const Volume& parts, const std::string& folder,
+             std::size_t index, const py::object& image, std::optional<double> background,
+             double spacingMm, bool fillPockets, const std::string& labelVolumes,
+             const std::string& format, double memoryBytes, const py::object& progress) {
+            // The frame step is Core's (pose/PoseRun.h), as for `repose pose`: beyond the budget
+            // the frame is made slab by slab into the folder.
+            FrameRun run = frameRunOf(r, image, background, spacingMm, fillPockets, labelVolumes,
+                                      memoryBytes, "pose_frame_to_folder");
+            run.budgetWhat = folder;
+            run.labelMapFiles = labelMapFilesFor(format, "");
+            run.folder = folder;
+            run.write.lockFolder = true;  // a `repose pose` writing there refuses, and so does this
+            run.outOfCore = true;
+            std::vector<std::string> warnings;
+            run.warn = [&](const std::string& line) { warnings.push_back(line); };
+            FrameOutcome outcome = withProgress(progress, [&](const ProgressFn& fn) {
+              run.progress = fn;
+              return runPoseFrame(*r.job, *r.rig, index, organs, parts, run);
+            });
+            if (!outcome.targetsMet)
+              warnings.push_back("it missed its targets: " + outcome.missedLine());
+            issueWarnings(outcome.frame.name, warnings);
+            return py::module_::import("json").attr("loads")(outcome.reportJson);
+          },
+          py::arg("organs"), py::arg("parts"), py::arg("folder"), py::arg("index") = 0,
+          py::kw_only(), py::arg("image") = py::none(), py::arg("background") = py::none(),
+          py::arg("spacing_mm") = 0.0, py::arg("fill_pockets") = true,
+          py::arg("label_volumes") = "preserve", py::arg("output_format") = "nii.gz",
+          py::arg("memory_bytes") = 0.0, py::arg("progress") = py::none(),
+          R"doc(Poses frame `index` at full resolution and writes it into `folder` as `repose pose`
+does (the files of PosedFrame.write, and report.json), returning the report. A frame whose posed
+volumes exceed memory_bytes (0: half the physical memory) is made slab by slab and written as it
+goes: the same files and report (plus "streamed"), whatever its size. output_format: 'nii.gz',
+'seg.nrrd' or 'both' ('dcmseg' only for a frame that fits). Refused while another Repose run
+writes into the folder.)doc")
       .def(
           "pose_labels_to_file",
           [](const Rig& r, const std::string& organsPath, const std::string& outPath,

@@ -257,6 +257,35 @@ def test_a_frame_beyond_the_memory_budget_is_refused_with_the_numbers(phantom, e
     assert "more than the memory budget of 0.000931 GiB" in message and "\n" not in message
 
 
+def test_a_frame_beyond_the_budget_is_written_slab_by_slab_into_its_folder(tmp_path, phantom,
+                                                                          elbow_rig):
+    """pose_frame_to_folder runs the frame as `repose pose` does: within the budget whole, beyond
+    it slab by slab (issue 56), with the same files and report either way."""
+    g, s = phantom["organs"], phantom["parts"]
+    whole = elbow_rig.pose_frame_to_folder(g, s, str(tmp_path / "whole"), spacing_mm=4.0,
+                                           image=phantom["image"], output_format="both")
+    assert "streamed" not in whole
+    # The process's resident set now, and a little more: the posed volumes do not fit.
+    with open("/proc/self/status") as status:
+        rss = next(int(l.split()[1]) * 1024 for l in status if l.startswith("VmRSS:"))
+    streamed = elbow_rig.pose_frame_to_folder(g, s, str(tmp_path / "slabs"), spacing_mm=4.0,
+                                              image=phantom["image"], output_format="both",
+                                              memory_bytes=rss + 8 * 2**20)
+    assert streamed["streamed"]["slabs"] > 1, streamed["streamed"]
+    del streamed["streamed"]
+    assert streamed == whole
+    for f in sorted((tmp_path / "whole").iterdir()):
+        a, b = f.read_bytes(), (tmp_path / "slabs" / f.name).read_bytes()
+        if f.suffix == ".ctbl":  # the first line names the file
+            a, b = a[a.index(b"\n"):], b[b.index(b"\n"):]
+        if f.name != "report.json":
+            assert a == b, f.name
+    # The same voxels as the frame posed in core.
+    frame = elbow_rig.pose_frame(g, s, spacing_mm=4.0, image=phantom["image"])
+    posed = np.asanyarray(nib.load(tmp_path / "slabs" / "posed_G.nii.gz").dataobj)
+    np.testing.assert_array_equal(posed, frame.organs.array)
+
+
 def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     g, s = phantom["organs"], phantom["parts"]
     frame = elbow_rig.pose_frame(g, s, spacing_mm=4.0, image=phantom["image"], background=-1000)

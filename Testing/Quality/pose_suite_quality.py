@@ -10,9 +10,13 @@ from each frame's report.json:
   its thigh across the gap; `arms_up160` must turn both shoulder girdles and `sitting` tilt the
   pelvis (the rhythms of docs/POSES.md).
 
+With `--out-of-core` each pose is posed again slab by slab (`repose pose --out-of-core` under a
+1.5 GiB budget, issue 56) and every file and report must equal the in-core frame's.
+
 usage: pose_suite_quality.py BIN_DIR POSES_DIR WORK_DIR [phantom options...]
        [--label-bound PERCENT]  the per-label bound beyond the floor (default 1, the target)
        [--suite NAME,NAME...]   the pose files of POSES_DIR to pose (default the standard suite)
+       [--out-of-core]          also slab by slab, compared file by file with the in-core frames
 
 Exits 1 naming every frame and target that fails.
 """
@@ -37,6 +41,40 @@ def run(args, allowed=(0,)):
     return r.stdout, r.returncode
 
 
+def same_out_of_core(repose, g, s, pose, out, frames, scene):
+    """The pose again slab by slab, its rig read from the scene the in-core run saved: every file
+    of every frame folder equal to the in-core one (the colour tables after their first line,
+    which names the file), every report too but for what says where the rig came from."""
+    slabs = out + "_slabs"
+    text, _ = run([repose, "pose", "--input", g, "--parts", s, "--pose", pose, "--out", slabs,
+                   "--json", "--out-of-core", "--memory", "1500M"] + scene,
+                  allowed=(0, EXIT_TARGETS_MISSED))
+    streamed = json.loads(text)
+    streamed = streamed.get("frames", [streamed])
+    failures = []
+    for f, g_ in zip(frames, streamed):
+        where = f"{f['pose']}/{f['frame']} out of core"
+        if "streamed" not in g_:
+            failures.append(f"{where}: not made slab by slab")
+            continue
+        slabs_of = g_.pop("streamed")["slabs"]
+        rig_keys = ("scene_reused", "green_coordinates")
+        if {k: v for k, v in g_.items() if k not in rig_keys} != \
+                {k: v for k, v in f.items() if k not in rig_keys}:
+            failures.append(f"{where}: the report differs from the in-core frame's")
+        one = len(frames) == 1
+        a = out if one else os.path.join(out, f["frame"])
+        b = slabs if one else os.path.join(slabs, f["frame"])
+        for name in sorted(os.listdir(a)):
+            x, y = open(os.path.join(a, name), "rb").read(), open(os.path.join(b, name), "rb").read()
+            if name.endswith(".ctbl"):
+                x, y = x[x.index(b"\n"):], y[y.index(b"\n"):]
+            if name != "report.json" and x != y:
+                failures.append(f"{where}: {name} differs from the in-core frame's")
+        print(f"{where}: {slabs_of} slabs, every file equal to the in-core frame's")
+    return failures
+
+
 def main():
     argv = sys.argv[1:]
     bound = 1.0
@@ -49,6 +87,9 @@ def main():
         i = argv.index("--suite")
         suite = argv[i + 1].split(",")
         del argv[i:i + 2]
+    out_of_core = "--out-of-core" in argv
+    if out_of_core:
+        argv.remove("--out-of-core")
     bin_dir, poses, work = argv[:3]
     phantom_args = argv[3:]
     gap_variant = "--gap-mm" in phantom_args
@@ -62,12 +103,18 @@ def main():
     failures, frames = [], 0
     for name in suite:
         out = os.path.join(work, name)
+        # With --out-of-core the rig is kept in a scene folder, which the run slab by slab reuses.
+        scene = ["--scene", os.path.join(work, "scene_" + name)] if out_of_core else []
         text, code = run([repose, "pose", "--input", g, "--parts",
                           os.path.join(rig, "S.nii.gz"), "--pose",
-                          os.path.join(poses, name + ".pose.json"), "--out", out, "--json"],
-                         allowed=(0, EXIT_TARGETS_MISSED))
+                          os.path.join(poses, name + ".pose.json"), "--out", out, "--json"]
+                         + scene, allowed=(0, EXIT_TARGETS_MISSED))
         report = json.loads(text)
         framesOf = report.get("frames", [report])
+        if out_of_core:
+            failures += same_out_of_core(repose, g, os.path.join(rig, "S.nii.gz"),
+                                         os.path.join(poses, name + ".pose.json"), out, framesOf,
+                                         scene)
         # The exit status and the reports agree: 4 exactly when some frame missed.
         missed = [f["frame"] for f in framesOf if not f["targets"]["met"]]
         if bool(missed) != (code == EXIT_TARGETS_MISSED):

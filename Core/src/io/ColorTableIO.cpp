@@ -31,12 +31,20 @@ std::string token(const std::string& name, int value) {
 }  // namespace
 
 void writeColorTable(const Volume& labelMap, const std::string& path) {
-  LabelTable labels = labelMap.labels();
+  std::vector<int> present;
   for (const LabelCount& c : countLabels(labelMap))
-    if (c.layer == 0 && !labels.find(c.value)) {
+    if (c.layer == 0) present.push_back(c.value);
+  writeColorTable(labelMap.labels(), present, path);
+}
+
+void writeColorTable(const LabelTable& table, const std::vector<int>& present,
+                     const std::string& path) {
+  LabelTable labels = table;
+  for (const int value : present)
+    if (value != 0 && !labels.find(value)) {
       Label l;
-      l.value = c.value;
-      l.color = LabelTable::defaultColor(c.value);
+      l.value = value;
+      l.color = LabelTable::defaultColor(value);
       l.colorGenerated = true;
       labels.set(l);
     }

@@ -1,6 +1,7 @@
 #include "repose/io/GzipPieces.h"
 
 #include "repose/util/Error.h"
+#include "repose/util/Parallel.h"
 
 #include <zlib.h>
 
@@ -73,6 +74,71 @@ std::uint32_t crc32Of(const void* data, std::size_t size, std::uint32_t crc) {
 
 std::uint32_t crc32Concat(std::uint32_t crcA, std::uint32_t crcB, std::uint64_t sizeB) {
   return static_cast<std::uint32_t>(crc32_combine(crcA, crcB, static_cast<z_off_t>(sizeB)));
+}
+
+GzipPieceStream::GzipPieceStream(std::FILE* file, std::string path, std::size_t pieceBytes)
+    : file_(file), path_(std::move(path)), piece_(pieceBytes) {
+  if (piece_ == 0) throw Error("gzip: pieces of 0 bytes");
+  put(gzipHeaderBytes());
+}
+
+void GzipPieceStream::put(const std::string& bytes) {
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size())
+    throwFileError(path_, "write failed (disk full?)");
+}
+
+void GzipPieceStream::deflateBatch(const std::vector<const char*>& pieces,
+                                   const std::vector<std::size_t>& sizes) {
+  std::vector<std::string> packed(pieces.size());
+  std::vector<std::uint32_t> crcs(pieces.size());
+  parallelFor(
+      std::int64_t(pieces.size()), 0,
+      [&](std::int64_t a, std::int64_t b) {
+        for (std::int64_t i = a; i < b; ++i) {
+          packed[std::size_t(i)] = deflatePiece(pieces[std::size_t(i)], sizes[std::size_t(i)]);
+          crcs[std::size_t(i)] = crc32Of(pieces[std::size_t(i)], sizes[std::size_t(i)]);
+        }
+      },
+      1);
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    crc_ = crc32Concat(crc_, crcs[i], sizes[i]);
+    put(packed[i]);
+  }
+}
+
+void GzipPieceStream::write(const void* data, std::size_t bytes) {
+  if (finished_) throw Error("gzip: written after its end");
+  const char* in = static_cast<const char*>(data);
+  total_ += bytes;
+  // A batch of pieces at a time, so the compressed copy stays small beside the data.
+  constexpr std::size_t kBatch = 16;
+  std::vector<const char*> pieces;
+  std::vector<std::size_t> sizes;
+  std::string first;  // the held partial piece completed, when there is one
+  if (!partial_.empty()) {
+    const std::size_t take = std::min(bytes, piece_ - partial_.size());
+    partial_.append(in, take);
+    in += take, bytes -= take;
+    if (partial_.size() < piece_) return;
+    first.swap(partial_);
+    pieces.push_back(first.data()), sizes.push_back(first.size());
+  }
+  // Whole pieces straight from the caller's data; the rest is held.
+  while (bytes >= piece_) {
+    pieces.push_back(in), sizes.push_back(piece_);
+    in += piece_, bytes -= piece_;
+    if (pieces.size() == kBatch) deflateBatch(pieces, sizes), pieces.clear(), sizes.clear();
+  }
+  if (!pieces.empty()) deflateBatch(pieces, sizes);
+  partial_.assign(in, bytes);
+}
+
+void GzipPieceStream::finish() {
+  if (finished_) return;
+  if (!partial_.empty()) deflateBatch({partial_.data()}, {partial_.size()});
+  partial_.clear();
+  put(gzipTrailerBytes(crc_, total_));
+  finished_ = true;
 }
 
 }  // namespace repose

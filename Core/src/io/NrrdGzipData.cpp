@@ -83,38 +83,10 @@ void writeGzipVoxels(const std::string& dataPath, bool append, const void* data,
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(
       std::fopen(dataPath.c_str(), append ? "ab" : "wb"), &std::fclose);
   if (!file) throwFileError(path, "cannot create the output file");
-  const auto put = [&](const std::string& bytesOut) {
-    if (std::fwrite(bytesOut.data(), 1, bytesOut.size(), file.get()) != bytesOut.size())
-      throwFileError(path, "write failed (disk full?)");
-  };
-  constexpr std::size_t kPiece = std::size_t(4) << 20;
-  const std::size_t pieces = (bytes + kPiece - 1) / kPiece;
-  const auto* in = static_cast<const char*>(data);
-  // A batch of pieces at a time, so the compressed copy stays small beside the volume.
-  constexpr std::size_t kBatch = 16;
-  std::vector<std::string> packed(kBatch);
-  std::vector<std::uint32_t> crcs(kBatch);
-  std::uint32_t crc = 0;
-  put(gzipHeaderBytes());
-  for (std::size_t first = 0; first < pieces; first += kBatch) {
-    const std::size_t n = std::min(kBatch, pieces - first);
-    const auto sizeOf = [&](std::size_t p) { return std::min(kPiece, bytes - p * kPiece); };
-    parallelFor(
-        std::int64_t(n), 0,
-        [&](std::int64_t a, std::int64_t b) {
-          for (std::int64_t i = a; i < b; ++i) {
-            const std::size_t p = first + std::size_t(i);
-            packed[std::size_t(i)] = deflatePiece(in + p * kPiece, sizeOf(p));
-            crcs[std::size_t(i)] = crc32Of(in + p * kPiece, sizeOf(p));
-          }
-        },
-        1);
-    for (std::size_t i = 0; i < n; ++i) {
-      crc = crc32Concat(crc, crcs[i], sizeOf(first + i));
-      put(packed[i]);
-    }
-  }
-  put(gzipTrailerBytes(crc, bytes));
+  // The same pieces as a volume streamed slab by slab (GzipPieceStream): the same bytes.
+  GzipPieceStream stream(file.get(), path);
+  stream.write(data, bytes);
+  stream.finish();
   if (std::fflush(file.get()) != 0) throwFileError(path, "write failed (disk full?)");
   if (std::fclose(file.release()) != 0) throwFileError(path, "write failed (disk full?)");
 }

@@ -3,6 +3,7 @@
 #include "repose/io/NrrdIO.h"
 
 #include "NrrdGzipData.h"
+#include "repose/io/GzipPieces.h"
 #include "NrrdHeaderCheck.h"
 #include "NrrdLoad.h"
 #include "ReaderCommon.h"
@@ -13,9 +14,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 
@@ -342,6 +345,36 @@ void saveNrrd(Nrrd* nrrd, NrrdIoState* nio, const std::string& file, const std::
 
 }  // namespace
 
+// A volume's header: `layers` (a list axis first when more than one) of `type` on `geometry`, in
+// LPS. `data` is wrapped, not owned.
+static void setVolumeHeader(Nrrd* nrrd, const VolumeGeometry& geometry, ScalarType type, int layers,
+                            void* data, const std::string& path) {
+  const auto& d = geometry.dims;
+  size_t sizes[4];
+  unsigned dim = 0;
+  if (layers > 1) sizes[dim++] = static_cast<size_t>(layers);
+  for (int a = 0; a < 3; ++a) sizes[dim++] = static_cast<size_t>(d[a]);
+  if (nrrdWrap_nva(nrrd, data, nrrdTypeFor(type), dim, sizes) != 0)
+    throwFileError(path, takeBiffMessage());
+  nrrdSpaceSet(nrrd, nrrdSpaceLeftPosteriorSuperior);
+  const Eigen::Matrix4d lps = flipLpsRas(geometry.ijkToRas);
+  double dirs[4][NRRD_SPACE_DIM_MAX];
+  int kinds[4];
+  unsigned axis = 0;
+  if (layers > 1) {
+    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[axis][r] = AIR_NAN;
+    kinds[axis++] = nrrdKindList;
+  }
+  for (int a = 0; a < 3; ++a, ++axis) {
+    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[axis][r] = r < 3 ? lps(r, a) : AIR_NAN;
+    kinds[axis] = nrrdKindDomain;
+  }
+  nrrdAxisInfoSet_nva(nrrd, nrrdAxisInfoSpaceDirection, dirs);
+  nrrdAxisInfoSet_nva(nrrd, nrrdAxisInfoKind, kinds);
+  const double origin[3] = {lps(0, 3), lps(1, 3), lps(2, 3)};
+  nrrdSpaceOriginSet(nrrd, origin);
+}
+
 void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions& options) {
   const bool segmentation = endsWith(path, ".seg.nrrd");
   if (segmentation && !isIntegerType(volume.scalarType()))
@@ -371,30 +404,7 @@ void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions
   std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), &nrrdNix);
   std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
                                                                    &nrrdIoStateNix);
-  const auto& d = volume.dims();
-  size_t sizes[4];
-  unsigned dim = 0;
-  if (layers > 1) sizes[dim++] = static_cast<size_t>(layers);
-  for (int a = 0; a < 3; ++a) sizes[dim++] = static_cast<size_t>(d[a]);
-  if (nrrdWrap_nva(nrrd.get(), data, nrrdTypeFor(volume.scalarType()), dim, sizes) != 0)
-    throwFileError(path, takeBiffMessage());
-  nrrdSpaceSet(nrrd.get(), nrrdSpaceLeftPosteriorSuperior);
-  const Eigen::Matrix4d lps = flipLpsRas(volume.geometry().ijkToRas);
-  double dirs[4][NRRD_SPACE_DIM_MAX];
-  int kinds[4];
-  unsigned axis = 0;
-  if (layers > 1) {
-    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[axis][r] = AIR_NAN;
-    kinds[axis++] = nrrdKindList;
-  }
-  for (int a = 0; a < 3; ++a, ++axis) {
-    for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[axis][r] = r < 3 ? lps(r, a) : AIR_NAN;
-    kinds[axis] = nrrdKindDomain;
-  }
-  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoSpaceDirection, dirs);
-  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoKind, kinds);
-  const double origin[3] = {lps(0, 3), lps(1, 3), lps(2, 3)};
-  nrrdSpaceOriginSet(nrrd.get(), origin);
+  setVolumeHeader(nrrd.get(), volume.geometry(), volume.scalarType(), layers, data, path);
   if (segmentation)
     for (const auto& [key, value] : segnrrd::formatSegments(volume))
       nrrdKeyValueAdd(nrrd.get(), key.c_str(), value.c_str());
@@ -404,44 +414,198 @@ void writeNrrd(const Volume& volume, const std::string& path, const WriteOptions
   reportProgress(options.progress, 1.0, "writing");
 }
 
-void writeDisplacementFieldNrrd(const std::vector<float>& rasVectors, const VolumeGeometry& grid,
-                                const std::string& path) {
-  grid.validate(path);
-  if (rasVectors.size() != static_cast<std::size_t>(3 * grid.numVoxels()))
-    throwFileError(path, "the displacement field does not match its grid");
-  AtomicOutput output(path);
-  std::vector<float> lps(rasVectors);
-  for (std::size_t v = 0; v < lps.size(); v += 3) lps[v] = -lps[v], lps[v + 1] = -lps[v + 1];
-  std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), &nrrdNix);
-  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
-                                                                   &nrrdIoStateNix);
+// The field's header: a float vector image in LPS, with what 3D Slicer needs to open it as a
+// transform. `data` is only wrapped (teem writes the header alone: skipData).
+static void setFieldHeader(Nrrd* nrrd, const VolumeGeometry& grid, void* data,
+                           const std::string& path) {
   size_t sizes[4] = {3, size_t(grid.dims[0]), size_t(grid.dims[1]), size_t(grid.dims[2])};
-  if (nrrdWrap_nva(nrrd.get(), lps.data(), nrrdTypeFloat, 4, sizes) != 0)
+  if (nrrdWrap_nva(nrrd, data, nrrdTypeFloat, 4, sizes) != 0)
     throwFileError(path, takeBiffMessage());
-  nrrdSpaceSet(nrrd.get(), nrrdSpaceLeftPosteriorSuperior);
+  nrrdSpaceSet(nrrd, nrrdSpaceLeftPosteriorSuperior);
   const Eigen::Matrix4d m = flipLpsRas(grid.ijkToRas);
   double dirs[4][NRRD_SPACE_DIM_MAX];
   for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[0][r] = AIR_NAN;
   for (int a = 0; a < 3; ++a)
     for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r) dirs[a + 1][r] = r < 3 ? m(r, a) : AIR_NAN;
   int kinds[4] = {nrrdKindVector, nrrdKindDomain, nrrdKindDomain, nrrdKindDomain};
-  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoSpaceDirection, dirs);
-  nrrdAxisInfoSet_nva(nrrd.get(), nrrdAxisInfoKind, kinds);
+  nrrdAxisInfoSet_nva(nrrd, nrrdAxisInfoSpaceDirection, dirs);
+  nrrdAxisInfoSet_nva(nrrd, nrrdAxisInfoKind, kinds);
   const double origin[3] = {m(0, 3), m(1, 3), m(2, 3)};
-  nrrdSpaceOriginSet(nrrd.get(), origin);
+  nrrdSpaceOriginSet(nrrd, origin);
   // What 3D Slicer needs to open it as a transform: qSlicerTransformsReader.cxx takes a 3D vector
   // image as a transform only with intent_code 1006 (NIfTI's displacement vector; else the
   // volumes reader wins and it opens as a vector volume); vtkMRMLTransformStorageNode.cxx reads
   // "displacement field type" resampling as a transform from parent (output -> input, as here,
   // never inverted) and refuses a measurement frame other than the identity.
-  if (nrrdKeyValueAdd(nrrd.get(), "intent_code", "1006") != 0 ||
-      nrrdKeyValueAdd(nrrd.get(), "displacement field type", "resampling") != 0)
+  if (nrrdKeyValueAdd(nrrd, "intent_code", "1006") != 0 ||
+      nrrdKeyValueAdd(nrrd, "displacement field type", "resampling") != 0)
     throwFileError(path, takeBiffMessage());
   for (int r = 0; r < NRRD_SPACE_DIM_MAX; ++r)
     for (int c = 0; c < NRRD_SPACE_DIM_MAX; ++c)
       nrrd->measurementFrame[r][c] = r < 3 && c < 3 ? (r == c ? 1.0 : 0.0) : AIR_NAN;
-  saveNrrd(nrrd.get(), nio.get(), output.tempPath(), path, true);
-  output.commit();
+}
+
+struct DisplacementFieldNrrdWriter::Impl {
+  VolumeGeometry grid;
+  std::string path;
+  AtomicOutput output;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file{nullptr, &std::fclose};
+  std::unique_ptr<GzipPieceStream> stream;
+  std::int64_t written = 0;  // slices
+  std::vector<float> lps;
+  Impl(const VolumeGeometry& g, const std::string& p) : grid(g), path(p), output(p) {}
+};
+
+DisplacementFieldNrrdWriter::DisplacementFieldNrrdWriter(const VolumeGeometry& grid,
+                                                         const std::string& path) {
+  grid.validate(path);
+  impl_ = std::make_unique<Impl>(grid, path);
+  std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), &nrrdNix);
+  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
+                                                                   &nrrdIoStateNix);
+  float unused = 0;
+  setFieldHeader(nrrd.get(), grid, &unused, path);
+  nio->encoding = nrrdEncodingGzip;
+  nio->skipData = AIR_TRUE;
+  const std::string& temp = impl_->output.tempPath();
+  if (nrrdSave(temp.c_str(), nrrd.get(), nio.get()) != 0) failedSave(nio.get(), path);
+  impl_->file.reset(std::fopen(temp.c_str(), "ab"));
+  if (!impl_->file) throwFileError(path, "cannot create the output file");
+  impl_->stream = std::make_unique<GzipPieceStream>(impl_->file.get(), path);
+}
+
+DisplacementFieldNrrdWriter::~DisplacementFieldNrrdWriter() = default;
+
+void DisplacementFieldNrrdWriter::writeSlices(const float* rasVectors, std::int64_t slices) {
+  Impl& r = *impl_;
+  if (slices <= 0 || r.written + slices > r.grid.dims[2])
+    throwFileError(r.path, "more slices of the displacement field than its grid holds");
+  const std::size_t n = std::size_t(3 * r.grid.dims[0] * r.grid.dims[1] * slices);
+  r.lps.assign(rasVectors, rasVectors + n);
+  for (std::size_t v = 0; v < n; v += 3) r.lps[v] = -r.lps[v], r.lps[v + 1] = -r.lps[v + 1];
+  r.stream->write(r.lps.data(), n * sizeof(float));
+  r.written += slices;
+}
+
+void DisplacementFieldNrrdWriter::finish() {
+  Impl& r = *impl_;
+  if (r.written != r.grid.dims[2])
+    throwFileError(r.path, "the displacement field ends after " + std::to_string(r.written) +
+                               " of its " + std::to_string(r.grid.dims[2]) + " slices");
+  r.stream->finish();
+  if (std::fflush(r.file.get()) != 0) throwFileError(r.path, "write failed (disk full?)");
+  if (std::fclose(r.file.release()) != 0) throwFileError(r.path, "write failed (disk full?)");
+  r.lps.clear(), r.lps.shrink_to_fit();
+  r.output.commit();
+}
+
+struct SegNrrdSlabWriter::Impl {
+  std::string path;
+  VolumeGeometry geometry;
+  ScalarType type;
+  int layers;
+  LabelTable labels;
+  AtomicOutput output;
+  std::string dataPath;  // the voxels' gzip pieces, beside the header being made
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file{nullptr, &std::fclose};
+  std::unique_ptr<GzipPieceStream> stream;
+  std::vector<segnrrd::Extents> extents;
+  std::vector<std::uint8_t> interleaved;
+  std::int64_t written = 0;
+  Impl(const std::string& p, const VolumeGeometry& g, ScalarType t, int l, const LabelTable& table)
+      : path(p), geometry(g), type(t), layers(l), labels(table), output(p) {}
+};
+
+SegNrrdSlabWriter::SegNrrdSlabWriter(const std::string& path, const VolumeGeometry& geometry,
+                                     ScalarType type, int layers, const LabelTable& labels) {
+  geometry.validate(path);
+  if (!isIntegerType(type))
+    throwFileError(path, "a segmentation needs integer labels, this volume is float32");
+  if (layers < 1) throwFileError(path, "a segmentation of no layer");
+  impl_ = std::make_unique<Impl>(path, geometry, type, layers, labels);
+  impl_->extents.resize(std::size_t(layers));
+  impl_->dataPath = impl_->output.tempPath() + ".voxels";
+  impl_->file.reset(std::fopen(impl_->dataPath.c_str(), "wb"));
+  if (!impl_->file) throwFileError(path, "cannot create the output file");
+  impl_->stream = std::make_unique<GzipPieceStream>(impl_->file.get(), path);
+}
+
+SegNrrdSlabWriter::~SegNrrdSlabWriter() {
+  if (impl_ && !impl_->dataPath.empty()) std::remove(impl_->dataPath.c_str());
+}
+
+void SegNrrdSlabWriter::writeSlices(const void* data, std::int64_t slices) {
+  Impl& r = *impl_;
+  const auto& d = r.geometry.dims;
+  if (slices <= 0 || r.written + slices > d[2])
+    throwFileError(r.path, "more slices than the segmentation's grid holds");
+  const std::size_t size = scalarSize(r.type);
+  const std::int64_t n = d[0] * d[1] * slices;
+  const auto* in = static_cast<const std::uint8_t*>(data);
+  for (int l = 0; l < r.layers; ++l)
+    segnrrd::addExtents(in + std::size_t(l * n) * size, r.type, d, r.written, r.written + slices,
+                        r.extents[std::size_t(l)]);
+  if (r.layers == 1) {
+    r.stream->write(data, std::size_t(n) * size);
+  } else {
+    // The file's layout: the layer index fastest.
+    r.interleaved.resize(std::size_t(n * r.layers) * size);
+    for (int l = 0; l < r.layers; ++l)
+      for (std::int64_t v = 0; v < n; ++v)
+        std::memcpy(&r.interleaved[std::size_t(v * r.layers + l) * size],
+                    in + std::size_t(l * n + v) * size, size);
+    r.stream->write(r.interleaved.data(), r.interleaved.size());
+  }
+  r.written += slices;
+}
+
+void SegNrrdSlabWriter::finish() {
+  Impl& r = *impl_;
+  if (r.written != r.geometry.dims[2])
+    throwFileError(r.path, "the segmentation ends after " + std::to_string(r.written) + " of its " +
+                               std::to_string(r.geometry.dims[2]) + " slices");
+  r.stream->finish();
+  if (std::fflush(r.file.get()) != 0 || std::fclose(r.file.release()) != 0)
+    throwFileError(r.path, "write failed (disk full?)");
+  // The header, now that the segments' extents are known, then the voxels after it.
+  std::unique_ptr<Nrrd, Nrrd* (*)(Nrrd*)> nrrd(nrrdNew(), &nrrdNix);
+  std::unique_ptr<NrrdIoState, NrrdIoState* (*)(NrrdIoState*)> nio(nrrdIoStateNew(),
+                                                                   &nrrdIoStateNix);
+  std::uint8_t unused = 0;
+  setVolumeHeader(nrrd.get(), r.geometry, r.type, r.layers, &unused, r.path);
+  for (const auto& [key, value] :
+       segnrrd::formatSegments(r.geometry, r.layers, r.labels, r.extents))
+    nrrdKeyValueAdd(nrrd.get(), key.c_str(), value.c_str());
+  nio->encoding = nrrdEncodingGzip;
+  nio->skipData = AIR_TRUE;
+  const std::string& temp = r.output.tempPath();
+  if (nrrdSave(temp.c_str(), nrrd.get(), nio.get()) != 0) failedSave(nio.get(), r.path);
+  {
+    std::ifstream in(r.dataPath, std::ios::binary);
+    std::ofstream out(temp, std::ios::binary | std::ios::app);
+    out << in.rdbuf();
+    out.flush();
+    if (!in || !out) throwFileError(r.path, "write failed (disk full?)");
+  }
+  std::remove(r.dataPath.c_str());
+  r.dataPath.clear();
+  r.interleaved.clear(), r.interleaved.shrink_to_fit();
+  r.output.commit();
+}
+
+void writeDisplacementFieldNrrd(const std::vector<float>& rasVectors, const VolumeGeometry& grid,
+                                const std::string& path) {
+  grid.validate(path);
+  if (rasVectors.size() != static_cast<std::size_t>(3 * grid.numVoxels()))
+    throwFileError(path, "the displacement field does not match its grid");
+  // Written in slabs of about 64 MiB (one writer for both: the same bytes either way), so the
+  // LPS copy stays small beside the field.
+  DisplacementFieldNrrdWriter writer(grid, path);
+  const std::int64_t plane = grid.dims[0] * grid.dims[1];
+  const std::int64_t slab = std::max<std::int64_t>(1, (std::int64_t(64) << 20) / (12 * plane));
+  for (std::int64_t k0 = 0; k0 < grid.dims[2]; k0 += slab)
+    writer.writeSlices(rasVectors.data() + 3 * k0 * plane, std::min(slab, grid.dims[2] - k0));
+  writer.finish();
 }
 
 }  // namespace repose

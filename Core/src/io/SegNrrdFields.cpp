@@ -25,37 +25,6 @@ int parseInt(const std::string& s, const std::string& key, const std::string& pa
   return static_cast<int>(v);
 }
 
-using Extent = std::array<std::int64_t, 6>;
-
-// Bounding boxes (imin imax jmin jmax kmin kmax) of every value of one layer, in one pass.
-std::map<int, Extent> extentsOf(const Volume& volume, int layer) {
-  std::map<int, Extent> out;
-  if (!isIntegerType(volume.scalarType())) return out;
-  const auto& d = volume.dims();
-  dispatchScalar(volume.scalarType(), [&](auto* tag) {
-    using T = std::remove_pointer_t<decltype(tag)>;
-    const T* v = volume.data<T>(layer);
-    std::int64_t idx = 0;
-    for (std::int64_t k = 0; k < d[2]; ++k)
-      for (std::int64_t j = 0; j < d[1]; ++j)
-        for (std::int64_t i = 0; i < d[0]; ++i, ++idx) {
-          if (v[idx] == 0) continue;
-          const int value = static_cast<int>(v[idx]);
-          auto [it, fresh] = out.try_emplace(value, Extent{i, i, j, j, k, k});
-          if (!fresh) {
-            Extent& e = it->second;
-            e[0] = std::min(e[0], i);
-            e[1] = std::max(e[1], i);
-            e[2] = std::min(e[2], j);
-            e[3] = std::max(e[3], j);
-            e[4] = std::min(e[4], k);
-            e[5] = std::max(e[5], k);
-          }
-        }
-  });
-  return out;
-}
-
 }  // namespace
 
 bool hasSegmentFields(const std::map<std::string, std::string>& kv) {
@@ -97,10 +66,46 @@ LabelTable parseSegments(const std::map<std::string, std::string>& kv, const std
   return table;
 }
 
+void addExtents(const void* slices, ScalarType type, const std::array<std::int64_t, 3>& d,
+                std::int64_t k0, std::int64_t k1, Extents& out) {
+  dispatchScalar(type, [&](auto* tag) {
+    using T = std::remove_pointer_t<decltype(tag)>;
+    if constexpr (std::is_integral_v<T>) {
+      const T* v = static_cast<const T*>(slices);
+      std::int64_t idx = 0;
+      for (std::int64_t k = k0; k < k1; ++k)
+        for (std::int64_t j = 0; j < d[1]; ++j)
+          for (std::int64_t i = 0; i < d[0]; ++i, ++idx) {
+            if (v[idx] == 0) continue;
+            const int value = static_cast<int>(v[idx]);
+            auto [it, fresh] = out.try_emplace(value, Extent{i, i, j, j, k, k});
+            if (!fresh) {
+              Extent& e = it->second;
+              e[0] = std::min(e[0], i);
+              e[1] = std::max(e[1], i);
+              e[2] = std::min(e[2], j);
+              e[3] = std::max(e[3], j);
+              e[4] = std::min(e[4], k);
+              e[5] = std::max(e[5], k);
+            }
+          }
+    }
+  });
+}
+
 KeyValues formatSegments(const Volume& volume) {
+  std::vector<Extents> extents(std::size_t(volume.layers()));
+  for (int layer = 0; layer < volume.layers(); ++layer)
+    addExtents(volume.layerData(layer), volume.scalarType(), volume.dims(), 0, volume.dims()[2],
+               extents[std::size_t(layer)]);
+  return formatSegments(volume.geometry(), volume.layers(), volume.labels(), extents);
+}
+
+KeyValues formatSegments(const VolumeGeometry& grid, int layers, const LabelTable& labels,
+                         const std::vector<Extents>& extents) {
   KeyValues out;
-  const Eigen::Matrix4d& m = volume.geometry().ijkToRas;
-  const auto& d = volume.dims();
+  const Eigen::Matrix4d& m = grid.ijkToRas;
+  const auto& d = grid.dims;
   std::ostringstream geometry;
   geometry.precision(17);
   for (int r = 0; r < 4; ++r)
@@ -117,17 +122,14 @@ KeyValues formatSegments(const Volume& volume) {
   out.emplace_back("Segmentation_MasterRepresentation", "Binary labelmap");
   out.emplace_back("Segmentation_ReferenceImageExtentOffset", "0 0 0");
 
-  std::vector<std::map<int, Extent>> extents;
-  for (int layer = 0; layer < volume.layers(); ++layer) extents.push_back(extentsOf(volume, layer));
   // A segment for every label of the table (a label a pose lost stays listed, empty) and for every
   // value present; a value the table does not name gets a generated name and colour, marked so.
   std::vector<std::pair<Label, bool>> segments;  // (label, name generated)
-  for (const Label& l : volume.labels().labels())
-    if (l.value != 0 && l.layer >= 0 && l.layer < volume.layers())
-      segments.emplace_back(l, l.name.empty());
-  for (int layer = 0; layer < volume.layers(); ++layer)
-    for (const auto& [value, extent] : extents[layer]) {
-      if (volume.labels().find(value, layer)) continue;
+  for (const Label& l : labels.labels())
+    if (l.value != 0 && l.layer >= 0 && l.layer < layers) segments.emplace_back(l, l.name.empty());
+  for (int layer = 0; layer < layers; ++layer)
+    for (const auto& [value, extent] : extents[std::size_t(layer)]) {
+      if (labels.find(value, layer)) continue;
       Label l;
       l.value = value;
       l.layer = layer;
@@ -146,9 +148,10 @@ KeyValues formatSegments(const Volume& volume) {
     std::ostringstream color;
     color << l.color[0] << " " << l.color[1] << " " << l.color[2];
     // An empty segment's extent is min > max, as Slicer writes it with a zero offset.
-    const auto e = extents[l.layer].find(l.value);
+    const Extents& layerExtents = extents[std::size_t(l.layer)];
+    const auto e = layerExtents.find(l.value);
     std::ostringstream extent;
-    if (e == extents[l.layer].end())
+    if (e == layerExtents.end())
       extent << "0 -1 0 -1 0 -1";
     else
       for (int i = 0; i < 6; ++i) extent << (i ? " " : "") << e->second[i];

@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
 
 #include <Eigen/SVD>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <type_traits>
 
@@ -24,64 +26,6 @@ double quantile(std::vector<double> v, double q) {
   return v[k];
 }
 
-struct DiceCounts {
-  std::map<int, std::int64_t> posed, expected, both, rest;
-};
-
-// For one group: per label of G, the voxels inside the group's parts (S) of the posed maps, of
-// the rest maps seen through the group's motion (nearest rest voxel at motion^-1 of each posed
-// voxel centre: the analytically posed copy), of both, and of the rest maps themselves.
-template <class TG, class TS>
-DiceCounts countForGroup(const Volume& G, const Volume& S, const Volume& PG, const Volume& PS,
-                         const RigidHandle& h) {
-  DiceCounts c;
-  std::vector<char> inParts(1 << 16, 0);
-  for (const int p : h.parts)
-    if (p >= 0 && p < (1 << 16)) inParts[p] = 1;
-  auto partOf = [&](auto s) {
-    return s >= 0 && std::int64_t(s) < (1 << 16) && inParts[std::size_t(s)];
-  };
-  const TG *g = G.data<TG>(), *pg = PG.data<TG>();
-  const TS *sp = S.data<TS>(), *ps = PS.data<TS>();
-  for (std::int64_t i = 0; i < G.numVoxels(); ++i)
-    if (partOf(sp[i])) ++c.rest[int(g[i])];
-  const auto d = PG.dims(), rd = G.dims();
-  // Posed voxel (i,j,k) -> rest continuous index, affine: one matrix for the whole grid.
-  const Eigen::Matrix4d toRest =
-      G.geometry().ijkToRas.inverse() * h.motion.inverse().matrix() * PG.geometry().ijkToRas;
-  for (std::int64_t k = 0; k < d[2]; ++k)
-    for (std::int64_t j = 0; j < d[1]; ++j)
-      for (std::int64_t i = 0; i < d[0]; ++i) {
-        const std::int64_t o = PG.index(i, j, k);
-        const int posed = partOf(ps[o]) ? int(pg[o]) : 0;
-        const Eigen::Vector4d r = toRest * Eigen::Vector4d(double(i), double(j), double(k), 1);
-        const double ri = std::floor(r.x() + 0.5), rj = std::floor(r.y() + 0.5),
-                     rk = std::floor(r.z() + 0.5);
-        int expected = 0;
-        if (ri >= 0 && rj >= 0 && rk >= 0 && ri < rd[0] && rj < rd[1] && rk < rd[2]) {
-          const std::int64_t q = G.index(std::int64_t(ri), std::int64_t(rj), std::int64_t(rk));
-          if (partOf(sp[q])) expected = int(g[q]);
-        }
-        if (posed) ++c.posed[posed];
-        if (expected) ++c.expected[expected];
-        if (posed && posed == expected) ++c.both[posed];
-      }
-  return c;
-}
-
-DiceCounts diceCounts(const PoseReportInput& in, const RigidHandle& h) {
-  DiceCounts out;
-  dispatchScalar(in.organs->scalarType(), [&](auto* gt) {
-    using TG = std::remove_pointer_t<decltype(gt)>;
-    dispatchScalar(in.parts->scalarType(), [&](auto* st) {
-      using TS = std::remove_pointer_t<decltype(st)>;
-      if constexpr (std::is_integral_v<TG> && std::is_integral_v<TS>)
-        out = countForGroup<TG, TS>(*in.organs, *in.parts, *in.posedOrgans, *in.posedParts, h);
-    });
-  });
-  return out;
-}
-
 }  // namespace
 
 // Per label of G: the voxels (of the output grid) that moving each group's parts rigidly with
@@ -89,34 +33,40 @@ DiceCounts diceCounts(const PoseReportInput& in, const RigidHandle& h) {
 // which no deformation can beat (a thin vessel turned on a thick-slice grid). Empty when some
 // body part is carried by no group of parts (cage-vertex groups): the floor is then unknown.
 static std::map<int, std::int64_t> floorCounts(const PoseReportInput& in,
-                                               const std::vector<DiceCounts>& groups) {
+                                               const std::vector<GroupDiceCounts>& groups) {
   std::map<int, std::int64_t> out;
   std::set<int> carried;
   for (const RigidHandle& h : *in.handles) carried.insert(h.parts.begin(), h.parts.end());
   for (const LabelCount& c : countLabels(*in.parts))
     if (c.layer == 0 && !carried.count(c.value)) return {};
-  for (const DiceCounts& g : groups)
+  for (const GroupDiceCounts& g : groups)
     for (const auto& [label, n] : g.expected) out[label] += n;
   return out;
 }
 
 static json makePoseReport(const PoseReportInput& in) {
   json report;
+  // The posed maps' counts: the caller's tally (a frame made slab by slab), else one over the
+  // whole posed maps.
+  std::optional<PosedTally> own;
+  const PosedTally* tally = in.posed;
+  if (!tally) {
+    own.emplace(*in.organs, *in.parts, in.handles, in.posedOrgans->geometry());
+    own->addWhole(*in.posedOrgans, *in.posedParts);
+    tally = &*own;
+  }
+  if (!tally->complete()) throw Error("pose report: the posed maps' tally is not complete");
   // Each group's parts moved rigidly, voxel by voxel: the bones' reference and the floors.
-  std::vector<DiceCounts> groupCounts;
-  if (in.handles)
-    for (const RigidHandle& h : *in.handles)
-      groupCounts.push_back(h.parts.empty() ? DiceCounts{} : diceCounts(in, h));
+  std::vector<GroupDiceCounts> groupCounts = tally->groups();
   const std::map<int, std::int64_t> floors =
       in.handles ? floorCounts(in, groupCounts) : std::map<int, std::int64_t>{};
-  const double outVoxelMm3 =
-      std::fabs(in.posedOrgans->geometry().ijkToRas.block<3, 3>(0, 0).determinant());
+  const double outVoxelMm3 = tally->grid().voxelVolumeMm3();
   // Per label: volume, and mass where the tissue table knows the label.
   std::map<int, std::pair<LabelCount, LabelCount>> counts;
   for (const LabelCount& c : countLabels(*in.organs))
     if (c.layer == 0) counts[c.value].first = c;
-  for (const LabelCount& c : countLabels(*in.posedOrgans))
-    if (c.layer == 0) counts[c.value].second = c;
+  for (const auto& [value, voxels] : tally->labelVoxels())
+    counts[value].second = {0, value, voxels, double(voxels) * outVoxelMm3};
   json labels = json::array();
   double bodyBefore = 0, bodyAfter = 0, massBefore = 0, massAfter = 0;
   bool massKnown = in.tissues != nullptr;
@@ -238,7 +188,7 @@ static json makePoseReport(const PoseReportInput& in) {
       if (tissue.rigid) bones[tissue.boneName()].push_back(value);
     for (const auto& [bone, labels] : bones)
       for (std::size_t g = 0; g < in.handles->size(); ++g) {
-        DiceCounts& c = groupCounts[g];
+        GroupDiceCounts& c = groupCounts[g];
         std::int64_t restVoxels = 0, both = 0, posed = 0, expected = 0;
         bool present = false;
         for (const int value : labels) {
@@ -262,7 +212,7 @@ static json makePoseReport(const PoseReportInput& in) {
   report["rigid_tissues"] = rigid;
 
   const std::int64_t holesBefore = countEnclosedBackground(*in.organs),
-                     holesAfter = countEnclosedBackground(*in.posedOrgans);
+                     holesAfter = tally->enclosedBackground();
   report["holes"] = {{"enclosed_background_voxels_before", holesBefore},
                      {"enclosed_background_voxels_after", holesAfter}};
 

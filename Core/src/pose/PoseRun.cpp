@@ -1,5 +1,7 @@
 #include "repose/pose/PoseRun.h"
 
+#include "PoseFrameSteps.h"
+
 #include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
 
@@ -102,21 +104,35 @@ FrameOutcome runPoseFrame(const PoseJob& job, const PoseRig& rig, std::size_t in
   fo.labelMapFiles = run.labelMapFiles;
   fo.progress = run.progress;
   fo.warn = run.warn;
+  FrameWriteOptions wo = run.write;
+  wo.labelMapFiles = run.labelMapFiles;
   // One memory rule for every front end: the posed volumes (the image's too) beside what the
-  // process holds now, checked on the frame's grid before anything is allocated for it.
+  // process holds now, checked on the frame's grid before anything is allocated for it. Beyond
+  // it a frame with a folder to go to is made slab by slab when the front end allows it.
   const double bytesPerVoxel = posedBytesPerVoxel(organs, parts, run.image);
-  fo.checkGrid = [&](const VolumeGeometry& grid) {
-    checkFrameMemory(grid, bytesPerVoxel, run.memoryBudget, run.budgetWhat, run.budgetHint);
-    if (run.onGrid) run.onGrid(grid);
-  };
+  frame::FrameStart start = frame::startFrame(rig, index, organs, parts, fo);
   FrameOutcome out;
-  out.frame = poseFrame(rig, index, organs, parts, fo);
-  out.frame.reportJson = job.completeReport(out.frame.reportJson, run.sceneReused, rig);
-  out.reportJson = out.frame.reportJson;
-  if (!run.folder.empty()) {
-    FrameWriteOptions wo = run.write;
-    wo.labelMapFiles = run.labelMapFiles;
-    out.reportJson = writePosedFrame(out.frame, run.folder, wo);
+  if (!run.folder.empty() &&
+      (run.alwaysOutOfCore ||
+       (run.outOfCore && !frameFitsMemory(start.grid, bytesPerVoxel, run.memoryBudget)))) {
+    if (run.onGrid) run.onGrid(start.grid);
+    out.streamed = true;
+    out.frame.name = start.frame.name;
+    out.frame.grid = start.grid;
+    out.frame.labelMapFiles = run.labelMapFiles;
+    out.reportJson =
+        frame::poseFrameToFolderFrom(start, rig, organs, parts, fo, run.folder, wo,
+                                     run.memoryBudget, 0, [&](const std::string& report) {
+                                       return job.completeReport(report, run.sceneReused, rig);
+                                     });
+    out.frame.reportJson = out.reportJson;
+  } else {
+    checkFrameMemory(start.grid, bytesPerVoxel, run.memoryBudget, run.budgetWhat, run.budgetHint);
+    if (run.onGrid) run.onGrid(start.grid);
+    out.frame = frame::poseFrameFrom(start, rig, organs, parts, fo);
+    out.frame.reportJson = job.completeReport(out.frame.reportJson, run.sceneReused, rig);
+    out.reportJson = out.frame.reportJson;
+    if (!run.folder.empty()) out.reportJson = writePosedFrame(out.frame, run.folder, wo);
   }
   const nlohmann::json targets = nlohmann::json::parse(out.reportJson).at("targets");
   out.targetsMet = targets.at("met").get<bool>();

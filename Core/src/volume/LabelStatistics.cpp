@@ -1,6 +1,8 @@
 // Per-label voxel counts: one pass per layer with a dense histogram for small integer types.
 #include "repose/volume/LabelStatistics.h"
 
+#include "repose/volume/BackgroundTrace.h"
+
 #include "repose/util/Parallel.h"
 
 #include <map>
@@ -98,14 +100,10 @@ std::vector<char> outsideBackground(const Volume& volume) {
 }
 
 std::int64_t countEnclosedBackground(const Volume& volume) {
-  const std::vector<char> outside = outsideBackground(volume);
-  std::int64_t enclosed = 0;
-  dispatchScalar(volume.scalarType(), [&](auto* tag) {
-    using T = std::remove_pointer_t<decltype(tag)>;
-    const T* v = volume.data<T>();
-    for (std::int64_t i = 0; i < volume.numVoxels(); ++i) enclosed += v[i] == 0 && !outside[i];
-  });
-  return enclosed;
+  // Traced slice by slice (BackgroundTrace.h): memory follows the holes, not the grid.
+  BackgroundTrace trace(volume.dims());
+  trace.add(volume.layerData(0), volume.scalarType(), 0, volume.dims()[2]);
+  return trace.enclosedVoxels();
 }
 
 }  // namespace repose

@@ -14,9 +14,21 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 using namespace repose;
 using namespace repose::test;
+using json = nlohmann::json;
+
+namespace {
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  EXPECT_TRUE(in.good()) << path;
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+}  // namespace
 
 TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   ScratchDir dir("pose");
@@ -178,29 +190,53 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("c")));
 }
 
-// `--memory` holds for the posed frame as for the reads: a budget the inputs fit in but the
-// posed volumes do not (4 mm phantom: 2.5M input voxels, 4M output voxels at 14 bytes each beside
-// the ~100 MB the rig holds) refuses the frame before allocating it, in one line with the numbers
-// and the way out, and leaves no output folder; a budget that holds it poses the same job.
-TEST(PoseCommand, AFrameBeyondTheMemoryBudgetIsRefusedWithTheNumbersAndNothingWritten) {
+// `--memory` holds for the posed frame as for the reads (4 mm phantom: 2.5M input voxels, 4M
+// output voxels at 14 bytes each beside the ~125 MB the rig holds). A budget the posed volumes
+// do not fit makes the frame slab by slab (issue 56): the same files, byte for byte, and the same
+// report as a budget that holds it whole. A budget the rig has used up refuses the frame before
+// the work, in one line with the numbers, and leaves no output folder; so does a budget the frame
+// exceeds when a single-file output (--posed-labels) asks for it whole.
+TEST(PoseCommand, AFrameBeyondTheMemoryBudgetIsMadeSlabBySlabOrRefusedWithTheNumbers) {
   ScratchDir dir("pose_budget");
   ASSERT_EQ(
       runCommand("repose", "phantom --voxel 4 --out " + shellQuote(dir.path().string())).exitCode,
       0);
   const std::string job = "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
                           shellQuote(dir.file("S.nii.gz")) + " --pose " +
-                          shellQuote(suitePoseFile("elbow90")) + " --joint-rings 0 --json";
+                          shellQuote(suitePoseFile("elbow90")) + " --joint-rings 0";
+  const CommandResult whole =
+      runCommand("repose", job + " --memory 4G --out " + shellQuote(dir.file("enough")));
+  ASSERT_EQ(whole.exitCode, 0) << whole.err;
+  EXPECT_EQ(whole.out.find("slab by slab"), std::string::npos) << whole.out;
+  const CommandResult streamed =
+      runCommand("repose", job + " --memory 160M --out " + shellQuote(dir.file("slabs")));
+  ASSERT_EQ(streamed.exitCode, 0) << streamed.err;
+  EXPECT_NE(streamed.out.find("made slab by slab"), std::string::npos) << streamed.out;
+  for (const char* name : {"posed_G.nii.gz", "posed_S.nii.gz", "transform.nrrd"})
+    EXPECT_EQ(readFile(dir.file(std::string("enough/") + name)),
+              readFile(dir.file(std::string("slabs/") + name)))
+        << name;
+  json a = json::parse(readFile(dir.file("enough/report.json")));
+  json b = json::parse(readFile(dir.file("slabs/report.json")));
+  EXPECT_GT(b["streamed"]["slabs"].get<int>(), 1);
+  b.erase("streamed");
+  EXPECT_EQ(a.dump(), b.dump());
+
   const CommandResult refused =
-      runCommand("repose", job + " --memory 64M --out " + shellQuote(dir.file("small")));
+      runCommand("repose", job + " --json --memory 64M --out " + shellQuote(dir.file("small")));
   EXPECT_EQ(refused.exitCode, 1);
   EXPECT_TRUE(refused.out.empty()) << refused.out;
   EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
-  for (const char* part : {"repose pose: error: ", "small: frame elbow90 needs ", " output voxels",
-                           "more than the memory budget of 0.0625 GiB", "repose warp"})
+  for (const char* part : {"repose pose: error: ", "small: frame elbow90 needs ",
+                           "for a slab of one slice", "more than the memory budget of 0.0625 GiB"})
     EXPECT_NE(refused.err.find(part), std::string::npos) << part << " in: " << refused.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("small")));
-  const CommandResult posed =
-      runCommand("repose", job + " --memory 4G --out " + shellQuote(dir.file("enough")));
-  ASSERT_EQ(posed.exitCode, 0) << posed.err;
-  EXPECT_TRUE(std::filesystem::exists(dir.file("enough/posed_G.nii.gz")));
+  const CommandResult whole1 = runCommand("repose", job + " --json --memory 160M --posed-labels " +
+                                                        shellQuote(dir.file("one.nii.gz")) +
+                                                        " --out " + shellQuote(dir.file("single")));
+  EXPECT_EQ(whole1.exitCode, 1);
+  for (const char* part :
+       {"single: frame elbow90 needs ", " output voxels", "the frame is made slab by slab"})
+    EXPECT_NE(whole1.err.find(part), std::string::npos) << part << " in: " << whole1.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("single")));
 }

@@ -5,6 +5,7 @@
 #include "repose/volume/Volume.h"
 
 #include <string>
+#include <vector>
 
 namespace repose {
 
@@ -16,6 +17,9 @@ namespace repose {
 // names become '_' (Slicer turns '_' back into spaces). Atomic. Throws repose::Error naming the
 // file for a negative label value (a colour table cannot index it).
 void writeColorTable(const Volume& labelMap, const std::string& path);
+// The same from a label table and the values present in layer 0 (a map written slab by slab).
+void writeColorTable(const LabelTable& labels, const std::vector<int>& present,
+                     const std::string& path);
 
 // Reads a Slicer colour table file (.ctbl or .txt; parseColorTable): what writeColorTable
 // writes, or Slicer's own tables such as GenericAnatomyColors.txt. Throws repose::Error naming

@@ -10,7 +10,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <string>
+#include <vector>
 
 namespace repose {
 
@@ -29,5 +31,30 @@ std::string gzipTrailerBytes(std::uint32_t crc, std::uint64_t size);
 // CRC-32 of data, continuing `crc`; and the CRC of A followed by B from CRC(A), CRC(B) and |B|.
 std::uint32_t crc32Of(const void* data, std::size_t size, std::uint32_t crc = 0);
 std::uint32_t crc32Concat(std::uint32_t crcA, std::uint32_t crcB, std::uint64_t sizeB);
+
+// One gzip member written to an open file as the data arrive, cut into pieces of `pieceBytes` of
+// the data stream whatever the sizes of the writes, so a volume written slab by slab is the same
+// file, byte for byte, as one written whole. Full pieces are deflated in batches on every core;
+// at most one partial piece is held between writes. Throws repose::Error naming `path` when a
+// write fails.
+class GzipPieceStream {
+ public:
+  GzipPieceStream(std::FILE* file, std::string path, std::size_t pieceBytes = std::size_t(4) << 20);
+  void write(const void* data, std::size_t bytes);
+  void finish();  // the last piece and the trailer
+  std::uint64_t bytesIn() const { return total_; }
+
+ private:
+  void put(const std::string& bytes);
+  void deflateBatch(const std::vector<const char*>& pieces, const std::vector<std::size_t>& sizes);
+
+  std::FILE* file_;
+  std::string path_;
+  std::size_t piece_;
+  std::string partial_;
+  std::uint32_t crc_ = 0;
+  std::uint64_t total_ = 0;
+  bool finished_ = false;
+};
 
 }  // namespace repose

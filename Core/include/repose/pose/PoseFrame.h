@@ -87,6 +87,8 @@ double posedBytesPerVoxel(const Volume& organs, const Volume& parts, const Volum
 // (<hint>)", the hint saying where the front end sets the budget and how to pose out of core.
 void checkFrameMemory(const VolumeGeometry& grid, double bytesPerVoxel, double budget,
                       const std::string& what, const std::string& hint);
+// Whether checkFrameMemory would let the frame through.
+bool frameFitsMemory(const VolumeGeometry& grid, double bytesPerVoxel, double budget);
 
 // The value a posed image takes where no tissue is, unless the user gives one: the image's
 // minimum, which is air in a CT (-1000 or -1024 HU) and the dark of an MR, so the body is not
@@ -124,5 +126,20 @@ struct FrameWriteOptions {
 // Both return report.json's text as written (its "outputs" name the files written).
 std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
                             const FrameWriteOptions& options);
+
+// Out of core (issue 56): the frame made slab by slab and written into `folder` as it goes, for
+// a frame whose posed volumes do not fit in memory. The same files (voxel for voxel; the NIfTI,
+// NRRD and segmentation files byte for byte) and the same report as poseFrame then
+// writePosedFrame, plus report.json's "streamed" (the slabs). Holds the rest maps, the rig and
+// slabs sized to `memoryBudget` bytes (0: memoryBudgetByDefault()) beside what the process
+// holds; the label-volume rounding's candidates beyond a quarter of that go to a temporary file.
+// `slabSlices` > 0 sets the slabs' thickness instead (tests cut a frame into slabs of a slice).
+// A DICOM SEG (made whole in memory) is refused in one line before the work. Returns
+// report.json's text as written. Throws repose::Error, or Cancelled from options.progress;
+// nothing is written then.
+std::string poseFrameToFolder(const PoseRig& rig, std::size_t index, const Volume& organs,
+                              const Volume& parts, const PoseFrameOptions& options,
+                              const std::string& folder, const FrameWriteOptions& write,
+                              double memoryBudget = 0, std::int64_t slabSlices = 0);
 
 }  // namespace repose

@@ -6,6 +6,7 @@
 
 #include "repose/mesh/RigidHandles.h"
 #include "repose/mesh/TransferMesh.h"
+#include "repose/pose/PosedTally.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
 
@@ -21,8 +22,10 @@ namespace repose {
 struct PoseReportInput {
   const Volume* organs = nullptr;  // G at rest
   const Volume* parts = nullptr;   // S at rest
+  // The posed maps, whole; or, for a frame made slab by slab, their tally (then these are null).
   const Volume* posedOrgans = nullptr;
   const Volume* posedParts = nullptr;
+  const PosedTally* posed = nullptr;
   const TransferMesh* mesh = nullptr;
   const std::vector<Eigen::Matrix3d>* tetMaps = nullptr;  // B_t of every tet
   const std::vector<RigidHandle>* handles = nullptr;      // with this frame's motions

@@ -87,6 +87,12 @@ struct FrameRun {
   // labelMapFiles is set from the one above).
   std::string folder;
   FrameWriteOptions write;
+  // With a folder: a frame whose posed volumes exceed the memory budget is made slab by slab and
+  // written as it goes (poseFrameToFolder: the same files and report), instead of refused. Its
+  // outcome holds no volumes (FrameOutcome::streamed).
+  bool outOfCore = false;
+  // With a folder: every frame slab by slab, whatever its size (the slabs sized to the budget).
+  bool alwaysOutOfCore = false;
 };
 
 struct FrameOutcome {
@@ -94,6 +100,9 @@ struct FrameOutcome {
   std::string reportJson;  // report.json as written (its "outputs" name the files), or completed
   bool targetsMet = true;  // report.json's targets.met
   std::vector<std::string> missed;  // report.json's targets.missed, one line each
+  // Made slab by slab into the folder (FrameRun::outOfCore): `frame` holds its name, grid and
+  // report only.
+  bool streamed = false;
   // "<missed>; <missed>": what a front end says after "written, but it missed its targets: ".
   std::string missedLine() const;
 };

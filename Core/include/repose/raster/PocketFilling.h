@@ -14,6 +14,8 @@
 #include "repose/volume/Volume.h"
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <vector>
 
 namespace repose {
@@ -29,5 +31,36 @@ struct PocketReport {
 // the same voxels with its own neighbours' labels.
 PocketReport fillPosePockets(Volume& posedLabels, const Volume& restLabels,
                              const std::vector<float>& displacement, Volume* posedParts = nullptr);
+
+// The same for a frame made slab by slab (fillPosePockets is this over one slab): pass 1 traces
+// the posed background slab by slab (BackgroundTrace.h) and notes, for each voxel not yet known to
+// be outside, where it comes from and its walls' labels; fill() then fills the enclosed ones from
+// their walls, and pass 2 writes them into each slab. Memory follows the holes, not the grid.
+class PosePockets {
+ public:
+  // `rest`: G at rest (integer, layer 0 examined); `posed`: the posed grid. Both are kept.
+  PosePockets(const Volume& rest, const VolumeGeometry& posed);
+  ~PosePockets();
+  PosePockets(const PosePockets&) = delete;
+  PosePockets& operator=(const PosePockets&) = delete;
+
+  // Pass 1, slabs in order from slice 0: slices [k0, k1) of the posed G (the rest map's type)
+  // as sampled, with the slices k0 - 1 and k1 (null at the grid's faces); the posed S likewise
+  // when it is filled too (`parts` null: not), of type `partsType`; and the slab's displacement
+  // field (3 floats per voxel, rasterizeDisplacement's).
+  void addSlab(std::int64_t k0, std::int64_t k1, const void* organsBelow, const void* organs,
+               const void* organsAbove, const void* partsBelow, const void* parts,
+               const void* partsAbove, ScalarType partsType, const float* field);
+  // After the last slab: fills the pockets. `finalOrgan(voxel, sampled)` is the label a voxel of
+  // G ends with where it was sampled as `sampled` (label-volume rounding may relabel it; null:
+  // as sampled); S's walls are as sampled.
+  PocketReport fill(const std::function<std::int64_t(std::int64_t, std::int64_t)>& finalOrgan = {});
+  // Pass 2: writes the filled labels of slices [k0, k1) into the slabs (`parts` null: G only).
+  void apply(std::int64_t k0, std::int64_t k1, void* organs, void* parts) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace repose

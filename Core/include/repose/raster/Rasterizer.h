@@ -127,6 +127,41 @@ class LabelSlabs {
                  const ProgressFn& progress = {}) const;
 
  private:
+  friend class LabelSlabRounding;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Label-volume rounding (RasterOptions::preserveLabelVolumes) of a frame made slab by slab with
+// LabelSlabs: the voxels rasterizeLabels relabels over the whole grid, chosen from every slab's
+// counts and candidates (pass 1) and applied to each slab when it is made again or read back
+// (pass 2). A single-layer integer map only; others say why in skipped().
+class LabelSlabRounding {
+ public:
+  // The targets (a scan of the rest mesh). Candidates beyond `memoryBytes` are kept in a
+  // temporary file (a 0.5 mm frame's label borders hold hundreds of millions).
+  explicit LabelSlabRounding(const LabelSlabs& slabs, std::size_t memoryBytes = std::size_t(-1));
+  ~LabelSlabRounding();
+  LabelSlabRounding(const LabelSlabRounding&) = delete;
+  LabelSlabRounding& operator=(const LabelSlabRounding&) = delete;
+
+  // Empty when the map is rounded; else why it is not.
+  const std::string& skipped() const;
+  // Pass 1, slabs in order from slice 0, each once: slices [k0, k1) as LabelSlabs::rasterize
+  // wrote them, with the slices k0 - 1 and k1 as it writes them (null at the grid's faces).
+  void addSlab(std::int64_t k0, std::int64_t k1, const void* below, const void* slab,
+               const void* above);
+  std::size_t candidatesInMemory() const;  // bytes
+  std::size_t candidatesOnDisk() const;    // bytes
+  // After the last slab: the choice; sets report's roundedVoxels, labelTargets and
+  // roundingSkipped as rasterizeLabels does.
+  void choose(RasterReport& report);
+  // Pass 2: relabels the chosen voxels of slices [k0, k1) in `slab` (after choose()).
+  void apply(std::int64_t k0, std::int64_t k1, void* slab) const;
+  // The label output voxel `voxel`, sampled as `sampled`, ends with (after choose()).
+  std::int64_t finalLabel(std::int64_t voxel, std::int64_t sampled) const;
+
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -172,6 +207,48 @@ Volume rasterizeImage(const Volume& image, const TransferMesh& mesh,
 std::vector<float> rasterizeDisplacement(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
                                          const VolumeGeometry& input, const VolumeGeometry& output,
                                          const RasterOptions& options = {});
+
+// The posed image slab by slab: output slices [k0, k1) of what rasterizeImage writes, into a
+// caller's buffer ((k1 - k0) * sliceBytes() bytes), on options.threads threads. Set-up (the scan's
+// input and shell) is done once; `image`, `mesh` and what `options` points to must outlive it.
+class ImageSlabs {
+ public:
+  ImageSlabs(const Volume& image, const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+             const VolumeGeometry& output, double background, const RasterOptions& options = {});
+  ~ImageSlabs();
+  ImageSlabs(const ImageSlabs&) = delete;
+  ImageSlabs& operator=(const ImageSlabs&) = delete;
+
+  std::int64_t sliceBytes() const;
+  // Adds the slab's counts (voxel writes, shell voxels) to `report`; `progress` gets the
+  // fraction of this slab, false cancels.
+  void rasterize(std::int64_t k0, std::int64_t k1, void* slab, RasterReport& report,
+                 const ProgressFn& progress = {}) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The displacement field slab by slab: output slices [k0, k1) of what rasterizeDisplacement
+// gives, 3 floats per voxel ((k1 - k0) * sliceFloats() floats), on options.threads threads.
+class DisplacementSlabs {
+ public:
+  DisplacementSlabs(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
+                    const VolumeGeometry& input, const VolumeGeometry& output,
+                    const RasterOptions& options = {});
+  ~DisplacementSlabs();
+  DisplacementSlabs(const DisplacementSlabs&) = delete;
+  DisplacementSlabs& operator=(const DisplacementSlabs&) = delete;
+
+  std::int64_t sliceFloats() const;
+  void rasterize(std::int64_t k0, std::int64_t k1, float* slab,
+                 const ProgressFn& progress = {}) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // How many deformed tets contain each output voxel centre (UInt8, saturating at 255): 1 inside a
 // conforming deformed mesh, 0 outside it, 2 or more where it folds over itself. No shell.

@@ -7,6 +7,8 @@
 
 #include "repose/io/GzipPieces.h"
 #include "repose/io/NiftiIO.h"
+#include "repose/io/NrrdIO.h"
+#include "repose/util/Error.h"
 #include "repose/io/VolumeIO.h"
 
 #include <gtest/gtest.h>
@@ -162,4 +164,62 @@ TEST(GzipPieces, NiftiWriterBytesAreThePiecesAndDoNotDependOnTheCallsSlicing) {
   const std::string nii = dir.file("whole.nii");
   writeVolume(v, nii);
   EXPECT_EQ(fileBytes(nii), plain);
+}
+
+// A stream of pieces cut from the data, not from the writes: any slicing of the same bytes into
+// writes gives the same file, which any gzip reader reads back whole.
+TEST(GzipPieces, AStreamsBytesDoNotDependOnHowItsWritesAreCut) {
+  ScratchDir dir;
+  const std::string data = labelBytes(3 * 1000 + 17, 5);
+  auto streamed = [&](const std::vector<std::size_t>& cuts, const std::string& name) {
+    const std::string path = dir.file(name);
+    std::FILE* file = std::fopen(path.c_str(), "wb");
+    GzipPieceStream stream(file, path, 1000);
+    std::size_t at = 0;
+    for (std::size_t c = 0; at < data.size(); ++c) {
+      const std::size_t n = std::min(cuts[c % cuts.size()], data.size() - at);
+      stream.write(data.data() + at, n);
+      at += n;
+    }
+    stream.finish();
+    EXPECT_EQ(stream.bytesIn(), data.size());
+    std::fclose(file);
+    return fileBytes(path);
+  };
+  const std::string whole = streamed({data.size()}, "whole.gz");
+  EXPECT_EQ(gunzip(whole), data);
+  EXPECT_EQ(streamed({1}, "ones.gz"), whole);
+  EXPECT_EQ(streamed({999, 2, 1000, 3001}, "mixed.gz"), whole);
+  EXPECT_EQ(streamed({250}, "quarters.gz"), whole);
+}
+
+// The displacement field written slab by slab is the whole field's file, byte for byte.
+TEST(GzipPieces, AFieldWrittenInSlabsIsTheWholeFieldsFile) {
+  ScratchDir dir;
+  const VolumeGeometry g = obliqueGeometry({37, 29, 41});
+  std::vector<float> field(std::size_t(3 * g.numVoxels()));
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> mm(-30, 30);
+  for (float& f : field) f = mm(rng);
+  const std::string whole = dir.file("whole.nrrd");
+  writeDisplacementFieldNrrd(field, g, whole);
+  const std::int64_t plane = 37 * 29;
+  for (const std::int64_t slab : {std::int64_t(1), std::int64_t(6), std::int64_t(41)}) {
+    const std::string path = dir.file("slabs" + std::to_string(slab) + ".nrrd");
+    DisplacementFieldNrrdWriter writer(g, path);
+    for (std::int64_t k0 = 0; k0 < 41; k0 += slab)
+      writer.writeSlices(field.data() + 3 * k0 * plane, std::min<std::int64_t>(slab, 41 - k0));
+    EXPECT_FALSE(std::ifstream(path).good()) << "nothing appears before finish()";
+    writer.finish();
+    EXPECT_EQ(fileBytes(path), fileBytes(whole)) << "slabs of " << slab;
+  }
+  // Read back: the vectors in LPS, as the whole writer puts them.
+  const Volume read = readVolume(whole);
+  EXPECT_EQ(read.dims(), (std::array<std::int64_t, 3>{37, 29, 41}));
+  EXPECT_EQ(read.layers(), 3);
+  EXPECT_FLOAT_EQ(read.data<float>(0)[5], -field[15]);
+  EXPECT_FLOAT_EQ(read.data<float>(2)[5], field[17]);
+  DisplacementFieldNrrdWriter short_(g, dir.file("short.nrrd"));
+  short_.writeSlices(field.data(), 40);
+  EXPECT_THROW(short_.finish(), Error);
 }

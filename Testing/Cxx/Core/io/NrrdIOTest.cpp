@@ -3,7 +3,9 @@
 #include "TestPaths.h"
 #include "TestVolumes.h"
 
+#include "repose/io/NrrdIO.h"
 #include "repose/io/VolumeIO.h"
+#include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
 
 #include <gtest/gtest.h>
@@ -26,7 +28,9 @@
 #endif
 
 #include <cstdint>
+#include <cstring>
 #include <fstream>
+#include <iterator>
 #include <regex>
 
 using namespace repose;
@@ -446,4 +450,46 @@ TEST(NrrdIO, AFailedWriteGivesOneLineAndLeavesNothingAllocated) {
       left.push_back(e.path().filename());
     EXPECT_TRUE(left.empty()) << name << ": " << left.front();
   }
+}
+
+// A segmentation written slab by slab (the header last, its extents gathered on the way) is the
+// whole map's file byte for byte: Slicer's own single-layer and overlapping (layered) ones.
+TEST(NrrdIO, ASegmentationWrittenInSlabsIsTheWholeMapsFile) {
+  ScratchDir dir;
+  auto bytes = [](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  for (const char* name : {"Segmentation.seg.nrrd", "SegmentationOverlapping.seg.nrrd"}) {
+    const Volume seg = readVolume(dataPath(std::string("slicer_seg/") + name));
+    const std::string whole = dir.file(std::string("whole_") + name);
+    writeVolume(seg, whole);
+    const auto d = seg.dims();
+    const std::int64_t plane = d[0] * d[1];
+    const std::size_t size = scalarSize(seg.scalarType());
+    for (const std::int64_t slab : {std::int64_t(1), std::int64_t(7), d[2]}) {
+      const std::string path = dir.file(std::to_string(slab) + "_" + name);
+      SegNrrdSlabWriter writer(path, seg.geometry(), seg.scalarType(), seg.layers(), seg.labels());
+      std::vector<std::uint8_t> buffer;
+      for (std::int64_t k0 = 0; k0 < d[2]; k0 += slab) {
+        const std::int64_t n = std::min(slab, d[2] - k0);
+        buffer.resize(std::size_t(n * plane * seg.layers()) * size);
+        for (int l = 0; l < seg.layers(); ++l)
+          std::memcpy(buffer.data() + std::size_t(l * n * plane) * size,
+                      static_cast<const std::uint8_t*>(seg.layerData(l)) + k0 * plane * size,
+                      std::size_t(n * plane) * size);
+        writer.writeSlices(buffer.data(), n);
+      }
+      EXPECT_FALSE(std::ifstream(path).good()) << "nothing appears before finish()";
+      writer.finish();
+      EXPECT_EQ(bytes(path), bytes(whole)) << name << ", slabs of " << slab;
+    }
+    if (std::string(name).find("Overlapping") != std::string::npos) EXPECT_GT(seg.layers(), 1);
+  }
+  SegNrrdSlabWriter unfinished(dir.file("short.seg.nrrd"),
+                               VolumeGeometry::make({4, 4, 4}, {1, 1, 1}, {0, 0, 0}),
+                               ScalarType::UInt8, 1, LabelTable());
+  std::vector<std::uint8_t> slice(16, 1);
+  unfinished.writeSlices(slice.data(), 1);
+  EXPECT_THROW(unfinished.finish(), Error);
 }

@@ -5,6 +5,7 @@
 
 #include "raster/LabelVolumeRounding.h"
 #include "repose/raster/Rasterizer.h"
+#include "repose/util/Error.h"
 
 #include <gtest/gtest.h>
 
@@ -184,4 +185,80 @@ TEST(LabelVolumeRounding, AMapOfLayersIsSampledAndTheReportSaysWhy) {
   EXPECT_EQ(preserved.roundedVoxels, 0);
   EXPECT_TRUE(std::equal(p.data<std::uint16_t>(0), p.data<std::uint16_t>(0) + p.numVoxels(),
                          n.data<std::uint16_t>(0)));
+}
+
+// A frame made slab by slab (LabelSlabs, LabelSlabRounding): the slabs' counts and candidates,
+// merged, choose exactly the whole grid's voxels, whatever the slab size, thread count, and
+// whether the candidates stay in memory or go to a temporary file; label borders run across
+// every slab border (slabs of 1 slice: every border between slices is a slab's).
+TEST(LabelVolumeRounding, SlabsChooseTheWholeGridsVoxels) {
+  const ThickSliceBlock b;
+  for (const double degrees : {41.0, 90.0}) {
+    const Eigen::MatrixX3d deformed = b.turned(degrees);
+    const VolumeGeometry grid = deformedGrid(b.labels.geometry(), deformed);
+    for (const int threads : {1, 2}) {
+      RasterOptions options = b.options(true);
+      options.threads = threads;
+      RasterReport whole;
+      const Volume expected = rasterizeLabels(b.labels, b.mesh, deformed, grid, options, &whole);
+      ASSERT_GT(whole.roundedVoxels, 0);
+      const LabelSlabs slabs(b.labels, b.mesh, deformed, grid, options);
+      const std::int64_t plane = grid.dims[0] * grid.dims[1], nz = grid.dims[2];
+      for (const std::int64_t size : {1, 3, 7})
+        for (const std::size_t memory : {std::size_t(-1), std::size_t(0)}) {
+          const std::string at = std::to_string(degrees) + " degrees, slabs of " +
+                                 std::to_string(size) + ", " + std::to_string(threads) +
+                                 " thread(s), " + (memory ? "in memory" : "on disk");
+          LabelSlabRounding rounding(slabs, memory);
+          EXPECT_EQ(rounding.skipped(), "") << at;
+          RasterReport unused;
+          // Pass 1: each slab with the slices beside it.
+          for (std::int64_t k0 = 0; k0 < nz; k0 += size) {
+            const std::int64_t k1 = std::min(nz, k0 + size);
+            const std::int64_t lo = std::max<std::int64_t>(0, k0 - 1), hi = std::min(nz, k1 + 1);
+            std::vector<std::uint16_t> halo(std::size_t((hi - lo) * plane));
+            slabs.rasterize(lo, hi, halo.data(), unused);
+            const std::uint16_t* slab = halo.data() + (k0 - lo) * plane;
+            rounding.addSlab(k0, k1, k0 > 0 ? slab - plane : nullptr, slab,
+                             k1 < nz ? slab + (k1 - k0) * plane : nullptr);
+          }
+          EXPECT_EQ(memory ? rounding.candidatesOnDisk() : rounding.candidatesInMemory(), 0u) << at;
+          RasterReport report;
+          rounding.choose(report);
+          EXPECT_EQ(report.roundedVoxels, whole.roundedVoxels) << at;
+          EXPECT_EQ(report.labelTargets, whole.labelTargets) << at;
+          // Pass 2: each slab made again, the choice applied.
+          std::vector<std::uint16_t> assembled(std::size_t(nz * plane));
+          for (std::int64_t k0 = 0; k0 < nz; k0 += size) {
+            const std::int64_t k1 = std::min(nz, k0 + size);
+            std::uint16_t* slab = assembled.data() + k0 * plane;
+            slabs.rasterize(k0, k1, slab, unused);
+            rounding.apply(k0, k1, slab);
+          }
+          EXPECT_TRUE(
+              std::equal(assembled.begin(), assembled.end(), expected.data<std::uint16_t>()))
+              << at;
+        }
+    }
+  }
+  // Out of order, or chosen early: refused.
+  const Eigen::MatrixX3d deformed = b.turned(41);
+  const VolumeGeometry grid = deformedGrid(b.labels.geometry(), deformed);
+  const LabelSlabs slabs(b.labels, b.mesh, deformed, grid, b.options(true));
+  LabelSlabRounding rounding(slabs);
+  std::vector<std::uint16_t> slab(std::size_t(grid.dims[0] * grid.dims[1]));
+  EXPECT_THROW(rounding.addSlab(1, 2, nullptr, slab.data(), nullptr), Error);
+  RasterReport report;
+  EXPECT_THROW(rounding.choose(report), Error);
+  EXPECT_THROW(rounding.apply(0, 1, slab.data()), Error);
+}
+
+TEST(LabelVolumeRounding, SlabsOfALayeredMapSayWhyTheyAreNotRounded) {
+  const ThickSliceBlock b;
+  Volume layered(b.labels.geometry(), ScalarType::UInt16, 2);
+  const Eigen::MatrixX3d deformed = b.turned(41);
+  const VolumeGeometry grid = deformedGrid(b.labels.geometry(), deformed);
+  const LabelSlabs slabs(layered, b.mesh, deformed, grid, b.options(true));
+  LabelSlabRounding rounding(slabs);
+  EXPECT_EQ(rounding.skipped(), "a map of 2 layers");
 }

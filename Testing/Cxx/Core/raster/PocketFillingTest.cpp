@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+
 using namespace repose;
 
 namespace {
@@ -66,4 +69,80 @@ TEST(PocketFilling, TrappedOutsideAndUncoveredVoxelsAreFilledCavitiesKept) {
   EXPECT_EQ(at(open, 5, 5, 5), 0);
 
   EXPECT_THROW(fillPosePockets(open, rest, std::vector<float>(3)), Error);
+}
+
+// A frame made slab by slab (PosePockets): the same pockets filled with the same labels in G and
+// S, the same cavities kept, for every slab size; pockets and cavities span slab borders, and
+// walls relabelled after sampling (label-volume rounding) vote with their final labels.
+TEST(PocketFilling, SlabsFillTheWholeGridsPockets) {
+  const VolumeGeometry grid = VolumeGeometry::make({14, 12, 19}, {2, 2, 2}, {0, 0, 0});
+  Volume rest(grid, ScalarType::UInt16), parts(grid, ScalarType::UInt8);
+  for (int k = 1; k < 18; ++k)
+    for (int j = 1; j < 11; ++j)
+      for (int i = 1; i < 13; ++i) {
+        rest.data<std::uint16_t>()[rest.index(i, j, k)] =
+            std::uint16_t(1 + (i + 2 * j + 3 * k) % 5);
+        parts.data<std::uint8_t>()[parts.index(i, j, k)] = k < 9 ? 1 : 2;
+      }
+  // Rest cavities: a column of 5 slices at (3, 3); kept where the pose leaves it in place.
+  for (int k = 6; k < 11; ++k) rest.data<std::uint16_t>()[rest.index(3, 3, k)] = 0;
+  // The posed map: the rest one with pockets punched through slab borders (0 in G and S), one
+  // voxel whose field points far off the grid (uncovered), the cavity posed in place.
+  Volume posed = rest, posedParts = parts;
+  std::mt19937 random(11);
+  std::uniform_int_distribution<int> x(2, 11), y(2, 9), z(2, 16), length(1, 6);
+  for (int pocket = 0; pocket < 25; ++pocket) {
+    const int i = x(random), j = y(random), k0 = z(random), n = length(random);
+    if (i == 3 && j == 3) continue;
+    for (int k = k0; k < std::min(17, k0 + n); ++k)
+      posed.data<std::uint16_t>()[posed.index(i, j, k)] = 0,
+                                                    posedParts.data<std::uint8_t>()[posed.index(
+                                                        i, j, k)] = 0;
+  }
+  std::vector<float> field(std::size_t(3 * grid.numVoxels()), 0.0f);
+  field[std::size_t(3 * posed.index(8, 6, 9))] = 1e6f;
+  posed.data<std::uint16_t>()[posed.index(8, 6, 9)] = 0;
+  // A relabelling after sampling: every seventh voxel of label 2 becomes 9.
+  auto relabel = [](std::int64_t voxel, std::int64_t sampled) {
+    return sampled == 2 && voxel % 7 == 0 ? std::int64_t(9) : sampled;
+  };
+  Volume wholeG = posed, wholeS = posedParts;
+  for (std::int64_t v = 0; v < wholeG.numVoxels(); ++v)
+    wholeG.data<std::uint16_t>()[v] = std::uint16_t(relabel(v, wholeG.data<std::uint16_t>()[v]));
+  const PocketReport whole = fillPosePockets(wholeG, rest, field, &wholeS);
+  ASSERT_GT(whole.filled, 20);
+  EXPECT_EQ(whole.keptCavities, 5);
+
+  const std::int64_t nz = grid.dims[2], plane = grid.dims[0] * grid.dims[1];
+  for (const std::int64_t size : {std::int64_t(1), std::int64_t(4), nz}) {
+    PosePockets pockets(rest, grid);
+    Volume G = posed, S = posedParts;
+    const std::uint16_t* g = G.data<std::uint16_t>();
+    const std::uint8_t* s = S.data<std::uint8_t>();
+    for (std::int64_t k0 = 0; k0 < nz; k0 += size) {
+      const std::int64_t k1 = std::min(nz, k0 + size);
+      pockets.addSlab(k0, k1, k0 > 0 ? g + (k0 - 1) * plane : nullptr, g + k0 * plane,
+                      k1 < nz ? g + k1 * plane : nullptr, k0 > 0 ? s + (k0 - 1) * plane : nullptr,
+                      s + k0 * plane, k1 < nz ? s + k1 * plane : nullptr, ScalarType::UInt8,
+                      field.data() + 3 * k0 * plane);
+    }
+    const PocketReport report = pockets.fill(relabel);
+    EXPECT_EQ(report.filled, whole.filled) << "slabs of " << size;
+    EXPECT_EQ(report.keptCavities, whole.keptCavities) << "slabs of " << size;
+    for (std::int64_t v = 0; v < G.numVoxels(); ++v)
+      G.data<std::uint16_t>()[v] = std::uint16_t(relabel(v, G.data<std::uint16_t>()[v]));
+    for (std::int64_t k0 = 0; k0 < nz; k0 += size)
+      pockets.apply(k0, std::min(nz, k0 + size), G.data<std::uint16_t>() + k0 * plane,
+                    S.data<std::uint8_t>() + k0 * plane);
+    EXPECT_TRUE(std::equal(g, g + G.numVoxels(), wholeG.data<std::uint16_t>()))
+        << "slabs of " << size;
+    EXPECT_TRUE(std::equal(s, s + S.numVoxels(), wholeS.data<std::uint8_t>()))
+        << "slabs of " << size;
+  }
+  // A slab inside the grid without the slices beside it is refused.
+  PosePockets pockets(rest, grid);
+  EXPECT_THROW(pockets.addSlab(0, 2, nullptr, posed.layerData(0), nullptr, nullptr, nullptr,
+                               nullptr, ScalarType::UInt8, field.data()),
+               Error);
+  EXPECT_THROW(pockets.fill(), Error);
 }

@@ -1,0 +1,117 @@
+#!/usr/bin/python3
+"""The whole pose job at the seed's scale and beyond (issue 56; docs/PERFORMANCE.md, "The pose
+job out of core"): `repose pose` of the arms-resting phantom on the adult male reference grid
+(2.137 x 2.137 x 8 mm, ICRP 110 labels, with its CT), the suite's elbow flexion, written at 1 mm
+and at 0.5 mm, in core (a budget that holds the frame) and slab by slab (a 2 GiB budget). Each run
+is one `repose pose` command timed with its peak resident memory (/usr/bin/time -v); the rig is
+built once into a scene folder and reused, so the runs time the frame. The streamed files are
+compared with the in-core ones where both exist (byte for byte; the colour tables after their
+first line, which names the file).
+
+    make bench-large    (runs this after bench/run_bench.py --large)
+    /usr/bin/python3 bench/pose_large_bench.py --build build --out build/bench-pose-large
+
+Prints and writes OUT/pose_large_bench.json. A 0.5 mm frame in core needs about 50 GiB: it is
+listed as refused (the machine's 24 GiB), not run.
+"""
+import argparse
+import json
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+GRID = "2.137,2.137,8"
+
+
+def run(args, check=True):
+    started = time.monotonic()
+    done = subprocess.run(["/usr/bin/time", "-v"] + [str(a) for a in args], capture_output=True,
+                          text=True)
+    seconds = time.monotonic() - started
+    if check and done.returncode != 0:
+        sys.exit(f"pose_large_bench: {' '.join(map(str, args[:3]))} failed:\n"
+                 f"{done.stderr[-3000:]}")
+    peak = re.search(r"Maximum resident set size \(kbytes\): (\d+)", done.stderr)
+    return done, seconds, int(peak.group(1)) * 1024 if peak else None
+
+
+def same_files(a, b):
+    """The files of folder a in folder b, equal (colour tables after their first line)."""
+    for f in sorted(Path(a).iterdir()):
+        if f.name == "report.json":
+            continue
+        x, y = f.read_bytes(), (Path(b) / f.name).read_bytes()
+        if f.suffix == ".ctbl":
+            x, y = x[x.index(b"\n"):], y[y.index(b"\n"):]
+        if x != y:
+            return False
+    ra = json.loads((Path(a) / "report.json").read_text())
+    rb = json.loads((Path(b) / "report.json").read_text())
+    rb.pop("streamed", None)
+    return ra == rb
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--build", default="build")
+    p.add_argument("--out", default="build/bench-pose-large")
+    p.add_argument("--spacings", default="1,0.5", help="output voxel sizes in mm")
+    p.add_argument("--streamed-memory", default="2G")
+    p.add_argument("--in-core-memory", default="20G")
+    p.add_argument("--in-core-below-voxels", type=float, default=1.2e9,
+                   help="frames above this many output voxels are not run in core")
+    a = p.parse_args()
+    repose = str((Path(a.build) / "bin" / "repose").resolve())
+    pose = Path(__file__).resolve().parent / "poses" / "elbow90.pose.json"
+    out = Path(a.out).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    body = out / "body"
+    if not (body / "G.nii.gz").exists():
+        run([repose, "phantom", "--arms-resting", "--spacing", GRID, "--labels", "icrp110",
+             "--image", "--out", body])
+    job = [repose, "pose", "--input", body / "G.nii.gz", "--parts", body / "S.nii.gz", "--image",
+           body / "CT.nii.gz", "--pose", pose, "--scene", out / "scene", "--json"]
+    # The rig, built once (a frame at the input's spacing), then reused by every run.
+    run(job + ["--out", out / "rig_frame"])
+    results = []
+    for spacing in [float(s) for s in a.spacings.split(",")]:
+        folders = {}
+        for mode, memory in (("in core", a.in_core_memory), ("streamed", a.streamed_memory)):
+            folder = out / f"frame_{spacing:g}mm_{mode.replace(' ', '_')}"
+            row = {"spacing_mm": spacing, "mode": mode, "memory": memory, "ranks": 1}
+            if mode == "in core" and results and results[-1].get("output_voxels", 0) > \
+                    a.in_core_below_voxels:
+                row["refused"] = "beyond this machine's memory in core"
+                results.append(row)
+                print(json.dumps(row), flush=True)
+                continue
+            done, seconds, peak = run(job + ["--spacing-mm", spacing, "--memory", memory,
+                                             "--out", folder], check=False)
+            row.update({"seconds": round(seconds, 1), "peak_resident_bytes": peak,
+                        "exit": done.returncode})
+            if done.returncode in (0, 4):
+                report = json.loads((folder / "report.json").read_text())
+                dims = report["grid"]["dims"]
+                row["output_voxels"] = dims[0] * dims[1] * dims[2]
+                row["streamed"] = "streamed" in report
+                if "streamed" in report:
+                    row["slabs"] = report["streamed"]["slabs"]
+                row["relabelled_voxels"] = report["label_volumes"]["relabelled_voxels"]
+                row["targets_met"] = report["targets"]["met"]
+                folders[mode] = folder
+            else:
+                row["error"] = done.stderr.strip().splitlines()[-1][:300] if done.stderr else ""
+            results.append(row)
+            print(json.dumps(row), flush=True)
+        if len(folders) == 2:
+            same = same_files(folders["in core"], folders["streamed"])
+            results[-1]["same_as_in_core"] = same
+            print(f"{spacing:g} mm: streamed files {'equal' if same else 'DIFFER from'} in core",
+                  flush=True)
+    (out / "pose_large_bench.json").write_text(json.dumps({"runs": results}, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
