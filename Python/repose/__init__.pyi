@@ -138,6 +138,12 @@ class Rig:
                    spacing_mm: float = ..., fill_pockets: bool = ...,
                    label_volumes: str = ..., memory_bytes: float = ...,
                    progress: Optional[Progress] = ...) -> PosedFrame: ...
+    def pose_frame_to_folder(self, organs: Volume, parts: Volume, folder: str, index: int = ...,
+                             *, image: Optional[Volume] = ..., background: Optional[float] = ...,
+                             spacing_mm: float = ..., fill_pockets: bool = ...,
+                             label_volumes: str = ..., output_format: str = ...,
+                             memory_bytes: float = ...,
+                             progress: Optional[Progress] = ...) -> Dict[str, Any]: ...
     def pose_labels_to_file(self, organs_path: str, out_path: str, index: int = ..., *,
                             memory_bytes: float = ..., spacing_mm: float = ...,
                             progress: Optional[Progress] = ...) -> None: ...

@@ -193,6 +193,21 @@ FrameRun frameRunOf(const Rig& r, const py::object& image, std::optional<double>
   return run;
 }
 
+// Runs the frame as `repose pose` does, its warnings issued as Python warnings once it is done;
+// a frame that missed a target is returned all the same, and said so in one line.
+FrameOutcome runFrame(const Rig& r, const Volume& organs, const Volume& parts, std::size_t index,
+                      FrameRun& run, const py::object& progress) {
+  std::vector<std::string> warnings;
+  run.warn = [&](const std::string& line) { warnings.push_back(line); };
+  FrameOutcome outcome = withProgress(progress, [&](const ProgressFn& fn) {
+    run.progress = fn;
+    return runPoseFrame(*r.job, *r.rig, index, organs, parts, run);
+  });
+  if (!outcome.targetsMet) warnings.push_back("it missed its targets: " + outcome.missedLine());
+  issueWarnings(outcome.frame.name, warnings);
+  return outcome;
+}
+
 }  // namespace
 
 void bindPoses(py::module_& m) {
@@ -493,19 +508,7 @@ mesh, `pose_frame` the full-resolution volumes and report.)doc")
             FrameRun run = frameRunOf(r, image, background, spacingMm, fillPockets, labelVolumes,
                                       memoryBytes, "pose_frame");
             run.budgetHint = "memory_bytes=; or pose_frame_to_folder, which makes it slab by slab";
-            std::vector<std::string> warnings;
-            run.warn = [&](const std::string& line) { warnings.push_back(line); };
-            FrameOutcome outcome = withProgress(progress, [&](const ProgressFn& fn) {
-              run.progress = fn;
-              return runPoseFrame(*r.job, *r.rig, index, organs, parts, run);
-            });
-            // A frame that missed a target is returned all the same, and said so in one line,
-            // as `repose pose` says it.
-            if (!outcome.targetsMet)
-              warnings.push_back("it missed its targets: " + outcome.missedLine());
-            PosedFrame f = std::move(outcome.frame);
-            issueWarnings(f.name, warnings);
-            return f;
+            return runFrame(r, organs, parts, index, run, progress).frame;
           },
           py::arg("organs"), py::arg("parts"), py::arg("index") = 0, py::kw_only(),
           py::arg("image") = py::none(), py::arg("background") = py::none(),
@@ -535,15 +538,7 @@ volumes beside what the process holds must fit in it (0: half the physical memor
             run.folder = folder;
             run.write.lockFolder = true;  // a `repose pose` writing there refuses, and so does this
             run.outOfCore = true;
-            std::vector<std::string> warnings;
-            run.warn = [&](const std::string& line) { warnings.push_back(line); };
-            FrameOutcome outcome = withProgress(progress, [&](const ProgressFn& fn) {
-              run.progress = fn;
-              return runPoseFrame(*r.job, *r.rig, index, organs, parts, run);
-            });
-            if (!outcome.targetsMet)
-              warnings.push_back("it missed its targets: " + outcome.missedLine());
-            issueWarnings(outcome.frame.name, warnings);
+            const FrameOutcome outcome = runFrame(r, organs, parts, index, run, progress);
             return py::module_::import("json").attr("loads")(outcome.reportJson);
           },
           py::arg("organs"), py::arg("parts"), py::arg("folder"), py::arg("index") = 0,

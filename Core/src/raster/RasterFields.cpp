@@ -16,12 +16,6 @@ namespace {
 
 using raster::ScanInput;
 
-void checkSlab(std::int64_t k0, std::int64_t k1, const VolumeGeometry& output) {
-  if (k0 < 0 || k1 > output.dims[2] || k0 >= k1)
-    throw Error("rasterizer: slab [" + std::to_string(k0) + ", " + std::to_string(k1) +
-                ") is not within the output's " + std::to_string(output.dims[2]) + " slices");
-}
-
 void addCounts(const RasterReport& part, RasterReport& report) {
   report.voxelWrites += part.voxelWrites;
   report.shellVoxels += part.shellVoxels;
@@ -71,7 +65,7 @@ std::int64_t ImageSlabs::sliceBytes() const {
 void ImageSlabs::rasterize(std::int64_t k0, std::int64_t k1, void* slab, RasterReport& report,
                            const ProgressFn& progress) const {
   const Impl& r = *impl_;
-  checkSlab(k0, k1, r.output);
+  raster::checkSlab(k0, k1, r.output);
   RasterOptions options = r.options;
   options.progress = progress;
   const auto d = r.image.dims();
@@ -165,7 +159,7 @@ std::int64_t DisplacementSlabs::sliceFloats() const {
 void DisplacementSlabs::rasterize(std::int64_t k0, std::int64_t k1, float* field,
                                   const ProgressFn& progress) const {
   const Impl& r = *impl_;
-  checkSlab(k0, k1, r.output);
+  raster::checkSlab(k0, k1, r.output);
   const VolumeGeometry &input = r.input, &output = r.output;
   const Eigen::Matrix3d O = output.ijkToRas.block<3, 3>(0, 0), I = input.ijkToRas.block<3, 3>(0, 0);
   const Eigen::Vector3d oo = output.origin(), io = input.origin();

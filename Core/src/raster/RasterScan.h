@@ -496,6 +496,13 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   }
 }
 
+// A slab [k0, k1) of output slices within the grid, or one line saying it is not.
+inline void checkSlab(std::int64_t k0, std::int64_t k1, const VolumeGeometry& output) {
+  if (k0 < 0 || k1 > output.dims[2] || k0 >= k1)
+    throw Error("rasterizer: slab [" + std::to_string(k0) + ", " + std::to_string(k1) +
+                ") is not within the output's " + std::to_string(output.dims[2]) + " slices");
+}
+
 inline double frameSign(const VolumeGeometry& output) {
   return output.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0;
 }

@@ -431,9 +431,7 @@ std::int64_t LabelSlabs::sliceBytes() const {
 void LabelSlabs::rasterize(std::int64_t k0, std::int64_t k1, void* slab, RasterReport& report,
                            const ProgressFn& progress) const {
   const Impl& r = *impl_;
-  if (k0 < 0 || k1 > r.output.dims[2] || k0 >= k1)
-    throw Error("rasterizer: slab [" + std::to_string(k0) + ", " + std::to_string(k1) +
-                ") is not within the output's " + std::to_string(r.output.dims[2]) + " slices");
+  checkSlab(k0, k1, r.output);
   const std::int64_t plane = r.output.dims[0] * r.output.dims[1], values = plane * (k1 - k0);
   RasterOptions options = r.options;
   options.progress = progress;
@@ -669,9 +667,7 @@ std::int64_t LabelSlabRasterizer::sliceBytes() const {
 void LabelSlabRasterizer::rasterize(std::int64_t k0, std::int64_t k1, void* slab,
                                     RasterReport& report, const ProgressFn& progress) {
   Impl& r = *impl_;
-  if (k0 < 0 || k1 > r.output.dims[2] || k0 >= k1)
-    throw Error("rasterizer: slab [" + std::to_string(k0) + ", " + std::to_string(k1) +
-                ") is not within the output's " + std::to_string(r.output.dims[2]) + " slices");
+  checkSlab(k0, k1, r.output);
   const NiftiLayout& layout = r.input.layout();
   const auto d = layout.geometry.dims;
   const std::int64_t nx = r.output.dims[0], plane = nx * r.output.dims[1];

@@ -85,9 +85,15 @@ void BackgroundTrace::add(const void* slices, ScalarType type, std::int64_t k0, 
     if constexpr (std::is_integral_v<T>)
       for (std::int64_t k = k0; k < k1; ++k) {
         addSlice(static_cast<const T*>(slices) + (k - k0) * plane, k);
-        for (std::int64_t v = 0; v < plane; ++v)
-          if (const std::int32_t id = here_[std::size_t(v)]; id >= 0 && find(id) != 0)
-            voxels.push_back(k * plane + v), ids.push_back(id);
+        // A run's voxels share an id: its root is looked up once per run, not per voxel.
+        std::int32_t last = -1;
+        bool stillOpen = false;
+        for (std::int64_t v = 0; v < plane; ++v) {
+          const std::int32_t id = here_[std::size_t(v)];
+          if (id < 0) continue;
+          if (id != last) last = id, stillOpen = find(id) != 0;
+          if (stillOpen) voxels.push_back(k * plane + v), ids.push_back(id);
+        }
       }
   });
   next_ = k1;
