@@ -12,13 +12,7 @@ std::vector<std::uint8_t> pieceRimFaces(const TransferMesh& mesh) {
   std::vector<std::uint8_t> out(std::size_t(nt), 0);
   if (mesh.rigid.empty()) return out;
   std::map<std::array<int, 3>, std::vector<std::int32_t>> faces;
-  auto key = [&](Eigen::Index t, int f) {
-    std::array<int, 3> k;
-    for (int c = 0, n = 0; c < 4; ++c)
-      if (c != f) k[std::size_t(n++)] = mesh.tets(t, c);
-    std::sort(k.begin(), k.end());
-    return k;
-  };
+  auto key = [&](Eigen::Index t, int f) { return sortedFace(mesh, t, f); };
   for (Eigen::Index t = 0; t < nt; ++t)
     if (mesh.rigid[std::size_t(t)])
       for (int f = 0; f < 4; ++f) faces[key(t, f)].push_back(std::int32_t(t));

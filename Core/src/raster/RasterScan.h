@@ -496,6 +496,16 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
   }
 }
 
+// Face f of tet t (the face opposite vertex f) as its three vertex indices, sorted: the key two
+// tets sharing the face agree on.
+inline std::array<int, 3> sortedFace(const TransferMesh& mesh, Eigen::Index t, int f) {
+  std::array<int, 3> k;
+  for (int c = 0, n = 0; c < 4; ++c)
+    if (c != f) k[std::size_t(n++)] = mesh.tets(t, c);
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
 // A slab [k0, k1) of output slices within the grid, or one line saying it is not.
 inline void checkSlab(std::int64_t k0, std::int64_t k1, const VolumeGeometry& output) {
   if (k0 < 0 || k1 > output.dims[2] || k0 >= k1)

@@ -60,13 +60,6 @@ std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh) {
     std::int32_t f;
     bool operator<(const Face& o) const { return b != o.b ? b < o.b : c < o.c; }
   };
-  auto sortedFace = [&](Eigen::Index t, int f) {
-    std::array<int, 3> k;
-    for (int c = 0, n = 0; c < 4; ++c)
-      if (c != f) k[std::size_t(n++)] = mesh.tets(t, c);
-    std::sort(k.begin(), k.end());
-    return k;
-  };
   int largest = -1;
   for (Eigen::Index t = 0; t < nt; ++t)
     for (int c = 0; c < 4; ++c) {
@@ -76,14 +69,14 @@ std::vector<std::uint8_t> outerFaces(const TransferMesh& mesh) {
     }
   std::vector<std::int64_t> first(std::size_t(largest) + 2, 0);
   for (Eigen::Index t = 0; t < nt; ++t)
-    for (int f = 0; f < 4; ++f) ++first[std::size_t(sortedFace(t, f)[0]) + 1];
+    for (int f = 0; f < 4; ++f) ++first[std::size_t(sortedFace(mesh, t, f)[0]) + 1];
   for (std::size_t a = 1; a < first.size(); ++a) first[a] += first[a - 1];
   std::vector<Face> faces(std::size_t(4 * nt));
   {
     std::vector<std::int64_t> next(first.begin(), first.end() - 1);
     for (Eigen::Index t = 0; t < nt; ++t)
       for (int f = 0; f < 4; ++f) {
-        const std::array<int, 3> k = sortedFace(t, f);
+        const std::array<int, 3> k = sortedFace(mesh, t, f);
         faces[std::size_t(next[std::size_t(k[0])]++)] = Face{k[1], k[2], std::int32_t(t), f};
       }
   }
