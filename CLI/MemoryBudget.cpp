@@ -13,6 +13,7 @@
 #include <iostream>
 #include <cstdlib>
 #include <sstream>
+#include <thread>
 
 namespace repose::cli {
 
@@ -36,6 +37,23 @@ double parseMemoryBudget(const std::string& text) {
     throw UsageError{"--memory: unknown unit in '" + text + "' (use K, M or G)"};
   if (!(v > 0)) throw UsageError{"--memory must be positive"};
   return v * scale;
+}
+
+namespace {
+int localRanks() {
+  const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+  return local ? std::max(1, std::atoi(local)) : 1;
+}
+}  // namespace
+
+double rankMemoryBudget(const std::string& memory) {
+  const double budget = parseMemoryBudget(memory);
+  return memory.empty() ? budget / localRanks() : budget;
+}
+
+int rankThreads(int threads) {
+  if (threads > 0) return threads;
+  return std::max(1, int(std::thread::hardware_concurrency()) / localRanks());
 }
 
 ReadOptions readOptionsWithin(double budget, bool progress) {

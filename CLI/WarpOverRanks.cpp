@@ -18,25 +18,10 @@
 #include "repose/util/Error.h"
 
 #include <chrono>
-#include <cstdlib>
 #include <filesystem>
 #include <optional>
 
 namespace repose::cli {
-namespace {
-
-// The budget of one rank: --memory, or half the RAM shared by the ranks on this node (Open MPI
-// says how many there are).
-double rankBudget(const std::string& memory) {
-  double budget = parseMemoryBudget(memory);
-  if (memory.empty())
-    if (const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE"))
-      budget /= std::max(1, std::atoi(local));
-  return budget;
-}
-
-}  // namespace
-
 int runWarpOverRanks(const ArgParser& p) {
   const auto start = std::chrono::steady_clock::now();
   const std::unique_ptr<WarpRanks> ranks = makeWarpRanks();
@@ -70,7 +55,7 @@ int runWarpOverRanks(const ArgParser& p) {
       refuseOverwritingInput(p.get(in), out);
     spacing = p.getDouble("spacing-mm");
     if (spacing < 0) throw UsageError{"--spacing-mm must be >= 0"};
-    budget = rankBudget(p.get("memory"));
+    budget = rankMemoryBudget(p.get("memory"));
     layout = readNiftiLayout(input);
     if (!isIntegerType(layout.type))
       throw Error(input + ": not a label map (float voxels); pose images with --image");

@@ -17,16 +17,19 @@
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
+#include <repose/pose/FramePreview.h>
 #include <repose/pose/PoseFrame.h>
 #include <repose/pose/PoseJob.h>
 #include <repose/pose/PoseRig.h>
 #include <repose/pose/PoseRun.h>
 #include <repose/rig/Rig.h>
 #include <repose/util/Error.h>
+#include <repose/util/Memory.h>
 
 #include <vtkObjectFactory.h>
 #include <vtkUnstructuredGrid.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <sstream>
@@ -247,9 +250,15 @@ bool vtkSlicerReposeJobsLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     const double budget = 1048576.0 * (this->Context->ParameterNode
                                            ? this->Context->ParameterNode->GetOutputMemoryBudgetMB()
                                            : 0);
-    const char* budgetHint = "Output > Memory budget; out of core: `repose warp`";
-    repose::checkFrameMemory(G->geometry(), repose::posedBytesPerVoxel(*G, *S, I.get()), budget,
-                             "the posed volumes", budgetHint);
+    // With an output folder a frame beyond the budget is made slab by slab there, as `repose
+    // pose` makes it (the same files); the new node then holds a preview read back from them.
+    const bool outOfCore = !outputFolder.empty();
+    const char* budgetHint =
+        "Output > Memory budget, or an output folder: a frame beyond the budget is made slab by "
+        "slab there";
+    if (!outOfCore)
+      repose::checkFrameMemory(G->geometry(), repose::posedBytesPerVoxel(*G, *S, I.get()), budget,
+                               "the posed volumes", budgetHint);
     vtkSmartPointer<vtkMRMLReposeSegmentationNode> segRef = seg;
     vtkSmartPointer<vtkMRMLReposePoseNode> poseRef = poseNode;
     this->Context->Job->Start(
@@ -272,20 +281,42 @@ bool vtkSlicerReposeJobsLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
           // Locked like `repose pose --out`: a run of it writing there refuses, and so does this.
           run.folder = outputFolder;
           run.write.lockFolder = true;
-          auto f = std::make_shared<repose::PosedFrame>(
-              repose::runPoseFrame(*job, *rig, std::min(frame, rig->frameCount() - 1), *G, *S, run)
-                  .frame);
+          run.outOfCore = outOfCore;
+          repose::FrameOutcome outcome =
+              repose::runPoseFrame(*job, *rig, std::min(frame, rig->frameCount() - 1), *G, *S, run);
+          auto f = std::make_shared<repose::PosedFrame>(std::move(outcome.frame));
+          std::vector<std::string> warnings = job->warnings();
+          std::string name = segRef->GetName() + " " + f->name;
+          if (outcome.streamed) {
+            // Its maps are the folder's files: the node gets G and S read back as a preview
+            // within what the budget leaves, 8 MiB to 512 MiB (the heap the frame used may not
+            // be back with the system, and a preview needs no more); no image.
+            const double previewBytes =
+                std::clamp(repose::memoryLeftWithin(budget), 8.0 * 1048576, 512.0 * 1048576);
+            const repose::FramePreview preview = repose::previewStreamedFrame(
+                outputFolder, previewBytes,
+                [&](double x, const std::string&) { return progress(0.9 + 0.1 * x, "preview"); });
+            f->organs = preview.organs;
+            f->parts = preview.parts;
+            f->image.reset();
+            const std::string ratio = "1:" + std::to_string(preview.factor);
+            name += " (preview " + ratio + ")";
+            warnings.push_back(
+                "made slab by slab (beyond Output > Memory budget): the full-"
+                "resolution frame is in " +
+                outputFolder + "; this node holds a " + ratio + " preview of G and S");
+          }
           repose::reportProgress(progress, 1, "posed");
           return [=] {
             auto node = vtkSmartPointer<vtkMRMLReposeSegmentationNode>::New();
-            node->SetName(segRef->GetName() + " " + f->name);
+            node->SetName(name);
             node->SetLabelMap(Conversion::ToImageData(f->organs));
             node->SetBodyPartMap(Conversion::ToImageData(f->parts));
             if (f->image) node->SetImage(Conversion::ToImageData(*f->image));
             node->SetNodeReferenceID("source", segRef->GetID());
             node->SetNodeReferenceID("pose", poseRef->GetID());
             node->SetPoseReportJSON(f->reportJson);
-            node->SetPoseWarnings(job->warnings());
+            node->SetPoseWarnings(warnings);
             this->Context->Scene->AddNode(node);
             if (this->Context->ParameterNode)
               this->Context->ParameterNode->SetOutputSegmentationNodeID(node->GetID());

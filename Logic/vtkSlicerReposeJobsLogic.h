@@ -41,7 +41,11 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeJobsLogic : public vt
   bool StartBuildRig(vtkMRMLReposeSegmentationNode* segmentation, vtkMRMLReposePoseNode* pose);
   // The pose node's current frame at full resolution (Core's repose::runPoseFrame): a new
   // segmentation node (posed G, S, image; the report and warnings) referring to its source and
-  // pose; with an output folder also the files `repose pose` writes there.
+  // pose; with an output folder also the files `repose pose` writes there. Without one, a frame
+  // whose posed volumes exceed Output > Memory budget is refused before the work; with one it
+  // is made slab by slab into the folder (the same files), and the node holds G and S read back
+  // from them as a coarser preview ("(preview 1:F)" in its name, a warning saying where the
+  // full-resolution files are; no image).
   bool StartApplyPose(vtkMRMLReposePoseNode* pose, const std::string& outputFolder = "");
   // The live pose's transfer mesh refined for its current frame (seed §4.2), `iterations` rounds:
   // a new transfer-mesh node the pose then refers to. Start live posing again to use it.

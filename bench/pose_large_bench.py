@@ -2,9 +2,10 @@
 """The whole pose job at the seed's scale and beyond (issue 56; docs/PERFORMANCE.md, "The pose
 job out of core"): `repose pose` of the arms-resting phantom on the adult male reference grid
 (2.137 x 2.137 x 8 mm, with its CT), the suite's elbow flexion, written at 1 mm
-and at 0.5 mm, in core (a budget that holds the frame) and slab by slab (a 2 GiB budget). Each run
-is one `repose pose` command timed with its peak resident memory (/usr/bin/time -v); the rig is
-built once into a scene folder and reused, so the runs time the frame. The streamed files are
+and at 0.5 mm, in core (a budget that holds the frame), slab by slab (a 2 GiB budget) and slab
+by slab over 2 MPI ranks (`--mpi`, 1 GiB each). Each run is one `repose pose` command timed with
+its peak resident memory (/usr/bin/time -v; over MPI each rank's, the largest and their sum); the
+rig is built once into a scene folder and reused, so the runs time the frame. The streamed files are
 compared with the in-core ones where both exist (byte for byte; the colour tables after their
 first line, which names the file).
 
@@ -49,6 +50,7 @@ def same_files(a, b):
             return False
     ra = json.loads((Path(a) / "report.json").read_text())
     rb = json.loads((Path(b) / "report.json").read_text())
+    ra.pop("streamed", None)
     rb.pop("streamed", None)
     return ra == rb
 
@@ -61,6 +63,10 @@ def main():
                    help="output voxel sizes in mm (0.45: beyond 2G voxels on this phantom)")
     p.add_argument("--streamed-memory", default="2G")
     p.add_argument("--in-core-memory", default="20G")
+    p.add_argument("--ranks", type=int, default=2,
+                   help="also run each frame slab by slab over this many MPI ranks (--mpi; 1: not)")
+    p.add_argument("--ranks-memory", default="1G",
+                   help="each rank's --memory over MPI (1G: the ranks share the 2 GiB)")
     p.add_argument("--in-core-below-voxels", type=float, default=1.2e9,
                    help="frames above this many output voxels are not run in core")
     a = p.parse_args()
@@ -78,18 +84,32 @@ def main():
     results = []
     for spacing in [float(s) for s in a.spacings.split(",")]:
         folders = {}
-        for mode, memory in (("streamed", a.streamed_memory), ("in core", a.in_core_memory)):
-            folder = out / f"frame_{spacing:g}mm_{mode.replace(' ', '_')}"
-            row = {"spacing_mm": spacing, "mode": mode, "memory": memory, "ranks": 1}
+        runs = [("streamed", a.streamed_memory, 1)]
+        if a.ranks > 1:
+            runs.append(("streamed", a.ranks_memory, a.ranks))
+        runs.append(("in core", a.in_core_memory, 1))
+        for mode, memory, ranks in runs:
+            name = f"frame_{spacing:g}mm_{mode.replace(' ', '_')}" + (
+                f"_{ranks}ranks" if ranks > 1 else "")
+            folder = out / name
+            row = {"spacing_mm": spacing, "mode": mode, "memory": memory, "ranks": ranks}
             if mode == "in core" and results[-1].get("output_voxels", 0) > a.in_core_below_voxels:
                 row["refused"] = "beyond this machine's memory in core"
                 results.append(row)
                 print(json.dumps(row), flush=True)
                 continue
-            done, seconds, peak = run(job + ["--spacing-mm", spacing, "--memory", memory,
-                                             "--out", folder], check=False)
+            args = job + ["--spacing-mm", spacing, "--memory", memory, "--out", folder]
+            if ranks > 1:
+                # Each rank's own peak, as the ranks' /usr/bin/time print it.
+                args = ["/usr/bin/mpirun", "-np", ranks, "--oversubscribe", "--allow-run-as-root",
+                        "/usr/bin/time", "-f", "rank peak %M"] + args + ["--mpi"]
+            done, seconds, peak = run(args, check=False)
             row.update({"seconds": round(seconds, 1), "peak_resident_bytes": peak,
                         "exit": done.returncode})
+            if ranks > 1:
+                peaks = [int(k) * 1024 for k in re.findall(r"rank peak (\d+)", done.stderr)]
+                row["peak_resident_bytes"] = max(peaks) if peaks else None
+                row["peak_resident_bytes_all_ranks"] = sum(peaks) if peaks else None
             if done.returncode in (0, 4):
                 report = json.loads((folder / "report.json").read_text())
                 dims = report["grid"]["dims"]
@@ -99,13 +119,18 @@ def main():
                     row["slabs"] = report["streamed"]["slabs"]
                 row["relabelled_voxels"] = report["label_volumes"]["relabelled_voxels"]
                 row["targets_met"] = report["targets"]["met"]
-                folders[mode] = folder
+                folders[(mode, ranks)] = folder
             else:
                 row["error"] = done.stderr.strip().splitlines()[-1][:300] if done.stderr else ""
             results.append(row)
             print(json.dumps(row), flush=True)
-        if len(folders) == 2:
-            same = same_files(folders["in core"], folders["streamed"])
+            if ranks > 1 and ("streamed", 1) in folders and (mode, ranks) in folders:
+                same = same_files(folders[("streamed", 1)], folders[(mode, ranks)])
+                row["same_as_one_rank"] = same
+                print(f"{spacing:g} mm: {ranks} ranks' files {'equal' if same else 'DIFFER from'}"
+                      " one rank's", flush=True)
+        if ("in core", 1) in folders and ("streamed", 1) in folders:
+            same = same_files(folders[("in core", 1)], folders[("streamed", 1)])
             results[-1]["same_as_in_core"] = same
             print(f"{spacing:g} mm: streamed files {'equal' if same else 'DIFFER from'} in core",
                   flush=True)

@@ -1,43 +1,23 @@
-// `repose warp --mpi` over the ranks of an MPI job (WarpRanks.h). Only the main thread calls
-// MPI (MPI_THREAD_FUNNELED): the deformation and the gzip pieces use worker threads that never
-// do. Waits poll with a short sleep instead of blocking in MPI, whose busy wait would take a core
-// from the ranks that work (rank 0 computing the deformation while the others wait for it).
+// `repose warp --mpi` over the ranks of an MPI job (WarpRanks.h), on an MPI session of its own
+// (MpiSession.h: only the main thread calls MPI, waits poll so that rank 0 computing the
+// deformation keeps its core while the others wait for it).
 // Built only where CMake's FindMPI finds MPI (CLI/CMakeLists.txt).
 #include "../ArgParser.h"
 #include "../WarpRanks.h"
+#include "MpiSession.h"
 
 #include "repose/io/GzipPieces.h"
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 
-#define OMPI_SKIP_MPICXX 1
-#define MPICH_SKIP_MPICXX 1
-#include <mpi.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
-#include <new>
-#include <thread>
 #include <vector>
 
 namespace repose::cli {
 namespace {
 
-void await(MPI_Request& request, MPI_Status* status = MPI_STATUS_IGNORE) {
-  for (int done = 0;;) {
-    MPI_Test(&request, &done, status);
-    if (done) return;
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
-  }
-}
-
-std::string mpiErrorText(int code) {
-  char text[MPI_MAX_ERROR_STRING];
-  int length = 0;
-  MPI_Error_string(code, text, &length);
-  return std::string(text, static_cast<std::size_t>(length));
-}
+using mpi::await;
 
 // Every rank's int64 values, `count` per rank, in rank order.
 std::vector<std::int64_t> allGather(MPI_Comm comm, int size,
@@ -52,60 +32,15 @@ std::vector<std::int64_t> allGather(MPI_Comm comm, int size,
 
 class MpiWarpRanks final : public WarpRanks {
  public:
-  MpiWarpRanks() {
-    int initialized = 0;
-    MPI_Initialized(&initialized);
-    if (!initialized) {
-      int provided = MPI_THREAD_SINGLE;
-      MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-      owns_ = true;
-    }
-    MPI_Comm_dup(MPI_COMM_WORLD, &comm_);
-    MPI_Comm_rank(comm_, &rank_);
-    MPI_Comm_size(comm_, &size_);
-  }
-
   ~MpiWarpRanks() override {
     if (file_ != MPI_FILE_NULL) MPI_File_close(&file_);  // every rank unwinds together
-    MPI_Comm_free(&comm_);
-    if (owns_) MPI_Finalize();
   }
 
   int rank() const override { return rank_; }
   std::int64_t slabs() const override { return slabs_; }
   int size() const override { return size_; }
 
-  void together(const std::function<void()>& step) override {
-    // Kind of failure: 0 none, 1 error, 2 interrupted, 3 usage error.
-    int kind = 0;
-    std::string message;
-    try {
-      step();
-    } catch (const Cancelled&) {
-      kind = 2;
-    } catch (const UsageError& e) {
-      kind = 3, message = e.message;
-    } catch (const QuietExit&) {
-      kind = 1, message = "a rank failed";
-    } catch (const std::bad_alloc&) {
-      kind = 1, message = "out of memory";
-    } catch (const std::exception& e) {
-      kind = 1, message = e.what();
-    }
-    int mine = kind ? rank_ : size_, first = size_;
-    MPI_Request r;
-    MPI_Iallreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm_, &r);
-    await(r);
-    if (first == size_) return;
-    std::string text = rank_ == first ? std::to_string(kind) + message : std::string();
-    text = broadcastFrom(first, text);
-    kind = text[0] - '0';
-    message = text.substr(1);
-    if (rank_ != 0) throw QuietExit{kind == 2 ? 130 : kind == 3 ? 2 : 1};
-    if (kind == 2) throw Cancelled();
-    if (kind == 3) throw UsageError{message};
-    throw Error(first == 0 ? message : "rank " + std::to_string(first) + ": " + message);
-  }
+  void together(const std::function<void()>& step) override { session_.together(step); }
 
   void broadcast(Eigen::MatrixX3d& matrix) override {
     std::int64_t rows = matrix.rows();
@@ -155,7 +90,7 @@ class MpiWarpRanks final : public WarpRanks {
                                    MPI_INFO_NULL, &file_);
       if (rc != MPI_SUCCESS) {
         file_ = MPI_FILE_NULL;
-        throw Error(path + ": cannot create the output file (" + mpiErrorText(rc) + ")");
+        throw Error(path + ": cannot create the output file (" + mpi::errorText(rc) + ")");
       }
     });
     together([&] {
@@ -233,21 +168,14 @@ class MpiWarpRanks final : public WarpRanks {
       const int rc = MPI_File_close(&file_);
       file_ = MPI_FILE_NULL;
       if (rc != MPI_SUCCESS)
-        throw Error(path + ": closing the file failed (" + mpiErrorText(rc) + ")");
+        throw Error(path + ": closing the file failed (" + mpi::errorText(rc) + ")");
     });
     return gatherReport(report);
   }
 
  private:
   std::string broadcastFrom(int root, std::string text) {
-    std::int64_t n = static_cast<std::int64_t>(text.size());
-    MPI_Request r;
-    MPI_Ibcast(&n, 1, MPI_INT64_T, root, comm_, &r);
-    await(r);
-    text.resize(static_cast<std::size_t>(n));
-    MPI_Ibcast(text.data(), static_cast<int>(n), MPI_CHAR, root, comm_, &r);
-    await(r);
-    return text;
+    return session_.broadcastFrom(root, std::move(text));
   }
 
   // A collective write (every rank calls it, some with nothing) or rank 0's own.
@@ -260,7 +188,7 @@ class MpiWarpRanks final : public WarpRanks {
         collective
             ? MPI_File_iwrite_at_all(file_, at, buffer, static_cast<int>(bytes), MPI_BYTE, &r)
             : MPI_File_iwrite_at(file_, at, buffer, static_cast<int>(bytes), MPI_BYTE, &r);
-    if (rc != MPI_SUCCESS) throw Error(path + ": write failed (" + mpiErrorText(rc) + ")");
+    if (rc != MPI_SUCCESS) throw Error(path + ": write failed (" + mpi::errorText(rc) + ")");
     await(r, &status);
     int written = 0;
     MPI_Get_count(&status, MPI_BYTE, &written);
@@ -302,11 +230,11 @@ class MpiWarpRanks final : public WarpRanks {
     return report;
   }
 
-  MPI_Comm comm_ = MPI_COMM_NULL;
+  mpi::Session session_;
+  const MPI_Comm comm_ = session_.comm();
+  const int rank_ = session_.rank(), size_ = session_.size();
   MPI_File file_ = MPI_FILE_NULL;
-  int rank_ = 0, size_ = 1;
   std::int64_t slabs_ = 0;
-  bool owns_ = false;
 };
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "repose/pose/PoseFrame.h"
 #include "repose/pose/PosedTally.h"
+#include "repose/pose/SlabRanks.h"
 #include "repose/raster/PocketFilling.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
@@ -37,12 +38,15 @@ FrameStart startFrame(const PoseRig& rig, std::size_t index, const Volume& organ
 PosedFrame poseFrameFrom(FrameStart& start, const PoseRig& rig, const Volume& organs,
                          const Volume& parts, const PoseFrameOptions& options);
 // The frame slab by slab into `folder` (poseFrameToFolder after its start); `complete` gives the
-// report as the job completes it before it is written (null: as it is).
+// report as the job completes it before it is written (null: as it is). Over `ranks` (null: this
+// process alone) every rank calls it; rank 0 writes the folder and returns the report's text, the
+// others make slabs and return "".
 std::string poseFrameToFolderFrom(FrameStart& start, const PoseRig& rig, const Volume& organs,
                                   const Volume& parts, const PoseFrameOptions& options,
                                   const std::string& folder, const FrameWriteOptions& write,
                                   double memoryBudget, std::int64_t slabSlices,
-                                  const std::function<std::string(const std::string&)>& complete);
+                                  const std::function<std::string(const std::string&)>& complete,
+                                  SlabRanks* ranks = nullptr);
 // Says `line` (when not empty) through options.warn and keeps it for the report.
 void warn(FrameStart& start, const PoseFrameOptions& options, const std::string& line);
 

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <optional>
 
 namespace repose {
 
@@ -110,22 +111,27 @@ FrameOutcome runPoseFrame(const PoseJob& job, const PoseRig& rig, std::size_t in
   // process holds now, checked on the frame's grid before anything is allocated for it. Beyond
   // it a frame with a folder to go to is made slab by slab when the front end allows it.
   const double bytesPerVoxel = posedBytesPerVoxel(organs, parts, run.image);
-  frame::FrameStart start = frame::startFrame(rig, index, organs, parts, fo);
+  std::optional<frame::FrameStart> started;
+  if (run.ranks)
+    run.ranks->together([&] { started = frame::startFrame(rig, index, organs, parts, fo); });
+  else
+    started = frame::startFrame(rig, index, organs, parts, fo);
+  frame::FrameStart& start = *started;
   FrameOutcome out;
   if (!run.folder.empty() &&
-      (run.alwaysOutOfCore ||
+      (run.alwaysOutOfCore || run.ranks ||
        (run.outOfCore && !frameFitsMemory(start.grid, bytesPerVoxel, run.memoryBudget)))) {
     if (run.onGrid) run.onGrid(start.grid);
     out.streamed = true;
     out.frame.name = start.frame.name;
     out.frame.grid = start.grid;
     out.frame.labelMapFiles = run.labelMapFiles;
-    out.reportJson =
-        frame::poseFrameToFolderFrom(start, rig, organs, parts, fo, run.folder, wo,
-                                     run.memoryBudget, 0, [&](const std::string& report) {
-                                       return job.completeReport(report, run.sceneReused, rig);
-                                     });
+    out.reportJson = frame::poseFrameToFolderFrom(
+        start, rig, organs, parts, fo, run.folder, wo, run.memoryBudget, 0,
+        [&](const std::string& report) { return job.completeReport(report, run.sceneReused, rig); },
+        run.ranks);
     out.frame.reportJson = out.reportJson;
+    if (run.ranks && !run.ranks->root()) return out;  // rank 0 has the report
   } else {
     checkFrameMemory(start.grid, bytesPerVoxel, run.memoryBudget, run.budgetWhat, run.budgetHint);
     if (run.onGrid) run.onGrid(start.grid);

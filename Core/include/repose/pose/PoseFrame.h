@@ -5,6 +5,7 @@
 #pragma once
 
 #include "repose/pose/PoseRig.h"
+#include "repose/pose/SlabRanks.h"
 #include "repose/util/Progress.h"
 #include "repose/volume/TissueTable.h"
 #include "repose/volume/Volume.h"
@@ -136,10 +137,13 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
 // `slabSlices` > 0 sets the slabs' thickness instead (tests cut a frame into slabs of a slice).
 // A DICOM SEG (made whole in memory) is refused in one line before the work. Returns
 // report.json's text as written. Throws repose::Error, or Cancelled from options.progress;
-// nothing is written then.
+// nothing is written then. Over `ranks` (SlabRanks.h; null: this process alone) every rank calls
+// it with the same arguments: the other ranks make the slabs, rank 0 writes the folder and returns
+// the report (the others "").
 std::string poseFrameToFolder(const PoseRig& rig, std::size_t index, const Volume& organs,
                               const Volume& parts, const PoseFrameOptions& options,
                               const std::string& folder, const FrameWriteOptions& write,
-                              double memoryBudget = 0, std::int64_t slabSlices = 0);
+                              double memoryBudget = 0, std::int64_t slabSlices = 0,
+                              SlabRanks* ranks = nullptr);
 
 }  // namespace repose

@@ -93,6 +93,9 @@ struct FrameRun {
   bool outOfCore = false;
   // With a folder: every frame slab by slab, whatever its size (the slabs sized to the budget).
   bool alwaysOutOfCore = false;
+  // With a folder: the ranks that share every frame's slabs (SlabRanks.h; every rank runs the
+  // frame, rank 0 writes it and has the outcome's report). Null: this process alone.
+  SlabRanks* ranks = nullptr;
 };
 
 struct FrameOutcome {
