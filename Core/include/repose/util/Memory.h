@@ -9,7 +9,9 @@
 namespace repose {
 
 double physicalMemoryBytes();
-// The resident set now (VmRSS) and its peak so far (VmHWM).
+// The resident set now (VmRSS), once the allocator has given back the heap the process freed
+// (glibc's malloc_trim: a setup's temporaries stay resident otherwise, and a budget measured
+// against them refuses work that fits), and its peak so far (VmHWM).
 double residentBytes();
 double peakResidentBytes();
 // Half the physical memory: --memory's default.
