@@ -1,5 +1,5 @@
-// Files the CLI tests share: the standard pose suite's pose files, JSON outputs, and a phantom
-// with its cage and transfer mesh made by the commands.
+// What the CLI tests share: the standard pose suite's pose files, JSON outputs, a phantom
+// with its cage and transfer mesh made by the commands, and the MPI tests' mpirun arguments.
 #pragma once
 
 #include "CommandRunner.h"
@@ -14,6 +14,19 @@
 namespace repose::test {
 
 // bench/poses/<name>.pose.json in the source tree.
+// How often `what` occurs in `text` (a message said once, not once per MPI rank).
+inline int occurrences(const std::string& text, const std::string& what) {
+  int n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// mpirun's arguments that start `program` (of the build's bin folder) on `ranks` ranks.
+inline std::string mpirunArgs(int ranks, const std::string& program = "repose") {
+  return "-np " + std::to_string(ranks) + " --oversubscribe --allow-run-as-root " +
+         shellQuote(binPath(program)) + " ";
+}
+
 inline std::string suitePoseFile(const std::string& name) {
   return std::string(REPOSE_SOURCE_DIR) + "/bench/poses/" + name + ".pose.json";
 }

@@ -20,17 +20,6 @@ using nlohmann::json;
 
 namespace {
 
-int occurrences(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
-
-std::string mpirun(int ranks, const std::string& program) {
-  return "-np " + std::to_string(ranks) + " --oversubscribe --allow-run-as-root " +
-         shellQuote(binPath(program)) + " ";
-}
-
 // A file of a frame's folder as the comparison takes it: a colour table after its first line
 // (which names the file it was written as).
 std::string frameFile(const fs::path& file) {
@@ -71,7 +60,7 @@ TEST(PoseMpiCommand, SlabsOverRanksWriteTheOneProcessFrameByteForByte) {
     // One rank: started without mpirun (MPI's singleton start).
     const CommandResult m = ranks == 1
                                 ? runCommand("repose", args)
-                                : runCommand("/usr/bin/mpirun", mpirun(ranks, "repose") + args);
+                                : runCommand("/usr/bin/mpirun", mpirunArgs(ranks, "repose") + args);
     ASSERT_EQ(m.exitCode, one.exitCode) << m.err << m.out;
     json report = json::parse(m.out);  // rank 0's alone on stdout
     EXPECT_EQ(report["streamed"]["ranks"], ranks);
@@ -114,7 +103,7 @@ TEST(PoseMpiCommand, WhatARankRefusesIsSaidOnceAndLeavesNothing) {
                  shellQuote(dir.file("one.nii.gz")),
              "--mpi writes the frames into --out only", 2},
         Case{job + " --scene " + shellQuote(dir.file("scene")) + " --memory 1K", "budget", 1}}) {
-    const CommandResult m = runCommand("/usr/bin/mpirun", mpirun(2, "repose") + c.args);
+    const CommandResult m = runCommand("/usr/bin/mpirun", mpirunArgs(2, "repose") + c.args);
     EXPECT_EQ(m.exitCode, c.exit) << c.args << "\n" << m.err;
     EXPECT_EQ(occurrences(m.err, "repose pose:"), 1) << m.err;
     EXPECT_NE(m.err.find(c.says), std::string::npos) << m.err;
@@ -127,7 +116,7 @@ TEST(PoseMpiCommand, TheSlabPipelineDeliversEverySlabInOrderAndAgreesOnAFailure)
   if (kAddressSanitizer) GTEST_SKIP() << "mpirun under AddressSanitizer (docs/RELIABILITY.md)";
   for (const int ranks : {1, 2, 3, 4}) {
     const CommandResult ok =
-        runCommand("/usr/bin/mpirun", mpirun(ranks, "ReposeSlabRanksProbe") + "ok");
+        runCommand("/usr/bin/mpirun", mpirunArgs(ranks, "ReposeSlabRanksProbe") + "ok");
     ASSERT_EQ(ok.exitCode, 0) << ok.err;
     EXPECT_NE(ok.out.find("used 28 slabs over " + std::to_string(ranks)), std::string::npos)
         << ok.out;
@@ -143,7 +132,7 @@ TEST(PoseMpiCommand, TheSlabPipelineDeliversEverySlabInOrderAndAgreesOnAFailure)
                         Case{"use-fails 22", "probe: error: slab 22 cannot be used", 1},
                         Case{"make-cancels 3", "probe: cancelled", 130}}) {
     const CommandResult m =
-        runCommand("/usr/bin/mpirun", mpirun(3, "ReposeSlabRanksProbe") + c.args);
+        runCommand("/usr/bin/mpirun", mpirunArgs(3, "ReposeSlabRanksProbe") + c.args);
     EXPECT_EQ(m.exitCode, c.exit) << c.args << "\n" << m.err;
     EXPECT_EQ(occurrences(m.err, "probe:"), 1) << m.err;
     EXPECT_NE(m.err.find(c.says), std::string::npos) << c.args << "\n" << m.err;

@@ -23,17 +23,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-int occurrences(const std::string& text, const std::string& what) {
-  int n = 0;
-  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
-
-std::string mpirun(int ranks) {
-  return "-np " + std::to_string(ranks) + " --oversubscribe --allow-run-as-root " +
-         shellQuote(binPath("repose")) + " ";
-}
-
 // The 4 mm phantom's left forearm flexed 60° at the elbow, warped to 1.5 mm output voxels
 // (289 x 164 x 871: enough slabs for three ranks under the budget below).
 struct Elbow {
@@ -88,7 +77,7 @@ TEST(WarpMpiCommand, SlabsOverRanksWriteTheSerialOutOfCoreFileByteForByte) {
       const std::string args = e.warp(e.posed) + " --mpi --out " + shellQuote(out) + budget;
       // One rank: started without mpirun (MPI's singleton start).
       const CommandResult m = ranks == 1 ? runCommand("repose", args)
-                                         : runCommand("/usr/bin/mpirun", mpirun(ranks) + args);
+                                         : runCommand("/usr/bin/mpirun", mpirunArgs(ranks) + args);
       ASSERT_EQ(m.exitCode, 0) << m.err << m.out;
       const auto mj = nlohmann::json::parse(m.out);
       EXPECT_EQ(mj["mpi"]["ranks"], ranks);
@@ -123,7 +112,7 @@ TEST(WarpMpiCommand, AFailureOnTheRanksIsReportedOnceAndLeavesNothing) {
         Case{e.warp(e.posed) + " --mpi --out " + shellQuote(out) + " --image " +
                  shellQuote(e.organs) + " --image-out " + shellQuote(e.dir.file("i.nii.gz")),
              "--image is not available"}}) {
-    const CommandResult m = runCommand("/usr/bin/mpirun", mpirun(2) + c.args);
+    const CommandResult m = runCommand("/usr/bin/mpirun", mpirunArgs(2) + c.args);
     EXPECT_NE(m.exitCode, 0) << c.args;
     EXPECT_EQ(occurrences(m.err, "repose warp:"), 1) << m.err;
     EXPECT_NE(m.err.find(c.says), std::string::npos) << m.err;
