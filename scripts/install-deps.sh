@@ -12,7 +12,7 @@ PACKAGES=(
   python3-dev pybind11-dev
   python3-numpy python3-nibabel python3-pytest python3-matplotlib python3-jsonschema
   python3-scipy python3-vtk9
-  xvfb xauth libxml2-utils
+  xvfb xauth libxml2-utils dicom3tools
   plastimatch time
   openems python3-openems libopenems-dev python3-h5py
   libopenmpi-dev openmpi-bin

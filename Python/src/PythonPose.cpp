@@ -550,8 +550,8 @@ volumes beside what the process holds must fit in it (0: half the physical memor
 does (the files of PosedFrame.write, and report.json), returning the report. A frame whose posed
 volumes exceed memory_bytes (0: half the physical memory) is made slab by slab and written as it
 goes: the same files and report (plus "streamed"), whatever its size. output_format: 'nii.gz',
-'seg.nrrd' or 'both' ('dcmseg' only for a frame that fits). Refused while another Repose run
-writes into the folder.)doc")
+'seg.nrrd', 'both' or 'dcmseg' (refused before the work when its frames would pass DICOM's 4 GiB
+of pixel data). Refused while another Repose run writes into the folder.)doc")
       .def(
           "pose_labels_to_file",
           [](const Rig& r, const std::string& organsPath, const std::string& outPath,

@@ -13,6 +13,9 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -138,6 +141,39 @@ inline bool setSegSpacingBetweenSlices(const std::string& path, const char* spac
          shared->findAndGetSequenceItem(DCM_PixelMeasuresSequence, measures, 0).good() &&
          measures->putAndInsertString(DCM_SpacingBetweenSlices, spacing).good() &&
          seg.saveFile(path.c_str(), EXS_LittleEndianExplicit).good();
+}
+
+// What a SEG Repose wrote holds beyond its identity (UIDs, dates): its NumberOfFrames, then its
+// bytes from the Per-frame Functional Groups Sequence to the end (every frame's position, slice
+// and segment, then the pixel data). Two SEGs of the same label map written apart agree in it.
+inline std::string segFramesOf(const std::string& path) {
+  DcmFileFormat file;
+  OFString frames;
+  if (!file.loadFile(path.c_str()).good() ||
+      !file.getDataset()->findAndGetOFString(DCM_NumberOfFrames, frames).good())
+    return "unreadable: " + path;
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(in), {});
+  const std::string tag("\x00\x52\x30\x92SQ", 6);  // (5200,9230) SQ, explicit VR little endian
+  const std::size_t at = bytes.find(tag);
+  if (at == std::string::npos) return "no per-frame functional groups: " + path;
+  return std::string(frames.c_str()) + " frames\n" + bytes.substr(at);
+}
+
+// The lines of dicom3tools' dciodvfy (the standard's IOD and attribute checks) on `path` that
+// say Error; "dciodvfy failed" when it did not run.
+inline std::string dciodvfyErrors(const std::string& path) {
+  const std::string command = "dciodvfy '" + path + "' 2>&1";
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return "dciodvfy failed";
+  std::string out;
+  char line[4096];
+  while (std::fgets(line, sizeof line, pipe))
+    if (std::string(line).find("Error") != std::string::npos) out += line;
+  const int status = pclose(pipe);
+  return status == -1 || (out.empty() && status != 0)
+             ? "dciodvfy failed (" + std::to_string(status) + ")"
+             : out;
 }
 
 }  // namespace repose::test

@@ -269,12 +269,14 @@ def test_a_frame_beyond_the_budget_is_written_slab_by_slab_into_its_folder(tmp_p
     # The process's resident set now, as the memory rule reads it (the heap the allocator keeps
     # of what was freed given back first: repose::residentBytes), and a little more: the posed
     # volumes do not fit.
-    ctypes.CDLL("libc.so.6").malloc_trim(0)
-    with open("/proc/self/status") as status:
-        rss = next(int(l.split()[1]) * 1024 for l in status if l.startswith("VmRSS:"))
+    def resident():
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+        with open("/proc/self/status") as status:
+            return next(int(l.split()[1]) * 1024 for l in status if l.startswith("VmRSS:"))
+
     streamed = elbow_rig.pose_frame_to_folder(g, s, str(tmp_path / "slabs"), spacing_mm=4.0,
                                               image=phantom["image"], output_format="both",
-                                              memory_bytes=rss + 24 * 2**20)
+                                              memory_bytes=resident() + 24 * 2**20)
     assert streamed["streamed"]["slabs"] > 1, streamed["streamed"]
     del streamed["streamed"]
     assert streamed == whole
@@ -288,6 +290,13 @@ def test_a_frame_beyond_the_budget_is_written_slab_by_slab_into_its_folder(tmp_p
     frame = elbow_rig.pose_frame(g, s, spacing_mm=4.0, image=phantom["image"])
     posed = np.asanyarray(nib.load(tmp_path / "slabs" / "posed_G.nii.gz").dataobj)
     np.testing.assert_array_equal(posed, frame.organs.array)
+    # As DICOM SEG, slab by slab too: the same voxels, read back.
+    dcm = elbow_rig.pose_frame_to_folder(g, s, str(tmp_path / "dcm"), spacing_mm=4.0,
+                                         output_format="dcmseg",
+                                         memory_bytes=resident() + 24 * 2**20)
+    assert dcm["streamed"]["slabs"] > 1, dcm["streamed"]
+    np.testing.assert_array_equal(rp.read_volume(str(tmp_path / "dcm" / "posed_G.dcm")).array,
+                                  frame.organs.array)
 
 
 def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):

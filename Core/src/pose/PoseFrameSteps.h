@@ -47,6 +47,17 @@ std::string poseFrameToFolderFrom(FrameStart& start, const PoseRig& rig, const V
                                   double memoryBudget, std::int64_t slabSlices,
                                   const std::function<std::string(const std::string&)>& complete,
                                   SlabRanks* ranks = nullptr);
+// An upper estimate of the frames of `map` posed on start.grid as a DICOM SEG (one per segment
+// and slice where it has voxels, one per empty slice and per segment with none), from the
+// segments' rest voxels and the posed tets that reach them (FrameDicomSegEstimate.cpp); `parts`
+// is the rest body-part map S the mesh was made from.
+std::int64_t dicomSegFramesEstimate(const FrameStart& start, const TransferMesh& mesh,
+                                    const Volume& map, const Volume& parts);
+// Throws one line naming `folder`'s posed_G.dcm or posed_S.dcm when its estimate passes the 4 GiB
+// of pixel data a DICOM object holds: said before the work, in core and slab by slab alike.
+void checkDicomSegFits(const FrameStart& start, const TransferMesh& mesh, const Volume& organs,
+                       const Volume& parts, const std::string& folder);
+
 // Says `line` (when not empty) through options.warn and keeps it for the report.
 void warn(FrameStart& start, const PoseFrameOptions& options, const std::string& line);
 

@@ -10,6 +10,7 @@
 
 #include "PoseFrameSteps.h"
 #include "repose/io/ColorTableIO.h"
+#include "repose/io/DicomSegIO.h"
 #include "repose/io/NiftiIO.h"
 #include "repose/io/NrrdIO.h"
 #include "repose/util/Interrupt.h"
@@ -50,14 +51,6 @@ void addPresent(const void* data, ScalarType type, std::int64_t n, std::set<int>
         if (v[i] != T(0) && v[i] != last) present.insert(int(v[i])), last = v[i];
     }
   });
-}
-
-// A DICOM SEG is made whole in memory (dcmseg holds every frame): refused before the work.
-void refuseDicomSeg(const FrameWriteOptions& write, const std::string& folder) {
-  if (write.labelMapFiles == LabelMapFiles::DicomSeg)
-    throw Error(folder +
-                ": a DICOM SEG is made whole in memory, and this frame's posed maps do not fit the "
-                "memory budget; write nii.gz or seg.nrrd (--output-format), or raise --memory");
 }
 
 // Rounded up to 8 bytes: where the next part of a slab's bytes starts (a float field aligned).
@@ -131,7 +124,6 @@ std::string poseFrameToFolder(const PoseRig& rig, std::size_t index, const Volum
                               const Volume& parts, const PoseFrameOptions& options,
                               const std::string& folder, const FrameWriteOptions& write,
                               double memoryBudget, std::int64_t slabSlices, SlabRanks* ranks) {
-  refuseDicomSeg(write, folder);
   frame::FrameStart start = frame::startFrame(rig, index, organs, parts, options);
   if (options.checkGrid) options.checkGrid(start.grid);
   return frame::poseFrameToFolderFrom(start, rig, organs, parts, options, folder, write,
@@ -147,8 +139,10 @@ std::string frame::poseFrameToFolderFrom(
   SlabRanks& ranks = ranksOrNull ? *ranksOrNull : *(alone = oneSlabRank());
   const bool root = ranks.root(), several = ranks.size() > 1;
   const LabelMapFiles files = write.labelMapFiles;
+  // A DICOM SEG beyond its format's 4 GiB is said before the work.
   ranks.together([&] {
-    if (root) refuseDicomSeg(write, folder);
+    if (root && files == LabelMapFiles::DicomSeg)
+      frame::checkDicomSegFits(start, rig.mesh(), organs, parts, folder);
   });
   if (several) shareStart(ranks, start);
   const TransferMesh& mesh = rig.mesh();
@@ -307,6 +301,7 @@ std::string frame::poseFrameToFolderFrom(
   // The choices every slab waits for; pass 2's files.
   std::optional<NiftiSlabWriter> niftiG, niftiS;
   std::optional<SegNrrdSlabWriter> segG, segS;
+  std::optional<DicomSegSlabWriter> dcmG, dcmS;
   ranks.together([&] {
     if (!root) return;
     named([&] {
@@ -336,6 +331,14 @@ std::string frame::poseFrameToFolderFrom(
                      organs.layers(), organs.labels());
         segS.emplace((temp / "posed_S.seg.nrrd").string(), grid, parts.scalarType(), parts.layers(),
                      parts.labels());
+      }
+      if (files == LabelMapFiles::DicomSeg) {
+        DicomSegWriteOptions d;
+        d.sourceDicom = write.sourceDicom;
+        dcmG.emplace((temp / "posed_G.dcm").string(), grid, organs.scalarType(), organs.layers(),
+                     organs.labels(), d);
+        dcmS.emplace((temp / "posed_S.dcm").string(), grid, parts.scalarType(), parts.layers(),
+                     parts.labels(), d);
       }
     });
   });
@@ -374,6 +377,8 @@ std::string frame::poseFrameToFolderFrom(
           if (niftiS) niftiS->writeSlices(partSlab, k1 - k0);
           if (segG) segG->writeSlices(organSlab, k1 - k0);
           if (segS) segS->writeSlices(partSlab, k1 - k0);
+          if (dcmG) dcmG->writeSlices(organSlab, k1 - k0);
+          if (dcmS) dcmS->writeSlices(partSlab, k1 - k0);
         });
         used(0.5, 1, k1);
       });
@@ -386,7 +391,10 @@ std::string frame::poseFrameToFolderFrom(
         if (*w) (*w)->finish();
       for (auto* w : {&segG, &segS})
         if (*w) (*w)->finish();
+      for (auto* w : {&dcmG, &dcmS})
+        if (*w) (*w)->finish();
       niftiG.reset(), niftiS.reset(), segG.reset(), segS.reset();  // their side files go
+      dcmG.reset(), dcmS.reset();
       if (nifti) {
         std::vector<int> presentG;
         for (const auto& [value, voxels] : posed->labelVoxels()) presentG.push_back(value);

@@ -118,9 +118,15 @@ FrameOutcome runPoseFrame(const PoseJob& job, const PoseRig& rig, std::size_t in
     started = frame::startFrame(rig, index, organs, parts, fo);
   frame::FrameStart& start = *started;
   FrameOutcome out;
-  if (!run.folder.empty() &&
+  // A DICOM SEG beyond its format's 4 GiB is said before the work (slab by slab: in
+  // poseFrameToFolderFrom).
+  const bool streams =
+      !run.folder.empty() &&
       (run.alwaysOutOfCore || run.ranks ||
-       (run.outOfCore && !frameFitsMemory(start.grid, bytesPerVoxel, run.memoryBudget)))) {
+       (run.outOfCore && !frameFitsMemory(start.grid, bytesPerVoxel, run.memoryBudget)));
+  if (!streams && !run.folder.empty() && run.labelMapFiles == LabelMapFiles::DicomSeg)
+    frame::checkDicomSegFits(start, rig.mesh(), organs, parts, run.folder);
+  if (streams) {
     if (run.onGrid) run.onGrid(start.grid);
     out.streamed = true;
     out.frame.name = start.frame.name;

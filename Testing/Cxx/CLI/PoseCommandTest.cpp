@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -27,6 +28,16 @@ std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   EXPECT_TRUE(in.good()) << path;
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The 4 mm phantom written into `dir`, and `repose pose`'s arguments for its elbow flexion.
+std::string elbowJobOn4mmPhantom(const ScratchDir& dir) {
+  EXPECT_EQ(
+      runCommand("repose", "phantom --voxel 4 --out " + shellQuote(dir.path().string())).exitCode,
+      0);
+  return "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+         shellQuote(dir.file("S.nii.gz")) + " --pose " + shellQuote(suitePoseFile("elbow90")) +
+         " --joint-rings 0";
 }
 
 }  // namespace
@@ -200,12 +211,7 @@ TEST(PoseCommand, ElbowFlexionWritesPosedMapsTransformAndACheckedReport) {
 // output (--posed-labels) asks for it whole.
 TEST(PoseCommand, AFrameBeyondTheMemoryBudgetIsMadeSlabBySlabOrRefusedWithTheNumbers) {
   ScratchDir dir("pose_budget");
-  ASSERT_EQ(
-      runCommand("repose", "phantom --voxel 4 --out " + shellQuote(dir.path().string())).exitCode,
-      0);
-  const std::string job = "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
-                          shellQuote(dir.file("S.nii.gz")) + " --pose " +
-                          shellQuote(suitePoseFile("elbow90")) + " --joint-rings 0";
+  const std::string job = elbowJobOn4mmPhantom(dir);
   const CommandResult whole =
       runCommand("repose", job + " --memory 4G --out " + shellQuote(dir.file("enough")));
   ASSERT_EQ(whole.exitCode, 0) << whole.err;
@@ -253,4 +259,38 @@ TEST(PoseCommand, AFrameBeyondTheMemoryBudgetIsMadeSlabBySlabOrRefusedWithTheNum
        {"single: frame elbow90 needs ", " output voxels", "the frame is made slab by slab"})
     EXPECT_NE(whole1.err.find(part), std::string::npos) << part << " in: " << whole1.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("single")));
+}
+
+// DICOM SEG slab by slab (issue 56): `--output-format dcmseg --out-of-core` writes the posed maps
+// in pieces, the voxels of the frame made whole; on a grid whose SEG would pass DICOM's 4 GiB of
+// pixel data (0.25 mm: 17G output voxels), one line naming the file before the work, exit 1, no
+// output folder.
+TEST(PoseCommand, ADicomSegIsMadeSlabBySlabOrRefusedBeforeTheWorkBeyondFourGiB) {
+  ScratchDir dir("pose_dcmseg");
+  const std::string job = elbowJobOn4mmPhantom(dir);
+  const CommandResult whole = runCommand("repose", job + " --out " + shellQuote(dir.file("whole")));
+  ASSERT_EQ(whole.exitCode, 0) << whole.err;
+  const CommandResult slabs =
+      runCommand("repose", job + " --output-format dcmseg --out-of-core --out " +
+                               shellQuote(dir.file("slabs")));
+  ASSERT_EQ(slabs.exitCode, 0) << slabs.err;
+  EXPECT_NE(slabs.out.find("made slab by slab"), std::string::npos) << slabs.out;
+  for (const char* map : {"posed_G", "posed_S"}) {
+    const Volume a = readVolume(dir.file(std::string("whole/") + map + ".nii.gz"));
+    const Volume b = readVolume(dir.file(std::string("slabs/") + map + ".dcm"));
+    ASSERT_EQ(a.dims(), b.dims()) << map;
+    EXPECT_EQ(std::memcmp(a.layerData(), b.layerData(),
+                          std::size_t(a.numVoxels()) * scalarSize(a.scalarType())),
+              0)
+        << map;
+  }
+  const CommandResult refused =
+      runCommand("repose", job + " --output-format dcmseg --out-of-core --spacing-mm 0.25 --out " +
+                               shellQuote(dir.file("fine")));
+  EXPECT_EQ(refused.exitCode, 1);
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  for (const char* part : {"repose pose: error: ", "fine/posed_G.dcm: frame elbow90 as DICOM SEG",
+                           "more than the 4 GiB a DICOM object's pixel data can hold"})
+    EXPECT_NE(refused.err.find(part), std::string::npos) << part << " in: " << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("fine")));
 }

@@ -135,7 +135,8 @@ std::string writePosedFrame(const PosedFrame& frame, const std::string& folder,
 // slabs sized to `memoryBudget` bytes (0: memoryBudgetByDefault()) beside what the process
 // holds; the label-volume rounding's candidates beyond a quarter of that go to a temporary file.
 // `slabSlices` > 0 sets the slabs' thickness instead (tests cut a frame into slabs of a slice).
-// A DICOM SEG (made whole in memory) is refused in one line before the work. Returns
+// A DICOM SEG is written in pieces too (DicomSegSlabWriter); one whose frames would pass the
+// 4 GiB of pixel data DICOM holds is refused in one line before the work. Returns
 // report.json's text as written. Throws repose::Error, or Cancelled from options.progress;
 // nothing is written then. Over `ranks` (SlabRanks.h; null: this process alone) every rank calls
 // it with the same arguments: the other ranks make the slabs, rank 0 writes the folder and returns

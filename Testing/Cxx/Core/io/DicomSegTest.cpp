@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -504,4 +505,74 @@ TEST(DicomSegWrite, TheSourceOfPatientAndStudyIsTheInputsDicomFile) {
   ScratchDir dir;
   std::filesystem::copy_file(dataPath("dcmqi_ct3slice/liver.dcm"), dir.file("seg.dcm"));
   EXPECT_EQ(dicomSourceOf(dir.path().string()), dir.file("seg.dcm"));
+}
+
+namespace {
+
+// `v` written by DicomSegSlabWriter in slabs of `slices` (each layer's slices together, as
+// LabelSlabs makes them).
+void writeInSlabs(const Volume& v, const std::string& path, std::int64_t slices) {
+  DicomSegSlabWriter writer(path, v.geometry(), v.scalarType(), v.layers(), v.labels());
+  const std::int64_t nz = v.dims()[2];
+  const std::size_t slice = std::size_t(v.dims()[0] * v.dims()[1]) * scalarSize(v.scalarType());
+  for (std::int64_t k0 = 0; k0 < nz; k0 += slices) {
+    const std::int64_t n = std::min(slices, nz - k0);
+    std::vector<std::uint8_t> slab(slice * std::size_t(n * v.layers()));
+    for (int l = 0; l < v.layers(); ++l)
+      std::memcpy(slab.data() + slice * std::size_t(l * n),
+                  static_cast<const std::uint8_t*>(v.layerData(l)) + slice * std::size_t(k0),
+                  slice * std::size_t(n));
+    writer.writeSlices(slab.data(), n);
+  }
+  writer.finish();
+}
+
+}  // namespace
+
+TEST(DicomSegWrite, SlabsOfAnySizeWriteTheWholeVolumesFramesAndTheStandardsCheckFindsNoError) {
+  // Layers (overlapping segments), and odd slices with empty ones and a segment with no voxel.
+  VolumeGeometry g;
+  g.dims = {5, 3, 4};
+  g.ijkToRas.block<3, 3>(0, 0) = Eigen::Vector3d(0.5, 0.7, 2.5).asDiagonal();
+  Volume odd(g, ScalarType::UInt16);
+  odd.setLabelMap(true);
+  odd.data<std::uint16_t>()[odd.index(0, 0, 0)] = 300;
+  odd.data<std::uint16_t>()[odd.index(4, 2, 0)] = 7;
+  odd.data<std::uint16_t>()[odd.index(2, 2, 3)] = 300;
+  Label lost;
+  lost.value = 9;
+  lost.name = "lost";
+  odd.labels().set(lost);
+  ScratchDir dir;
+  int volumes = 0;
+  for (const Volume& in :
+       {readVolume(dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd")), std::move(odd)}) {
+    const std::string whole = dir.file("whole" + std::to_string(volumes) + ".dcm");
+    writeVolume(in, whole);
+    EXPECT_EQ(dciodvfyErrors(whole), "") << whole;
+    for (const std::int64_t slices : {std::int64_t(1), std::int64_t(3), in.dims()[2]}) {
+      const std::string slabs =
+          dir.file("slabs" + std::to_string(volumes) + "_" + std::to_string(slices) + ".dcm");
+      writeInSlabs(in, slabs, slices);
+      EXPECT_TRUE(segFramesOf(slabs) == segFramesOf(whole)) << slabs;
+      const Volume back = readVolume(slabs);
+      EXPECT_TRUE(sameVoxels(back, in)) << slabs;
+      EXPECT_EQ(back.labels().size(), readVolume(whole).labels().size()) << slabs;
+      EXPECT_EQ(dciodvfyErrors(slabs), "") << slabs;
+      EXPECT_NE(attribute(slabs, DCM_SOPInstanceUID), attribute(whole, DCM_SOPInstanceUID));
+    }
+    ++volumes;
+  }
+  // A writer given too few slices or too many says so, and leaves nothing.
+  const Volume in = readVolume(dataPath("slicer_seg/SegmentationOverlapping.seg.nrrd"));
+  ScratchDir empty;
+  {
+    DicomSegSlabWriter writer(empty.file("short.dcm"), in.geometry(), in.scalarType(), 2,
+                              in.labels());
+    std::vector<std::uint8_t> slab(std::size_t(in.dims()[0] * in.dims()[1] * 2), 0);
+    writer.writeSlices(slab.data(), 1);
+    EXPECT_THROW(writer.finish(), Error);
+    EXPECT_THROW(writer.writeSlices(slab.data(), in.dims()[2]), Error);
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(empty.path()));
 }

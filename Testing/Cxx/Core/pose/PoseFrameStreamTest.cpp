@@ -3,9 +3,13 @@
 // NIfTI and as Slicer segmentations, their colour tables, the posed image, the transform) and the
 // same report, for slabs of one slice (every label border, pocket and bone crosses a slab
 // border; the rounding's candidates all on disk) and of several; through runPoseFrame when the
-// memory budget is too small for the frame; and a DICOM SEG refused in one line before the work.
+// memory budget is too small for the frame; DICOM SEG written in pieces as well, and refused in
+// one line before the work when its frames would pass DICOM's 4 GiB.
+#include "pose/PoseFrameSteps.h"
+#include "TestDicomSeg.h"
 #include "TestPaths.h"
 #include "TestPoses.h"
+#include "TestVolumes.h"
 
 #include "repose/io/VolumeIO.h"
 #include "repose/phantom/Phantom.h"
@@ -22,6 +26,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <set>
 
 #include <unistd.h>
 
@@ -89,6 +94,15 @@ void expectSameFolder(const fs::path& whole, const fs::path& streamed, const std
     ASSERT_TRUE(fs::exists(streamed / name)) << at << ": " << name;
     ++files;
     if (name == "report.json") continue;
+    if (name.size() > 4 && name.substr(name.size() - 4) == ".dcm") {
+      // New UIDs and dates each time: the frames and the voxels are the same.
+      EXPECT_TRUE(segFramesOf(entry.path().string()) == segFramesOf((streamed / name).string()))
+          << at << ": " << name;
+      EXPECT_TRUE(
+          sameVoxels(readVolume(entry.path().string()), readVolume((streamed / name).string())))
+          << at << ": " << name;
+      continue;
+    }
     if (name.size() > 5 && name.substr(name.size() - 5) == ".ctbl") {
       // The first line names the file it was written as: the rest is the table.
       const std::string a = bytes(entry.path()), b = bytes(streamed / name);
@@ -141,7 +155,7 @@ TEST(PoseFrameStream, SlabsWriteTheWholeFramesFilesAndReport) {
   EXPECT_GT(filled, 0);
 }
 
-TEST(PoseFrameStream, RunPoseFrameStreamsAFrameBeyondItsBudgetAndRefusesDicomSeg) {
+TEST(PoseFrameStream, RunPoseFrameStreamsAFrameBeyondItsBudgetAsDicomSegToo) {
   Scratch scratch;
   const Body b("elbow90");
   FrameRun run;
@@ -169,16 +183,65 @@ TEST(PoseFrameStream, RunPoseFrameStreamsAFrameBeyondItsBudgetAndRefusesDicomSeg
   // The job completed the report (its rig and inputs) on both paths.
   EXPECT_TRUE(report(scratch.dir / "streamed").contains("scene_reused"));
   EXPECT_TRUE(report(scratch.dir / "streamed").contains("rhythms"));
-  // DICOM SEG: one line naming the folder, before the work; nothing written.
+  // DICOM SEG: written in pieces too, the whole frame's frames and voxels.
   run.labelMapFiles = LabelMapFiles::DicomSeg;
   run.folder = (scratch.dir / "dicom").string();
-  try {
-    runPoseFrame(*b.job, *b.rig, 0, b.organs, b.parts, run);
-    ADD_FAILURE() << "a DICOM SEG beyond the budget was written";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    EXPECT_NE(message.find("DICOM SEG"), std::string::npos) << message;
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_TRUE(runPoseFrame(*b.job, *b.rig, 0, b.organs, b.parts, run).streamed);
+  run.outOfCore = false;
+  run.memoryBudget = 0;
+  run.folder = (scratch.dir / "dicom_whole").string();
+  EXPECT_FALSE(runPoseFrame(*b.job, *b.rig, 0, b.organs, b.parts, run).streamed);
+  expectSameFolder(scratch.dir / "dicom_whole", scratch.dir / "dicom", "DICOM SEG");
+  EXPECT_EQ(dciodvfyErrors((scratch.dir / "dicom" / "posed_G.dcm").string()), "");
+}
+
+TEST(PoseFrameStream, ADicomSegBeyondFourGiBIsSaidBeforeTheWorkAndTheEstimateBoundsTheFrames) {
+  Scratch scratch;
+  for (const char* pose : {"elbow90", "sitting", "arms_up160", "walk"}) {
+    const Body b(pose);
+    PoseFrameOptions options = b.job->frameOptions();
+    options.spacingMm = 3;
+    FrameWriteOptions write;
+    write.labelMapFiles = LabelMapFiles::DicomSeg;
+    // The first frame and the last (one when the pose has no keyframes).
+    for (const std::size_t index : std::set<std::size_t>{0, b.rig->frameCount() - 1}) {
+      const fs::path folder = scratch.dir / (std::string(pose) + std::to_string(index));
+      poseFrameToFolder(*b.rig, index, b.organs, b.parts, options, folder.string(), write);
+      const frame::FrameStart start = frame::startFrame(*b.rig, index, b.organs, b.parts, options);
+      for (const auto& [map, name] :
+           {std::pair{&b.organs, "posed_G.dcm"}, {&b.parts, "posed_S.dcm"}}) {
+        const std::string frames = segFramesOf((folder / name).string());
+        const std::int64_t written = std::stoll(frames.substr(0, frames.find(' ')));
+        const std::int64_t estimate =
+            frame::dicomSegFramesEstimate(start, b.rig->mesh(), *map, b.parts);
+        // An upper bound, within twice what is written: on this coarse body (8 mm voxels, tets
+        // of several slices, a shell of 16 mm) 1.3 to 1.9 times.
+        EXPECT_GE(estimate, written) << pose << " " << index << " " << name;
+        EXPECT_LE(double(estimate), 2 * double(written)) << pose << " " << index << " " << name;
+        std::printf("%s frame %zu %s: %lld frames written, %lld estimated\n", pose, index, name,
+                    static_cast<long long>(written), static_cast<long long>(estimate));
+      }
+    }
   }
-  EXPECT_FALSE(fs::exists(run.folder));
+  // On a grid of 0.25 mm, the frames pass 4 GiB: one line naming the file, before the work, and
+  // nothing written, in core and slab by slab alike.
+  const Body b("elbow90");
+  FrameRun run;
+  run.spacingMm = 0.25;
+  run.labelMapFiles = LabelMapFiles::DicomSeg;
+  run.memoryBudget = 1e15;
+  for (const bool outOfCore : {false, true}) {
+    run.alwaysOutOfCore = outOfCore;
+    run.folder = (scratch.dir / ("huge" + std::to_string(outOfCore))).string();
+    try {
+      runPoseFrame(*b.job, *b.rig, 0, b.organs, b.parts, run);
+      ADD_FAILURE() << "a DICOM SEG beyond 4 GiB was written";
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find(run.folder + "/posed_G.dcm: "), std::string::npos) << message;
+      EXPECT_NE(message.find("4 GiB"), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+    EXPECT_FALSE(fs::exists(run.folder));
+  }
 }
