@@ -4,7 +4,8 @@ job out of core"): `repose pose` of the arms-resting phantom on the adult male r
 (2.137 x 2.137 x 8 mm, with its CT), the suite's elbow flexion, written at 1 mm
 and at 0.5 mm, in core (a budget that holds the frame), slab by slab (a 2 GiB budget) and slab
 by slab over 2 MPI ranks (`--mpi`, 1 GiB each), and slab by slab as DICOM SEG (written in
-pieces, or refused before the work beyond DICOM's 4 GiB). Each run is one `repose pose` command timed with
+pieces, or refused before the work beyond DICOM's 4 GiB; its voxels, read back, compared with the
+streamed NIfTI's). Each run is one `repose pose` command timed with
 its peak resident memory (/usr/bin/time -v; over MPI each rank's, the largest and their sum); the
 rig is built once into a scene folder and reused, so the runs time the frame. The streamed files are
 compared with the in-core ones where both exist (byte for byte; the colour tables after their
@@ -54,6 +55,22 @@ def same_files(a, b):
     ra.pop("streamed", None)
     rb.pop("streamed", None)
     return ra == rb
+
+
+def same_voxels_as_dicom(nifti_folder, dcm_folder, build):
+    """posed_G and posed_S of nifti_folder (NIfTI) voxel for voxel those of dcm_folder (DICOM SEG,
+    read by Repose's Python module from `build`)."""
+    import nibabel
+    import numpy
+    sys.path.insert(0, str(Path(build).resolve() / "python"))
+    import repose
+    for stem in ("posed_G", "posed_S"):
+        a = numpy.asanyarray(nibabel.load(Path(nifti_folder) / f"{stem}.nii.gz").dataobj)
+        b = repose.read_volume(str(Path(dcm_folder) / f"{stem}.dcm")).array
+        if a.shape != b.shape or not numpy.array_equal(a, b):
+            return False
+        del a, b
+    return True
 
 
 def main():
@@ -136,6 +153,13 @@ def main():
                 row["same_as_one_rank"] = same
                 print(f"{spacing:g} mm: {ranks} ranks' files {'equal' if same else 'DIFFER from'}"
                       " one rank's", flush=True)
+        if ("streamed", 1) in folders and ("streamed dcmseg", 1) in folders:
+            same = same_voxels_as_dicom(folders[("streamed", 1)], folders[("streamed dcmseg", 1)],
+                                        a.build)
+            next(r for r in results if r["spacing_mm"] == spacing and
+                 r["mode"] == "streamed dcmseg")["same_voxels_as_streamed"] = same
+            print(f"{spacing:g} mm: DICOM SEG's voxels {'equal' if same else 'DIFFER from'} the"
+                  " streamed NIfTI's", flush=True)
         if ("in core", 1) in folders and ("streamed", 1) in folders:
             same = same_files(folders[("in core", 1)], folders[("streamed", 1)])
             next(r for r in results if r["spacing_mm"] == spacing and r["mode"] == "in core" and
