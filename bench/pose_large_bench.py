@@ -57,6 +57,15 @@ def same_files(a, b):
     return ra == rb
 
 
+def number_of_frames(dcm):
+    """A SEG's NumberOfFrames (0028,0008), from its header (explicit VR little endian)."""
+    with open(dcm, "rb") as f:
+        head = f.read(1 << 20)
+    at = head.find(b"\x28\x00\x08\x00IS")
+    length = head[at + 6] | head[at + 7] << 8
+    return int(head[at + 8:at + 8 + length])
+
+
 def same_voxels_as_dicom(nifti_folder, dcm_folder, build):
     """posed_G and posed_S of nifti_folder (NIfTI) voxel for voxel those of dcm_folder (DICOM SEG,
     read by Repose's Python module from `build`)."""
@@ -143,6 +152,13 @@ def main():
                     row["slabs"] = report["streamed"]["slabs"]
                 row["relabelled_voxels"] = report["label_volumes"]["relabelled_voxels"]
                 row["targets_met"] = report["targets"]["met"]
+                if "dicom_seg" in report:
+                    # The frames checkDicomSegFits bounded before the work, and those written.
+                    for name in ("posed_G.dcm", "posed_S.dcm"):
+                        bound = report["dicom_seg"][name]["frames_bound"]
+                        written = number_of_frames(folder / name)
+                        row[name] = {"frames_bound": bound, "frames": written,
+                                     "bound_over_frames": round(bound / written, 3)}
                 folders[(mode, ranks)] = folder
             else:
                 row["error"] = done.stderr.strip().splitlines()[-1][:300] if done.stderr else ""

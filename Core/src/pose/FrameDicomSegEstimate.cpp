@@ -219,9 +219,11 @@ std::int64_t dicomSegFramesEstimate(const FrameStart& start, const TransferMesh&
   return frames;
 }
 
-void checkDicomSegFits(const FrameStart& start, const TransferMesh& mesh, const Volume& organs,
-                       const Volume& parts, const std::string& folder) {
+nlohmann::json checkDicomSegFits(const FrameStart& start, const TransferMesh& mesh,
+                                 const Volume& organs, const Volume& parts,
+                                 const std::string& folder) {
   const std::int64_t pixels = start.grid.dims[0] * start.grid.dims[1];
+  nlohmann::json bounds = {{"pixel_data_limit_bytes", kDicomSegPixelDataBytes}};
   for (const auto& [map, name] : {std::pair{&organs, "posed_G.dcm"}, {&parts, "posed_S.dcm"}}) {
     const std::int64_t frames = dicomSegFramesEstimate(start, mesh, *map, parts);
     const double bytes = std::ceil(double(frames) * double(pixels) / 8);
@@ -232,7 +234,9 @@ void checkDicomSegFits(const FrameStart& start, const TransferMesh& mesh, const 
                   " (" + gib(bytes) +
                   "), more than the 4 GiB a DICOM object's pixel data can hold; write nii.gz or "
                   "seg.nrrd (--output-format), or a coarser grid (--spacing-mm)");
+    bounds[name] = {{"frames_bound", frames}, {"pixel_data_bound_bytes", std::int64_t(bytes)}};
   }
+  return bounds;
 }
 
 }  // namespace repose::frame

@@ -55,8 +55,10 @@ std::int64_t dicomSegFramesEstimate(const FrameStart& start, const TransferMesh&
                                     const Volume& map, const Volume& parts);
 // Throws one line naming `folder`'s posed_G.dcm or posed_S.dcm when its estimate passes the 4 GiB
 // of pixel data a DICOM object holds: said before the work, in core and slab by slab alike.
-void checkDicomSegFits(const FrameStart& start, const TransferMesh& mesh, const Volume& organs,
-                       const Volume& parts, const std::string& folder);
+// Returns report.json's "dicom_seg": the limit, and per file the estimate and its bytes.
+nlohmann::json checkDicomSegFits(const FrameStart& start, const TransferMesh& mesh,
+                                 const Volume& organs, const Volume& parts,
+                                 const std::string& folder);
 
 // Says `line` (when not empty) through options.warn and keeps it for the report.
 void warn(FrameStart& start, const PoseFrameOptions& options, const std::string& line);

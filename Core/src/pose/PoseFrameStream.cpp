@@ -140,9 +140,10 @@ std::string frame::poseFrameToFolderFrom(
   const bool root = ranks.root(), several = ranks.size() > 1;
   const LabelMapFiles files = write.labelMapFiles;
   // A DICOM SEG beyond its format's 4 GiB is said before the work.
+  nlohmann::json dicomSeg;
   ranks.together([&] {
     if (root && files == LabelMapFiles::DicomSeg)
-      frame::checkDicomSegFits(start, rig.mesh(), organs, parts, folder);
+      dicomSeg = frame::checkDicomSegFits(start, rig.mesh(), organs, parts, folder);
   });
   if (several) shareStart(ranks, start);
   const TransferMesh& mesh = rig.mesh();
@@ -410,6 +411,7 @@ std::string frame::poseFrameToFolderFrom(
                        options.image != nullptr);
     if (complete) text = complete(text);
     nlohmann::json report = nlohmann::json::parse(text);
+    if (!dicomSeg.is_null()) report["dicom_seg"] = dicomSeg;
     report["streamed"] = {{"slab_slices", slab},
                           {"slabs", count},
                           {"ranks", ranks.size()},

@@ -124,8 +124,9 @@ FrameOutcome runPoseFrame(const PoseJob& job, const PoseRig& rig, std::size_t in
       !run.folder.empty() &&
       (run.alwaysOutOfCore || run.ranks ||
        (run.outOfCore && !frameFitsMemory(start.grid, bytesPerVoxel, run.memoryBudget)));
+  nlohmann::json dicomSeg;
   if (!streams && !run.folder.empty() && run.labelMapFiles == LabelMapFiles::DicomSeg)
-    frame::checkDicomSegFits(start, rig.mesh(), organs, parts, run.folder);
+    dicomSeg = frame::checkDicomSegFits(start, rig.mesh(), organs, parts, run.folder);
   if (streams) {
     if (run.onGrid) run.onGrid(start.grid);
     out.streamed = true;
@@ -143,6 +144,11 @@ FrameOutcome runPoseFrame(const PoseJob& job, const PoseRig& rig, std::size_t in
     if (run.onGrid) run.onGrid(start.grid);
     out.frame = frame::poseFrameFrom(start, rig, organs, parts, fo);
     out.frame.reportJson = job.completeReport(out.frame.reportJson, run.sceneReused, rig);
+    if (!dicomSeg.is_null()) {
+      nlohmann::json report = nlohmann::json::parse(out.frame.reportJson);
+      report["dicom_seg"] = dicomSeg;
+      out.frame.reportJson = report.dump();
+    }
     out.reportJson = out.frame.reportJson;
     if (!run.folder.empty()) out.reportJson = writePosedFrame(out.frame, run.folder, wo);
   }

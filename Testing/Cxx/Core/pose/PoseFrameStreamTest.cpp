@@ -11,6 +11,7 @@
 #include "TestPoses.h"
 #include "TestVolumes.h"
 
+#include "repose/io/DicomSegIO.h"
 #include "repose/io/VolumeIO.h"
 #include "repose/phantom/Phantom.h"
 #include "repose/pose/PoseJob.h"
@@ -220,6 +221,11 @@ TEST(PoseFrameStream, ADicomSegBeyondFourGiBIsSaidBeforeTheWorkAndTheEstimateBou
         EXPECT_LE(double(estimate), 2 * double(written)) << pose << " " << index << " " << name;
         std::printf("%s frame %zu %s: %lld frames written, %lld estimated\n", pose, index, name,
                     static_cast<long long>(written), static_cast<long long>(estimate));
+        // The report says it, beside the limit.
+        const nlohmann::json said =
+            nlohmann::json::parse(bytes(folder / "report.json"))["dicom_seg"];
+        EXPECT_EQ(said[name]["frames_bound"].get<std::int64_t>(), estimate) << name;
+        EXPECT_EQ(said["pixel_data_limit_bytes"].get<std::int64_t>(), kDicomSegPixelDataBytes);
       }
     }
   }
