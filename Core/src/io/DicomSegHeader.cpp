@@ -92,34 +92,35 @@ std::string dicomDecimal(const std::string& path, double v) {
   throwFileError(path, "the value " + std::to_string(v) + " does not fit DICOM's decimal strings");
 }
 
-void checkDicomSegGrid(const std::string& path, const VolumeGeometry& g) {
+DicomSegPlane dicomSegPlane(const std::string& path, const VolumeGeometry& g) {
   if (g.dims[0] > 65535 || g.dims[1] > 65535)
     throwFileError(path, "slices of " + std::to_string(g.dims[0]) + "x" +
                              std::to_string(g.dims[1]) + " exceed DICOM's 65535 rows or columns");
   // The frames' plane: i along the rows, j along the columns (LPS); k must be their normal, as
   // a SEG's frames give only their plane's position.
-  const Eigen::Matrix4d lps = flipLpsRas(g.ijkToRas);
+  DicomSegPlane plane;
+  plane.lps = flipLpsRas(g.ijkToRas);
   const Eigen::Vector3d spacing = g.spacing();
-  const Eigen::Vector3d rowDir = lps.block<3, 1>(0, 0) / spacing[0];
-  const Eigen::Vector3d colDir = lps.block<3, 1>(0, 1) / spacing[1];
-  const Eigen::Vector3d sliceDir = lps.block<3, 1>(0, 2) / spacing[2];
-  if (std::fabs(rowDir.dot(colDir)) > 1e-4 || rowDir.cross(colDir).dot(sliceDir) < 1 - 1e-4)
+  plane.row = plane.lps.block<3, 1>(0, 0) / spacing[0];
+  plane.column = plane.lps.block<3, 1>(0, 1) / spacing[1];
+  const Eigen::Vector3d sliceDir = plane.lps.block<3, 1>(0, 2) / spacing[2];
+  if (std::fabs(plane.row.dot(plane.column)) > 1e-4 ||
+      plane.row.cross(plane.column).dot(sliceDir) < 1 - 1e-4)
     throwFileError(path,
                    "a DICOM SEG's slices must be stacked along the normal of their rows and "
                    "columns (a right-handed, unsheared grid); resample this one first");
+  return plane;
 }
 
 void makeDicomSegHeader(DcmFileFormat& file, const std::string& path, const VolumeGeometry& g,
                         const std::vector<Label>& segments, std::int64_t frames,
                         const DicomSegWriteOptions& options) {
   prepareDcmtk(path);
-  checkDicomSegGrid(path, g);
+  const DicomSegPlane plane = dicomSegPlane(path, g);
   if (segments.empty()) throwFileError(path, "the label map has no label to write as a segment");
   if (segments.size() > 65535) throwFileError(path, "more than 65535 labels");
-  const Eigen::Matrix4d lps = flipLpsRas(g.ijkToRas);
   const Eigen::Vector3d spacing = g.spacing();
-  const Eigen::Vector3d rowDir = lps.block<3, 1>(0, 0) / spacing[0];
-  const Eigen::Vector3d colDir = lps.block<3, 1>(0, 1) / spacing[1];
+  const Eigen::Vector3d &rowDir = plane.row, &colDir = plane.column;
 
   const Uint16 rows = Uint16(g.dims[1]), columns = Uint16(g.dims[0]);
   IODGeneralEquipmentModule::EquipmentInfo equipment("Repose", "Repose", "1", REPOSE_VERSION);
@@ -215,7 +216,7 @@ void makeDicomSegHeader(DcmFileFormat& file, const std::string& path, const Volu
   // stands in for the frames the writer appends, and goes again below.
   {
     std::vector<Uint8> empty(std::size_t(rows) * columns, 0);
-    const Eigen::Vector3d p = lps.block<3, 1>(0, 3);
+    const Eigen::Vector3d p = plane.lps.block<3, 1>(0, 3);
     std::unique_ptr<FGPlanePosPatient> position(FGPlanePosPatient::createMinimal(
         dicomDecimal(path, p[0]).c_str(), dicomDecimal(path, p[1]).c_str(),
         dicomDecimal(path, p[2]).c_str()));

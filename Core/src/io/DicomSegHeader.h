@@ -9,6 +9,8 @@
 #include "repose/volume/LabelTable.h"
 #include "repose/volume/VolumeGeometry.h"
 
+#include <Eigen/Core>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -20,9 +22,14 @@ namespace repose::io {
 // A DS value: at most 16 characters (PS3.5 6.2). Throws naming `path` for one that cannot fit.
 std::string dicomDecimal(const std::string& path, double v);
 
-// Throws naming `path` unless a SEG can hold frames of `grid`'s slices: rows and columns within
-// 65535, slices stacked along the normal of their rows and columns.
-void checkDicomSegGrid(const std::string& path, const VolumeGeometry& grid);
+// The frames' plane of `grid` in LPS: ijk to LPS, and the unit directions along a row (i) and a
+// column (j). Throws naming `path` unless a SEG can hold frames of its slices: rows and columns
+// within 65535, slices stacked along the normal of their rows and columns.
+struct DicomSegPlane {
+  Eigen::Matrix4d lps;
+  Eigen::Vector3d row, column;
+};
+DicomSegPlane dicomSegPlane(const std::string& path, const VolumeGeometry& grid);
 
 // The SEG's dataset for `segments` (in (layer, value) order: segment n is segments[n - 1]) on
 // `grid`, with NumberOfFrames `frames` and neither PerFrameFunctionalGroupsSequence nor

@@ -104,6 +104,7 @@ struct DicomSegSlabWriter::Impl {
   std::uint8_t carry = 0;                 // the last byte begun, not yet written
   std::int64_t written = 0;
   std::vector<std::uint8_t> packed;
+  Eigen::Matrix4d lps;  // ijk to LPS: the frames' positions
   Impl(const std::string& p, const VolumeGeometry& g, ScalarType t, int l, const LabelTable& table,
        const DicomSegWriteOptions& o)
       : path(p), geometry(g), type(t), layers(l), labels(table), options(o), output(p) {}
@@ -187,8 +188,9 @@ DicomSegSlabWriter::DicomSegSlabWriter(const std::string& path, const VolumeGeom
   if (layers < 1) throwFileError(path, "a segmentation of no layer");
   if (geometry.dims[2] > 0x7FFFFFFF) throwFileError(path, "more slices than DICOM can number");
   io::prepareDcmtk(path);
-  io::checkDicomSegGrid(path, geometry);
+  const io::DicomSegPlane plane = io::dicomSegPlane(path, geometry);
   impl_ = std::make_unique<Impl>(path, geometry, type, layers, labels, options);
+  impl_->lps = plane.lps;
   impl_->framesPath = impl_->output.tempPath() + ".frames";
   impl_->frames.reset(std::fopen(impl_->framesPath.c_str(), "wb"));
   if (!impl_->frames) throwFileError(path, "cannot create the output file");
@@ -283,11 +285,10 @@ void DicomSegSlabWriter::finish() {
   reportProgress(r.options.progress, 0.95, "writing DICOM SEG");
   {
     std::ofstream out(temp, std::ios::binary | std::ios::app);
-    const Eigen::Matrix4d lps = flipLpsRas(r.geometry.ijkToRas);
     std::string chunk;
     openSequence(chunk, 0x5200, 0x9230);
     for (const FrameSource& f : r.sources) {
-      const Eigen::Vector3d p = (lps * Eigen::Vector4d(0, 0, double(f.k), 1)).head<3>();
+      const Eigen::Vector3d p = (r.lps * Eigen::Vector4d(0, 0, double(f.k), 1)).head<3>();
       const std::string position = io::dicomDecimal(r.path, p[0]) + "\\" +
                                    io::dicomDecimal(r.path, p[1]) + "\\" +
                                    io::dicomDecimal(r.path, p[2]);
@@ -320,17 +321,23 @@ void writeDicomSeg(const Volume& volume, const std::string& path,
   slabOptions.progress = {};
   DicomSegSlabWriter writer(path, volume.geometry(), volume.scalarType(), volume.layers(),
                             volume.labels(), slabOptions);
-  // A slice of every layer at a time (the layers are apart in memory).
+  // A slice of every layer at a time: one layer's straight from the volume, several copied
+  // together (the layers are apart in memory).
   const std::int64_t nz = volume.dims()[2];
   const std::size_t slice =
       std::size_t(volume.dims()[0] * volume.dims()[1]) * scalarSize(volume.scalarType());
-  std::vector<std::uint8_t> layers(slice * std::size_t(volume.layers()));
+  std::vector<std::uint8_t> layers(volume.layers() > 1 ? slice * std::size_t(volume.layers()) : 0);
   for (std::int64_t k = 0; k < nz; ++k) {
-    for (int l = 0; l < volume.layers(); ++l)
-      std::memcpy(layers.data() + std::size_t(l) * slice,
-                  static_cast<const std::uint8_t*>(volume.layerData(l)) + std::size_t(k) * slice,
-                  slice);
-    writer.writeSlices(layers.data(), 1);
+    auto at = [&](int l) {
+      return static_cast<const std::uint8_t*>(volume.layerData(l)) + std::size_t(k) * slice;
+    };
+    if (volume.layers() == 1) {
+      writer.writeSlices(at(0), 1);
+    } else {
+      for (int l = 0; l < volume.layers(); ++l)
+        std::memcpy(layers.data() + std::size_t(l) * slice, at(l), slice);
+      writer.writeSlices(layers.data(), 1);
+    }
     reportProgress(options.progress, 0.9 * double(k + 1) / double(nz), "writing DICOM SEG");
   }
   writer.finish();

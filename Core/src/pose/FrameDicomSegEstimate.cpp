@@ -10,6 +10,7 @@
 // and the pockets. The estimate counts, per slice, the segments whose extent holds it (at least
 // one: an empty slice's frame), and once each segment with none.
 #include "PoseFrameSteps.h"
+#include "raster/RasterScan.h"
 
 #include "repose/io/DicomSegIO.h"
 #include "repose/util/Memory.h"
@@ -100,9 +101,9 @@ std::int64_t dicomSegFramesEstimate(const FrameStart& start, const TransferMesh&
   const VolumeGeometry& grid = start.grid;
   const std::int64_t nz = grid.dims[2];
   // How far beyond its tet a voxel takes the tet's map: the shell (outer tets), a piece's rim or
-  // ghost (within the piece's voxel size), as the rasterizer's defaults (RasterScan.cpp) have them.
-  const double pieceMm = std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm);
-  const double shellMm = 2 * pieceMm;
+  // ghost, as the frame's rasterizer has them (its options leave the shell at its default).
+  const double pieceMm = raster::pieceReachMm(mesh, input);
+  const double shellMm = raster::shellWidthMm(mesh, input, RasterOptions());
   // Blocks about as wide as a piece's reach along each axis, and at least 8 mm (a fine input's
   // blocks stay few: 1G voxels of 0.5 mm are 244K blocks); finer would cost memory and time and
   // tighten little.

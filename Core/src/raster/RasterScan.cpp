@@ -68,6 +68,15 @@ static void markOwnPartShells(const TransferMesh& mesh, const VolumeGeometry& in
   }
 }
 
+double pieceReachMm(const TransferMesh& mesh, const VolumeGeometry& input) {
+  return std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm);
+}
+
+double shellWidthMm(const TransferMesh& mesh, const VolumeGeometry& input,
+                    const RasterOptions& options) {
+  return options.shellMm < 0 ? 2 * pieceReachMm(mesh, input) : options.shellMm;
+}
+
 Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const VolumeGeometry& output,
                 const RasterOptions& options) {
   Shell sh;
@@ -95,13 +104,12 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
     sh.boneLabel.resize(pieceOf.size());
     for (std::size_t v = 0; v < pieceOf.size(); ++v) sh.boneLabel[v] = pieceOf[v] != 0;
     sh.ghosts = raster::pieceGhosts(mesh, *options.pieceLabels, pieceOf);
-    sh.pieceMm = std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm);
+    sh.pieceMm = pieceReachMm(mesh, input);
     const Eigen::Matrix3d Minv = output.ijkToRas.block<3, 3>(0, 0).inverse();
     for (int c = 0; c < 3; ++c) sh.pieceGrowth[c] = sh.pieceMm * Minv.row(c).norm();
     sh.normalToMm = output.ijkToRas.block<3, 3>(0, 0).inverse().transpose();
   }
-  sh.mm = options.shellMm < 0 ? 2 * std::max(input.spacing().maxCoeff(), mesh.sourceSpacingMm)
-                              : options.shellMm;
+  sh.mm = shellWidthMm(mesh, input, options);
   if (sh.mm <= 0) return sh;
   sh.outer = options.outerFaces ? *options.outerFaces : outerFaces(mesh);
   if (sh.outer.size() != static_cast<std::size_t>(mesh.tets.rows()))
