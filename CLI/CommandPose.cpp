@@ -428,7 +428,10 @@ int runPose(const Args& args) {
               "(DICOM SEG, patient and study from a DICOM input), or auto (seg.nrrd when "
               "--input is a .seg.nrrd, else nii.gz)",
               "auto")
-      .option("cage-vertices", "N", "cage size", "300")
+      .option("cage-vertices", "N",
+              "cage size; a cage that fails its checks is built again with more vertices, then "
+              "other dilations (report.json's \"cage\" says which)",
+              "300")
       .option("dilate-mm", "MM", "cage distance from the body", "10")
       .option("mesh-mm", "MM", "transfer-mesh tet size (0: 5% of S's diagonal)", "0")
       .option("joint-rings", "N",

@@ -83,6 +83,7 @@ bool vtkSlicerReposeJobsLogic::StartBuildRig(vtkMRMLReposeSegmentationNode* seg,
             cage->SetMesh(vtkSlicerReposeMeshConversion::ToPolyData(geometry->cage));
             cage->SetTargetVertexCount(settings.cageVertices);
             cage->SetDilationMm(settings.dilateMm);
+            cage->SetCageChoice(geometry->cageChoice.json());
             std::vector<vtkMRMLReposeCageNode::HandleGroup> groups;
             for (std::size_t g = 0; g < handles->size(); ++g)
               groups.push_back({pose.groups[g].name, (*handles)[g].cageVertices});
@@ -237,7 +238,7 @@ bool vtkSlicerReposeJobsLogic::StartApplyPose(vtkMRMLReposePoseNode* poseNode,
     repose::RigGeometry geometry{
         vtkSlicerReposeMeshConversion::FromPolyData(cageNode->GetMesh()),
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(meshNode->GetMesh()),
-        meshNode->GetCoordinatesFile()};
+        meshNode->GetCoordinatesFile(), Inputs::CageChoiceOf(cageNode)};
     const repose::Pose& pose = Inputs::PoseOf(poseNode);
     const std::size_t frame = std::size_t(poseNode->GetCurrentFrame());
     // Tissues, skeleton and the joints' bends as `repose pose` has them.

@@ -60,6 +60,14 @@ std::vector<vtkSlicerReposeJobsLogic::QualityCheck> vtkSlicerReposeJobsLogic::Ge
   if (q.contains("no_label_lost"))
     rows.push_back({"Labels lost", std::to_string(q["no_label_lost"].value("labels_lost", 0)),
                     "none", met("no_label_lost")});
+  if (q.contains("pieces_apart")) {
+    const nlohmann::json& c = q["pieces_apart"];
+    std::string text = std::to_string(c.value("voxels", 0)) + " shared voxels";
+    if (c.contains("most") && c["most"].is_array() && c["most"].size() == 2)
+      text +=
+          " (" + c["most"][0].get<std::string>() + " / " + c["most"][1].get<std::string>() + ")";
+    rows.push_back({"Bones collided", text, "none", met("pieces_apart")});
+  }
   if (q.contains("prediction_within_targets")) {
     const nlohmann::json& p = q["prediction_within_targets"];
     const std::string part = p.value("worst_part", std::string());

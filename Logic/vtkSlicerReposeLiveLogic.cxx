@@ -91,7 +91,7 @@ bool vtkSlicerReposeLiveLogic::StartLivePose(vtkMRMLReposePoseNode* poseNode) {
     repose::RigGeometry geometry{
         vtkSlicerReposeMeshConversion::FromPolyData(nodes.Cage->GetMesh()),
         vtkSlicerReposeMeshConversion::FromUnstructuredGrid(nodes.TransferMesh->GetMesh()),
-        nodes.TransferMesh->GetCoordinatesFile()};
+        nodes.TransferMesh->GetCoordinatesFile(), Inputs::CageChoiceOf(nodes.Cage)};
     const repose::Pose& pose = Inputs::PoseOf(poseNode);
     // The joints bend live as they do in the export and in `repose pose` (Core's pose job).
     auto G = inputs.labels;

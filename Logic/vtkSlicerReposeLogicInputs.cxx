@@ -51,6 +51,21 @@ std::optional<repose::Skeleton> SkeletonOf(vtkMRMLReposeSegmentationNode* seg) {
   return repose::parseSkeleton(seg->GetSkeletonJSON(), seg->GetName() + " skeleton");
 }
 
+repose::CageChoice CageChoiceOf(vtkMRMLReposeCageNode* cage) {
+  if (!cage->GetCageChoice().empty()) {
+    try {
+      return repose::CageChoice::fromJson(cage->GetCageChoice());
+    } catch (const repose::Error&) {
+      // edited by hand: the node's own setting below
+    }
+  }
+  repose::CageChoice c;
+  c.asked = {cage->GetTargetVertexCount(), cage->GetDilationMm()};
+  c.used = c.asked;
+  c.tried.push_back({c.used, ""});
+  return c;
+}
+
 repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg) {
   if (seg->GetBodyPartMap()) return Conversion::GetLabelTable(seg->GetBodyPartMap());
   repose::LabelTable table;

@@ -4,6 +4,7 @@
 #ifndef vtkSlicerReposeLogicInputs_h
 #define vtkSlicerReposeLogicInputs_h
 
+#include <repose/cage/CageLadder.h>
 #include <repose/skeleton/Skeleton.h>
 #include <repose/volume/LabelTable.h>
 
@@ -35,6 +36,10 @@ PoseNodes Resolve(vtkMRMLReposeScene* scene, vtkMRMLReposePoseNode* pose);
 
 // The segmentation's skeleton (its SkeletonJSON), or none.
 std::optional<repose::Skeleton> SkeletonOf(vtkMRMLReposeSegmentationNode* seg);
+
+// The setting the cage node's cage was built with (asked, used, tried); a cage from a file, or a
+// scene saved before the ladder, has its node's target vertex count and dilation as both.
+repose::CageChoice CageChoiceOf(vtkMRMLReposeCageNode* cage);
 
 // S of a segmentation, or the body mask of G (label 1 where G is not 0) when it has none.
 repose::Volume PartsOf(vtkMRMLReposeSegmentationNode* seg);

@@ -16,6 +16,8 @@ void vtkMRMLReposeCageNode::WriteFields(nlohmann::ordered_json& json) const {
   json[sc::cage::kFile] = this->FileName;
   json[sc::cage::kTargetVertexCount] = this->TargetVertexCount;
   json[sc::cage::kDilationMm] = this->DilationMm;
+  if (!this->CageChoice.empty())
+    json[sc::cage::kChoice] = nlohmann::ordered_json::parse(this->CageChoice, nullptr, false);
   nlohmann::ordered_json groups = nlohmann::ordered_json::array();
   for (const HandleGroup& g : this->HandleGroups)
     groups.push_back({{sc::cage::kGroupName, g.name}, {sc::cage::kGroupVertices, g.vertices}});
@@ -28,6 +30,8 @@ bool vtkMRMLReposeCageNode::ReadFields(const nlohmann::json& json, bool apply, s
         !CheckInteger(json, sc::cage::kTargetVertexCount, error) ||
         !CheckNumber(json, sc::cage::kDilationMm, error))
       return false;
+    if (json.contains(sc::cage::kChoice) && !json[sc::cage::kChoice].is_object())
+      return error = std::string(sc::cage::kChoice) + ": expected an object", false;
     if (json.contains(sc::cage::kHandleGroups)) {
       const auto& groups = json[sc::cage::kHandleGroups];
       if (!groups.is_array()) return error = "HandleGroups: expected an array", false;
@@ -49,6 +53,7 @@ bool vtkMRMLReposeCageNode::ReadFields(const nlohmann::json& json, bool apply, s
   if (json.contains(sc::cage::kTargetVertexCount))
     this->SetTargetVertexCount(json[sc::cage::kTargetVertexCount]);
   if (json.contains(sc::cage::kDilationMm)) this->SetDilationMm(json[sc::cage::kDilationMm]);
+  this->SetCageChoice(json.contains(sc::cage::kChoice) ? json[sc::cage::kChoice].dump() : "");
   if (json.contains(sc::cage::kHandleGroups)) {
     std::vector<HandleGroup> groups;
     for (const auto& g : json[sc::cage::kHandleGroups])
@@ -64,6 +69,7 @@ void vtkMRMLReposeCageNode::CopyContent(vtkMRMLReposeNode* other) {
   this->SetFileName(o->FileName);
   this->SetTargetVertexCount(o->TargetVertexCount);
   this->SetDilationMm(o->DilationMm);
+  this->SetCageChoice(o->CageChoice);
   this->SetHandleGroups(o->HandleGroups);
   vtkSmartPointer<vtkPolyData> mesh;
   if (o->Mesh) {

@@ -26,6 +26,11 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeCageNode : public vtkMRM
   double GetDilationMm() const { return this->DilationMm; }
   void SetDilationMm(double mm) { this->SetField(this->DilationMm, mm); }
 
+  // The setting the cage was built with, asked and tried (Core's CageChoice::json as text; ""
+  // when unknown: a cage read from a file).
+  const std::string& GetCageChoice() const { return this->CageChoice; }
+  void SetCageChoice(const std::string& json) { this->SetField(this->CageChoice, json); }
+
   struct HandleGroup {
     std::string name;
     std::vector<int> vertices;
@@ -47,5 +52,6 @@ class VTK_SLICER_REPOSE_MODULE_MRML_EXPORT vtkMRMLReposeCageNode : public vtkMRM
   std::string FileName;
   int TargetVertexCount = 300;
   double DilationMm = 10;
+  std::string CageChoice;
   std::vector<HandleGroup> HandleGroups;
 };

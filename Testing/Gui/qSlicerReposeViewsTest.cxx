@@ -278,6 +278,7 @@ class qSlicerReposeViewsTest : public QObject {
                                               {"Bones rigid", "bones_rigid"},
                                               {"Holes", "no_new_holes"},
                                               {"Labels lost", "no_label_lost"},
+                                              {"Bones collided", "pieces_apart"},
                                               {"Mesh prediction", "prediction_within_targets"}};
     QCOMPARE(quality->rowCount(), int(checks.size()) - 1);  // all_met is the sum of the rows
     for (int r = 0; r < quality->rowCount(); ++r) {

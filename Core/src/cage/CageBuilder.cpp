@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace repose {
@@ -66,6 +67,12 @@ Region Region::parse(const std::string& text) {
   return r;
 }
 
+std::string describeCageSetting(int vertices, double dilateMm) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%d vertices, %g mm", vertices, dilateMm);
+  return text;
+}
+
 Cage buildCage(const Volume& parts, const CageOptions& options) {
   if (options.targetVertices < 50 || options.targetVertices > 2000)
     throw Error("cage vertex count must be between 50 and 2000, not " +
@@ -113,11 +120,17 @@ Cage buildCage(const Volume& parts, const CageOptions& options) {
   cage.report.faces = static_cast<int>(cage.mesh.faces.rows());
   if (!cage.report.valid()) {
     std::string failed;
-    if (!checks.closed) failed += " not closed;";
-    if (!checks.manifold) failed += " not manifold;";
-    if (!checks.outward) failed += " not outward-oriented;";
-    if (!checks.selfIntersectionFree) failed += " self-intersecting;";
-    throw Error("the cage failed its checks:" + failed + " try more vertices or a larger dilation");
+    auto add = [&](bool ok, const char* what) {
+      if (!ok) failed += (failed.empty() ? "" : ", ") + std::string(what);
+    };
+    add(checks.closed, "not closed");
+    add(checks.manifold, "not manifold");
+    add(checks.outward, "not outward-oriented");
+    add(checks.selfIntersectionFree, "self-intersecting");
+    throw CageCheckError(
+        "the cage (" + describeCageSetting(options.targetVertices, options.dilateMm) +
+            ") failed its checks: " + failed + "; try more vertices or another dilation",
+        failed);
   }
 
   reportProgress(options.progress, 0.9, "cage: enclosed body");

@@ -116,6 +116,12 @@ nlohmann::json targetsOf(const nlohmann::json& report) {
   if (const nlohmann::json* r = row("no_label_lost"))
     missed.push_back(std::to_string((*r)["labels_lost"].get<std::int64_t>()) +
                      " label(s) lost (target none)");
+  if (const nlohmann::json* r = row("pieces_apart"))
+    missed.push_back(
+        (r->contains("most") ? (*r)["most"][0].get<std::string>() + " and " +
+                                   (*r)["most"][1].get<std::string>() + " run into each other"
+                             : std::string("rigid pieces run into each other")) +
+        " in " + std::to_string((*r)["voxels"].get<std::int64_t>()) + " voxels (target none)");
   if (const nlohmann::json* r = row("prediction_within_targets")) {
     if (std::fabs((*r)["body_change_percent"].get<double>()) > kBodyTargetPercent)
       missed.push_back("predicted body volume " +
@@ -297,6 +303,24 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
                                   {"inverted_tets_after", vr.invertedAfter}};
   report["bone_collisions"] = collisions;
   report.update(nlohmann::json::parse(poseReportJson(ri)));
+  // The labels whose rounding did not hold: named, and said (docs/FORMATS.md).
+  if (report.contains("label_rounding_missed")) {
+    report["label_volumes"]["rounding_missed"] = report["label_rounding_missed"];
+    report.erase("label_rounding_missed");
+    std::string names;
+    for (const nlohmann::json& l : report["label_volumes"]["rounding_missed"])
+      names += (names.empty() ? "" : ", ") + l["name"].get<std::string>() + " " +
+               percent(l["missed_by_percent"].get<double>(), 2);
+    if (!names.empty())
+      warn(start, options,
+           "the label rounding missed the volume the deformation gives " + names +
+               " (where the pose folds the body, overlapping tissue is counted once)");
+  }
+  // Where the tets inside out are: by the joint nearest each (docs/FORMATS.md).
+  nlohmann::json byJoint = nlohmann::json::object();
+  for (const auto& [joint, tets] : rig.invertedTetsByJoint(frame.deformed))
+    byJoint[joint.empty() ? "body" : joint] = tets;
+  report["mesh"]["inverted_tets_by_joint"] = byJoint;
   // The prediction is a target too: a part the posed mesh stretches or squeezes beyond +-1 % is
   // a frame that missed, even where the voxels' rounding hides it.
   report["quality"]["prediction_within_targets"] = {
@@ -306,8 +330,21 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
       {"worst_part_change_percent", start.prediction["worst_part_change_percent"]},
       {"rule",
        "the posed transfer mesh keeps the body within +-0.5% and every body part within +-1%"}};
-  report["quality"]["all_met"] =
-      report["quality"]["all_met"].get<bool>() && start.prediction["met"].get<bool>();
+  // Two rigid pieces running into each other take voxels from one another: a missed target
+  // naming the two bones (a pivot off the joint's centre, or a pose beyond its range).
+  nlohmann::json apart = {{"met", collisions["voxels"].get<std::int64_t>() == 0},
+                          {"voxels", collisions["voxels"]},
+                          {"rule", "no two rigid pieces (bones, whole organs) share a voxel"}};
+  if (!collisions["pairs"].empty()) {
+    const nlohmann::json* most = &collisions["pairs"][0];
+    for (const nlohmann::json& p : collisions["pairs"])
+      if (p["voxels"].get<std::int64_t>() > (*most)["voxels"].get<std::int64_t>()) most = &p;
+    apart["most"] = {(*most)["a"], (*most)["b"]};
+    apart["most_voxels"] = (*most)["voxels"];
+  }
+  report["quality"]["pieces_apart"] = apart;
+  report["quality"]["all_met"] = report["quality"]["all_met"].get<bool>() &&
+                                 start.prediction["met"].get<bool>() && apart["met"].get<bool>();
   report["targets"] = targetsOf(report);
   // Folds, parts the cage cannot reach, labels gone (docs/RELIABILITY.md, degenerate geometry).
   auto count = [&](std::int64_t n, const std::string& what) {

@@ -259,6 +259,9 @@ std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, const Pose& pose
       if (const int a = label(j.parts[0]), b = label(j.parts[1]); a > 0 && b > 0)
         jointed.emplace_back(a, b);
     rig->setJointedParts(std::move(jointed));
+    std::vector<JointSite> sites;
+    for (const SkeletonJoint& j : skeleton_->joints) sites.push_back({j.name, j.centre});
+    rig->setJointSites(std::move(sites));
   }
   if (request_.volumeRestoration) rig->setTetTissues(tetTissues(rig->mesh(), *organs_, threads));
   return rig;
@@ -283,6 +286,9 @@ std::string PoseJob::completeReport(const std::string& reportJson, bool sceneReu
   report["green_coordinates"] = {{"read", d.coordinatesRead()},
                                  {"note", d.coordinatesNote()},
                                  {"bytes", d.coefficientBytes()}};
+  // The cage the rig has, and what the ladder tried before it (a scene of an older version
+  // recorded none: the asked setting then).
+  report["cage"] = nlohmann::json::parse(rig.cageChoice().json());
   report["joint_rings"] = jointRings_;
   report["separations"] = nlohmann::json::parse(separations_.reportJson());
   report["skeleton"] = skeleton_ ? nlohmann::json(skeleton_->source) : nlohmann::json();

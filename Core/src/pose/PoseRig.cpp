@@ -190,7 +190,7 @@ RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparati
   co.threads = settings.threads;
   co.progress = scaled(0, 0.5);
   RigGeometry g;
-  g.cage = buildCage(parts, co).mesh;
+  g.cage = buildCageTrying(parts, co, &g.cageChoice).mesh;
   TransferMeshOptions to;
   to.sizeMm = settings.meshMm;
   to.progress = scaled(0.5, 1);
@@ -321,6 +321,30 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(
   if (!anything) return {};
   std::vector<char> held = bends_.empty() ? std::vector<char>() : bends_.reachTets(m, handles);
   return restoreVolumes(m, grown, deformed, {}, held, tissues_.empty() ? nullptr : &tissues_);
+}
+
+std::vector<std::pair<std::string, int>> PoseRig::invertedTetsByJoint(
+    const Eigen::MatrixX3d& deformed) const {
+  const TransferMesh& m = geometry_.mesh;
+  std::vector<int> count(std::max<std::size_t>(1, jointSites_.size()), 0);
+  for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
+    Eigen::Matrix3d E;
+    for (int c = 0; c < 3; ++c)
+      E.col(c) = (deformed.row(m.tets(t, c + 1)) - deformed.row(m.tets(t, 0))).transpose();
+    if (E.determinant() > 0) continue;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) centroid += m.vertices.row(m.tets(t, k)).transpose() / 4;
+    std::size_t nearest = 0;
+    for (std::size_t j = 1; j < jointSites_.size(); ++j)
+      if ((jointSites_[j].centre - centroid).squaredNorm() <
+          (jointSites_[nearest].centre - centroid).squaredNorm())
+        nearest = j;
+    ++count[nearest];
+  }
+  std::vector<std::pair<std::string, int>> out;
+  for (std::size_t j = 0; j < count.size(); ++j)
+    if (count[j] > 0) out.emplace_back(jointSites_.empty() ? "" : jointSites_[j].name, count[j]);
+  return out;
 }
 
 PoseRig::Frame PoseRig::frame(std::size_t index, GreenPrecision precision,

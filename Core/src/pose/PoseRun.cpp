@@ -77,6 +77,11 @@ SceneRig rigForScene(const PoseJob& job, const SceneRigRun& run) {
     say("building the cage (" + std::to_string(job.settings().cageVertices) +
         " vertices) and the mesh");
     geometry = job.buildGeometry(run.buildProgress);
+    const CageChoice& cage = geometry.cageChoice;
+    if (cage.fallback() && run.note)
+      run.note("the cage of " + describeCageSetting(cage.asked.vertices, cage.asked.dilateMm) +
+               " failed its checks (" + cage.tried.front().failure + "); built with " +
+               describeCageSetting(cage.used.vertices, cage.used.dilateMm));
   }
   const std::string coordinates = geometry.coordinatesFile;
   say("embedding the mesh in the cage");

@@ -132,6 +132,7 @@ void writeSceneFolder(const std::string& folder, const PoseRig& rig, const std::
         {sc::cage::kFile, "cage.vtk"},
         {sc::cage::kTargetVertexCount, settings.cageVertices},
         {sc::cage::kDilationMm, settings.dilateMm},
+        {sc::cage::kChoice, json::parse(rig.cageChoice().json())},
         {sc::cage::kHandleGroups, groups}},
        {{sc::kClass, sc::transfer_mesh::kClassName},
         {sc::kId, mesh},
@@ -191,6 +192,27 @@ std::string fileOf(const fs::path& scene, const json& node, const char* key) {
   return fs::path(name).is_absolute() ? name : (scene / name).string();
 }
 
+// The cage node's setting: the choice Core recorded, else (an older scene, or the workbench's)
+// the node's target vertex count and dilation, asked and used alike.
+CageChoice cageChoiceOf(const json& node) {
+  const auto it = node.find(sc::cage::kChoice);
+  if (it != node.end() && it->is_object()) {
+    try {
+      return CageChoice::fromJson(it->dump());
+    } catch (const Error&) {
+      // a hand-edited choice: the node's setting below
+    }
+  }
+  CageChoice c;
+  const auto v = node.find(sc::cage::kTargetVertexCount);
+  const auto d = node.find(sc::cage::kDilationMm);
+  if (v != node.end() && v->is_number_integer()) c.asked.vertices = v->get<int>();
+  if (d != node.end() && d->is_number()) c.asked.dilateMm = d->get<double>();
+  c.used = c.asked;
+  c.tried.push_back({c.used, ""});
+  return c;
+}
+
 }  // namespace
 
 SceneContents readSceneFolder(const std::string& folder) {
@@ -206,6 +228,7 @@ SceneContents readSceneFolder(const std::string& folder) {
       out.inputs.image = fileOf(scene, node, sc::segmentation::kImageFile);
     } else if (cls == sc::cage::kClassName && cageFile.empty()) {
       cageFile = fileOf(scene, node, sc::cage::kFile);
+      out.geometry.cageChoice = cageChoiceOf(node);
     } else if (cls == sc::transfer_mesh::kClassName && meshFile.empty()) {
       meshFile = fileOf(scene, node, sc::transfer_mesh::kFile);
     } else if (cls == sc::pose::kClassName && poseFile.empty()) {
@@ -248,9 +271,12 @@ std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::st
     return notReused((scene / sc::kDocument).string() +
                      ": built for another body-part map or other settings");
   std::string cageFile, meshFile;
+  CageChoice choice;
   for (const json& node : nodesOf(doc)) {
-    if (stringOf(node, sc::kClass) == sc::cage::kClassName)
+    if (stringOf(node, sc::kClass) == sc::cage::kClassName) {
       cageFile = fileOf(scene, node, sc::cage::kFile);
+      choice = cageChoiceOf(node);
+    }
     if (stringOf(node, sc::kClass) == sc::transfer_mesh::kClassName)
       meshFile = fileOf(scene, node, sc::transfer_mesh::kFile);
   }
@@ -261,7 +287,7 @@ std::optional<RigGeometry> readSceneRig(const std::string& folder, const std::st
   const std::string edited = editedRigFile(scene, doc);
   if (!edited.empty()) return notReused(edited);
   return RigGeometry{readTriangleMesh(cageFile), readTransferMesh(meshFile),
-                     greenCoordinatesFileFor(meshFile)};
+                     greenCoordinatesFileFor(meshFile), choice};
 }
 
 }  // namespace repose

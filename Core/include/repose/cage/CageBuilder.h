@@ -4,6 +4,7 @@
 
 #include "repose/cage/TriangleMesh.h"
 #include "repose/util/Progress.h"
+#include "repose/util/Error.h"
 #include "repose/volume/Volume.h"
 
 #include <string>
@@ -58,9 +59,21 @@ struct Cage {
   CageReport report;
 };
 
+// "300 vertices, 10 mm": how messages and reports name a cage's setting.
+std::string describeCageSetting(int vertices, double dilateMm);
+
+// A cage that failed its checks (closed, manifold, outward, no self-intersection): `failed` says
+// which, e.g. "self-intersecting" (CageLadder.h tries other settings on this one only).
+class CageCheckError : public Error {
+ public:
+  CageCheckError(const std::string& message, std::string failedChecks)
+      : Error(message), failed(std::move(failedChecks)) {}
+  std::string failed;
+};
+
 // parts: S (body-part labels, or any label map: non-zero is body). Throws repose::Error naming
-// the problem for an empty mask, absent labels, a region that selects nothing, or a cage that
-// fails its checks (closed, manifold, outward, no self-intersection).
+// the problem for an empty mask, absent labels or a region that selects nothing, and
+// CageCheckError for a cage that fails its checks.
 Cage buildCage(const Volume& parts, const CageOptions& options = {});
 
 }  // namespace repose

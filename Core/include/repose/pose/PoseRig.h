@@ -5,6 +5,7 @@
 #pragma once
 
 #include "repose/cage/CageBuilder.h"
+#include "repose/cage/CageLadder.h"
 #include "repose/mesh/JointBend.h"
 #include "repose/mesh/VolumeRestoration.h"
 #include "repose/mesh/Refinement.h"
@@ -71,6 +72,8 @@ struct RigGeometry {
   // The Green coordinates saved with them (a scene's tm.green; CageDeformation); "" when none.
   // Used only if written for this very cage and mesh, else computed again.
   std::string coordinatesFile;
+  // The cage's setting: asked, used (the ladder's first that passed its checks) and tried.
+  CageChoice cageChoice;
 };
 
 // settings.bonePieces for a tissue table: each bone's rigid labels -> the bone's smallest label.
@@ -89,7 +92,8 @@ Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSetting
 int demotePiecesAcrossJoints(TransferMesh& mesh);
 
 // Cage and transfer mesh of S, separated where asked; with G (organs, on S's grid) the mesh has
-// the labelsMovingWhole as pieces of their own. Progress: cage 0-0.5, mesh 0.5-1.
+// the labelsMovingWhole as pieces of their own. The cage is the first of the ladder from the
+// settings' size that passes its checks (buildCageTrying). Progress: cage 0-0.5, mesh 0.5-1.
 RigGeometry buildRigGeometry(const Volume& parts, const std::vector<LimbSeparation>& separations,
                              const RigSettings& settings, const ProgressFn& progress = {},
                              const Volume* organs = nullptr);
@@ -104,6 +108,13 @@ TransferMesh refineRigMesh(const Volume& parts, const TriangleMesh& cage,
                            const RigSettings& settings, int iterations,
                            const ProgressFn& progress = {}, const Volume* organs = nullptr,
                            std::vector<RefinementStep>* steps = nullptr);
+
+// A joint of the body's skeleton as the report names it: where the tets turned inside out are
+// counted (PoseRig::invertedTetsByJoint).
+struct JointSite {
+  std::string name;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+};
 
 // Whether a frame computes every tet's linear map B_t (exports and reports need them; the live
 // view shows positions only, and skipping them spares most of a frame's time at 200K tets).
@@ -157,6 +168,8 @@ class PoseRig {
 
   const TriangleMesh& cage() const { return geometry_.cage; }
   const TransferMesh& mesh() const { return geometry_.mesh; }
+  // The cage's setting, asked and used (CageLadder.h).
+  const CageChoice& cageChoice() const { return geometry_.cageChoice; }
   const CageDeformation& deformation() const { return *deformation_; }
   const std::vector<RigidHandle>& handles() const { return handles_; }
   const HandleInfluence& influence() const { return influence_; }
@@ -181,6 +194,13 @@ class PoseRig {
   // restoration relaxes the transition as it does a bend. Elsewhere a blend is a tether.
   void setJointedParts(std::vector<std::pair<int, int>> pairs) { jointedParts_ = std::move(pairs); }
   bool volumeRestoration() const { return restoreVolumes_; }
+  // The skeleton's joints (PoseJob::makeRig): invertedTetsByJoint names them.
+  void setJointSites(std::vector<JointSite> sites) { jointSites_ = std::move(sites); }
+  // The tets turned inside out at `deformed` (posed volume <= 0), each counted at the joint
+  // nearest its rest centroid: (joint, tets) for the joints with any, in the skeleton's order;
+  // ("", tets) when the rig has no joints.
+  std::vector<std::pair<std::string, int>> invertedTetsByJoint(
+      const Eigen::MatrixX3d& deformed) const;
   // The restoration frame() applies, on posed vertices of this rig's mesh solved elsewhere (a
   // live frame, to predict what its export will measure) with the frame's handles (their
   // motions say which joints bend). It acts in the joints' bends only, the soft tissue the bends
@@ -212,6 +232,7 @@ class PoseRig {
   bool restoreVolumes_ = true;
   TetTissues tissues_;
   std::vector<std::pair<int, int>> jointedParts_;
+  std::vector<JointSite> jointSites_;
   std::vector<std::pair<std::string, std::vector<Eigen::Isometry3d>>> frames_;
 };
 

@@ -54,6 +54,9 @@ inline constexpr char kClassName[] = "vtkMRMLReposeCageNode";
 inline constexpr char kFile[] = "FileName";  // .vtk or .obj
 inline constexpr char kTargetVertexCount[] = "TargetVertexCount";
 inline constexpr char kDilationMm[] = "DilationMm";
+// The setting the cage was built with, asked and tried (Core's CageLadder.h, CageChoice::json);
+// written by Core's scene folders, absent from older scenes and from the workbench's.
+inline constexpr char kChoice[] = "CageChoice";
 inline constexpr char kHandleGroups[] = "HandleGroups";  // [{name, vertices}]
 inline constexpr char kGroupName[] = "name";
 inline constexpr char kGroupVertices[] = "vertices";

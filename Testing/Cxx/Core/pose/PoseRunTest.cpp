@@ -8,6 +8,7 @@
 #include "repose/io/VolumeIO.h"
 #include "repose/phantom/Phantom.h"
 #include "repose/pose/PoseJob.h"
+#include "repose/pose/PoseReport.h"
 #include "repose/pose/PoseRun.h"
 #include "repose/util/Error.h"
 #include "repose/volume/TissueTable.h"
@@ -15,9 +16,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include <unistd.h>
@@ -133,6 +137,47 @@ TEST(PoseRun, AFrameIsTheFrameOfPoseFrameCompletedByTheJobAndWritten) {
   EXPECT_EQ(out.targetsMet, out.missed.empty());
   // Warnings reached the front end as they are in the report.
   EXPECT_EQ(warnings.size(), written["warnings"].size());
+
+  // The cage the rig has: asked and used (200 vertices passes its checks: nothing else tried).
+  EXPECT_EQ(written["cage"]["asked"]["vertices"], 200);
+  EXPECT_EQ(written["cage"]["used"], written["cage"]["asked"]);
+  EXPECT_EQ(written["cage"]["fallback"], false);
+  ASSERT_EQ(written["cage"]["tried"].size(), 1u);
+  EXPECT_TRUE(written["cage"]["tried"][0]["failed"].is_null());
+  // The tets inside out, by the skeleton's joints: every one counted once, at a joint named by
+  // the skeleton, and at the bent elbow if anywhere.
+  std::int64_t byJoint = 0;
+  for (const auto& [joint, tets] : written["mesh"]["inverted_tets_by_joint"].items()) {
+    EXPECT_TRUE(std::any_of(b.job->skeleton()->joints.begin(), b.job->skeleton()->joints.end(),
+                            [&](const SkeletonJoint& j) { return j.name == joint; }))
+        << joint;
+    EXPECT_GT(tets.get<int>(), 0) << joint;
+    byJoint += tets.get<std::int64_t>();
+  }
+  EXPECT_EQ(byJoint, written["mesh"]["inverted_tets"].get<std::int64_t>());
+  // Rigid pieces apart is a target, and agrees with the collisions it counts.
+  EXPECT_EQ(written["quality"]["pieces_apart"]["met"],
+            written["bone_collisions"]["voxels"].get<std::int64_t>() == 0);
+  // The rounding says whether it held, label by label, and names those of >= 1000 voxels that
+  // missed.
+  std::set<int> missed;
+  for (const auto& l : written["label_volumes"]["rounding_missed"])
+    missed.insert(l["value"].get<int>());
+  int rounded = 0;
+  for (const auto& row : written["labels"]) {
+    if (!row.contains("rounding")) continue;
+    ++rounded;
+    const auto& r = row["rounding"];
+    const double by = r["missed_by_percent"].get<double>();
+    EXPECT_NEAR(
+        by, 100 * (row["voxels_after"].get<double>() / r["target_voxels"].get<double>() - 1), 1e-9);
+    EXPECT_EQ(r["held"].get<bool>(), std::fabs(by) <= r["tolerance_percent"].get<double>());
+    EXPECT_EQ(row["rounded"], r["held"]);
+    EXPECT_EQ(missed.count(row["value"].get<int>()) == 1,
+              !r["held"].get<bool>() && row["voxels_before"].get<std::int64_t>() >= 1000)
+        << row["name"];
+  }
+  EXPECT_GT(rounded, 3);
 }
 
 TEST(PoseRun, WithoutAFolderNothingIsWrittenAndTheReportHasNoOutputs) {
@@ -276,6 +321,9 @@ TEST(PoseRun, ARigIsBuiltAndSavedOnceThenReusedFromItsScene) {
   EXPECT_EQ(again.rig->cage().vertices, built.rig->cage().vertices);
   EXPECT_EQ(again.rig->mesh().tets, built.rig->mesh().tets);
   EXPECT_TRUE(again.rig->frame(0).deformed.isApprox(built.rig->frame(0).deformed, 1e-9));
+  // The cage's choice is kept with the scene and read back with it.
+  EXPECT_EQ(again.rig->cageChoice().json(), built.rig->cageChoice().json());
+  EXPECT_EQ(again.rig->cageChoice().used.vertices, 200);
   // Green coordinates: written with the scene, then read back rather than computed.
   EXPECT_TRUE(again.rig->deformation().coordinatesRead())
       << again.rig->deformation().coordinatesNote();
@@ -297,4 +345,46 @@ TEST(PoseRun, ARigIsBuiltAndSavedOnceThenReusedFromItsScene) {
   EXPECT_EQ(notes[0].rfind("the scene's rig is built again: ", 0), 0u) << notes[0];
   // Not saved over the scene: the first rig is still reused.
   EXPECT_TRUE(rigForScene(*b.job, run).reused);
+}
+
+// A label whose final count misses the volume the deformation gives it (tissue lost to a fold:
+// here a target 5 % above what was written) is named, not reported as rounded; one on its target
+// is rounded.
+TEST(PoseReport, ARoundingThatMissedIsNamedNotReportedAsRounded) {
+  const Body& b = body();
+  const PosedFrame posed = poseFrame(*b.rig, 0, b.organs, b.parts, b.job->frameOptions());
+  const PoseRig::Frame frame = b.rig->frame(0);
+  std::map<int, std::int64_t> counts;
+  const auto* g = posed.organs.data<std::uint8_t>();
+  for (std::int64_t v = 0; v < posed.organs.numVoxels(); ++v) ++counts[g[v]];
+  // The two largest labels but the background: one on its target, one 5 % short of it.
+  std::vector<std::pair<std::int64_t, int>> bySize;
+  for (const auto& [label, n] : counts)
+    if (label != 0) bySize.emplace_back(n, label);
+  std::sort(bySize.rbegin(), bySize.rend());
+  ASSERT_GE(bySize.size(), 2u);
+  const int onTarget = bySize[0].second, short5 = bySize[1].second;
+  const std::map<int, double> targets = {{onTarget, double(bySize[0].first)},
+                                         {short5, 1.05 * double(bySize[1].first)}};
+  PoseReportInput in;
+  in.organs = &b.organs, in.parts = &b.parts;
+  in.posedOrgans = &posed.organs, in.posedParts = &posed.parts;
+  in.mesh = &b.rig->mesh(), in.tetMaps = &frame.tetMaps, in.handles = &frame.handles;
+  for (const PoseGroup& group : b.rig->pose().groups) in.groupNames.push_back(group.name);
+  in.tissues = &*b.job->tissues().table;
+  in.labelTargets = &targets;
+  const nlohmann::json report = nlohmann::json::parse(poseReportJson(in));
+  for (const auto& row : report["labels"]) {
+    if (row["value"] == onTarget) {
+      EXPECT_EQ(row["rounded"], true);
+      EXPECT_NEAR(row["rounding"]["missed_by_percent"].get<double>(), 0, 1e-9);
+    } else if (row["value"] == short5) {
+      EXPECT_EQ(row["rounded"], false);
+      EXPECT_NEAR(row["rounding"]["missed_by_percent"].get<double>(), 100 * (1 / 1.05 - 1), 1e-6);
+    } else {
+      EXPECT_FALSE(row.contains("rounding")) << row["name"];
+    }
+  }
+  ASSERT_EQ(report["label_rounding_missed"].size(), 1u);
+  EXPECT_EQ(report["label_rounding_missed"][0]["value"], short5);
 }
