@@ -19,7 +19,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kRoundingSlackPercent = 0.1;
+constexpr double kRoundingSlackPercent = 0.5;
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
@@ -115,8 +115,9 @@ static json makePoseReport(const PoseReportInput& in) {
       const double nearest = row.contains("resampling_floor_percent")
                                  ? std::fabs(row["resampling_floor_percent"].get<double>())
                                  : 0.0;
-      // At least 0.1 % and a voxel: the greedy choice stops a few voxels short of a large
-      // label's volume when no border voxel lowers the misfit further.
+      // At least half the label target (0.5 %) and a voxel: on coarse grids the greedy choice
+      // stops short of a label's volume when no border voxel lowers the misfit further (0.1-0.3 %
+      // on 8 mm slices); a fold's loss is more (muscle -0.8 % under arms raised 160 degrees).
       const double tolerance =
           std::max({nearest, kRoundingSlackPercent, target > 0 ? 100 / target : 100.0});
       const bool held = std::fabs(missedBy) <= tolerance;

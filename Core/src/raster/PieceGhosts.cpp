@@ -80,6 +80,21 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
     if (found.empty()) break;
     for (const auto& [t, ph] : found) host[std::size_t(t)].insert(ph);
   }
+  // A soft tet holding a piece that no piece tet reaches within the rings (a rib one voxel thick
+  // on 8 mm slices, which Mesh_3 gives a handful of tets of its own) takes any tet of that piece
+  // in its body part as host: a piece moves whole with one group, so every one of its tets has
+  // the same rigid map. Without, such a bone bent with the soft tissue around it (the ribs'
+  // Dice 0.65 under arms raised 160 degrees on the ICRP adult male's grid).
+  std::map<std::pair<int, int>, std::int32_t> anyTetOf;  // (body part, piece) -> a tet of it
+  for (Eigen::Index t = 0; t < nt; ++t)
+    if (const int p = mesh.rigid[std::size_t(t)])
+      anyTetOf.try_emplace({mesh.labels[t], p}, std::int32_t(t));
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (const int p : holds[std::size_t(t)])
+      if (!host[std::size_t(t)].count(p)) {
+        const auto it = anyTetOf.find({mesh.labels[t], p});
+        if (it != anyTetOf.end()) host[std::size_t(t)][p] = it->second;
+      }
   for (Eigen::Index t = 0; t < nt; ++t)
     if (!mesh.rigid[std::size_t(t)])
       for (const auto& [p, h] : host[std::size_t(t)]) out.push_back({std::int32_t(t), h});

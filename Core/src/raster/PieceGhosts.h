@@ -27,7 +27,8 @@ struct PieceGhost {
 
 // The soft tets whose rest volume holds a label of a piece (sampled at the centroid and half way
 // to each vertex, on `pieceLabels`, the label map on the input's grid) and a tet of that piece in
-// the same body part within `rings` vertex-sharing steps through such tets. `pieceOf[label]`: the
+// the same body part within `rings` vertex-sharing steps through such tets, else any tet of that
+// piece in that body part (a piece moves whole: one rigid map). `pieceOf[label]`: the
 // piece id the label is meshed in (0: none). `input`: the grid of `pieceLabels`.
 std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& pieceLabels,
                                     const std::vector<int>& pieceOf, int rings = 3);
