@@ -27,6 +27,13 @@ def row(r):
     if bones and bones.get("min_dice_bone") and bones["min_dice"] < 0.9995:
         dice += f" ({bones['min_dice_bone']})"
     vr = r.get("volume_restoration", {})
+    # The tets inside out, and the joint nearest most of them (report.json's
+    # mesh.inverted_tets_by_joint).
+    by_joint = r["mesh"].get("inverted_tets_by_joint", {})
+    inverted = str(r["mesh"]["inverted_tets"])
+    if by_joint:
+        joint, n = max(by_joint.items(), key=lambda kv: kv[1])
+        inverted += f" ({joint} {n})"
     return (f"| {r['frame'] if r['frame'] == r['pose'] else r['pose'] + '/' + r['frame']} "
             f"| {r['body']['volume_change_percent']:+.3f} "
             f"| {pred['worst_part'] or '-'} {pred['worst_part_change_percent']:+.2f} "
@@ -35,6 +42,7 @@ def row(r):
             f"| {q['no_new_holes']['new_enclosed_voxels']} | {q['no_label_lost']['labels_lost']} "
             f"| {len(r['separations'].get('made', []))} "
             f"| {vr.get('max_correction_mm', 0):.1f} "
+            f"| {inverted} "
             f"| {'yes' if r['targets']['met'] else 'no'} |")
 
 
@@ -43,8 +51,8 @@ def main():
     order = sys.argv[2].split(",") if len(sys.argv) > 2 else ORDER
     print("| frame | body % | predicted worst part % | worst label beyond floor % | bones min Dice "
           "| bones collided (voxels) | new holes | lost | cuts | restoration's largest move (mm) "
-          "| all met |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "| inverted tets (most at) | all met |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for pose in order:
         for p in sorted((work / pose).rglob("report.json")):
             print(row(json.loads(p.read_text())))
