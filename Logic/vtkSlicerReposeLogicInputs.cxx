@@ -59,11 +59,7 @@ repose::CageChoice CageChoiceOf(vtkMRMLReposeCageNode* cage) {
       // edited by hand: the node's own setting below
     }
   }
-  repose::CageChoice c;
-  c.asked = {cage->GetTargetVertexCount(), cage->GetDilationMm()};
-  c.used = c.asked;
-  c.tried.push_back({c.used, ""});
-  return c;
+  return repose::CageChoice::given({cage->GetTargetVertexCount(), cage->GetDilationMm()});
 }
 
 repose::LabelTable BodyPartLabels(vtkMRMLReposeSegmentationNode* seg) {

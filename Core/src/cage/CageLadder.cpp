@@ -62,6 +62,13 @@ CageChoice CageChoice::fromJson(const std::string& text) {
   }
 }
 
+CageChoice CageChoice::given(const CageSetting& setting) {
+  CageChoice c;
+  c.asked = c.used = setting;
+  c.tried.push_back({setting, ""});
+  return c;
+}
+
 std::vector<CageSetting> cageLadder(const CageSetting& asked) {
   std::vector<CageSetting> out;
   auto add = [&](int vertices, double dilateMm) {

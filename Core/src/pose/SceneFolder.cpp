@@ -203,14 +203,12 @@ CageChoice cageChoiceOf(const json& node) {
       // a hand-edited choice: the node's setting below
     }
   }
-  CageChoice c;
+  CageSetting setting;
   const auto v = node.find(sc::cage::kTargetVertexCount);
   const auto d = node.find(sc::cage::kDilationMm);
-  if (v != node.end() && v->is_number_integer()) c.asked.vertices = v->get<int>();
-  if (d != node.end() && d->is_number()) c.asked.dilateMm = d->get<double>();
-  c.used = c.asked;
-  c.tried.push_back({c.used, ""});
-  return c;
+  if (v != node.end() && v->is_number_integer()) setting.vertices = v->get<int>();
+  if (d != node.end() && d->is_number()) setting.dilateMm = d->get<double>();
+  return CageChoice::given(setting);
 }
 
 }  // namespace

@@ -42,6 +42,9 @@ struct CageChoice {
   std::string json() const;
   // Reads what json() wrote; throws repose::Error on text that is not such an object.
   static CageChoice fromJson(const std::string& text);
+  // A cage of a known setting with nothing else tried (a cage read from a file, or a scene that
+  // recorded no choice): asked and used alike.
+  static CageChoice given(const CageSetting& setting);
 };
 
 // The settings tried, in order, starting with `asked` (no setting twice; vertices within

@@ -50,6 +50,12 @@ TEST(CageLadder, TheChoiceSurvivesItsJson) {
   EXPECT_EQ(back.tried[1].failure, "not manifold, self-intersecting");
   EXPECT_EQ(back.tried[2].failure, "");
   EXPECT_THROW(CageChoice::fromJson("{\"asked\": 3}"), Error);
+  // A cage of a known setting, nothing else tried.
+  const CageChoice given = CageChoice::given({450, 8});
+  EXPECT_FALSE(given.fallback());
+  EXPECT_TRUE(given.used == (CageSetting{450, 8}));
+  ASSERT_EQ(given.tried.size(), 1u);
+  EXPECT_EQ(given.tried[0].failure, "");
 }
 
 namespace {

@@ -719,20 +719,20 @@ TEST(Rasterizer, AWholePieceKeepsItsVoxelsWhereSoftTissueFoldsOverIt) {
 // Through its piece tets, rims and the ghosts of its soft tets (raster/PieceGhosts.h) every bone
 // voxel lands where the bone's own motion puts it; without the pieces' label map the soft end
 // bends with the joint.
-TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
-  const BoneEnd b = boneEndInSoftTets();
-  ASSERT_GT(b.softTets, 0);
-  const TransferMesh& mesh = b.mesh;
-  const Eigen::Isometry3d& motion = b.motion;
-  const Eigen::MatrixX3d& deformed = b.deformed;
-  const VolumeGeometry& grid = b.grid;
-  const Volume &G = b.G, &S = b.S;
+// The Dice of bone label `bone` posed through the mesh against the bone moved by `motion` alone,
+// with the pieces' map (rims, ghosts: G and S at rest) and without it.
+static std::pair<double, double> boneDice(const Volume& G, const Volume& S,
+                                          const TransferMesh& mesh,
+                                          const Eigen::MatrixX3d& deformed,
+                                          const VolumeGeometry& grid,
+                                          const Eigen::Isometry3d& motion, int bone) {
   const Volume expected =
       mapDirectly(G, grid, [&](const Eigen::Vector3d& ras) { return motion.inverse() * ras; });
   auto dice = [&](const Volume& posed) {
     std::int64_t a = 0, b = 0, both = 0;
     for (std::int64_t v = 0; v < grid.numVoxels(); ++v) {
-      const bool x = posed.data<std::uint8_t>()[v] == 5, y = expected.data<std::uint8_t>()[v] == 5;
+      const bool x = posed.data<std::uint8_t>()[v] == bone,
+                 y = expected.data<std::uint8_t>()[v] == bone;
       a += x, b += y, both += x && y;
     }
     return double(2 * both) / double(a + b);
@@ -740,8 +740,14 @@ TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
   RasterOptions options;
   options.pieceLabels = &G;
   options.restParts = &S;
-  const double withPieces = dice(rasterizeLabels(G, mesh, deformed, grid, options));
-  const double without = dice(rasterizeLabels(G, mesh, deformed, grid));
+  return {dice(rasterizeLabels(G, mesh, deformed, grid, options)),
+          dice(rasterizeLabels(G, mesh, deformed, grid))};
+}
+
+TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
+  const BoneEnd b = boneEndInSoftTets();
+  ASSERT_GT(b.softTets, 0);
+  const auto [withPieces, without] = boneDice(b.G, b.S, b.mesh, b.deformed, b.grid, b.motion, 5);
   EXPECT_LT(without, 0.95);  // the sheared end is a third of the bone
   EXPECT_GT(withPieces, 0.995) << "without the pieces' map: " << without;
 }
@@ -776,21 +782,7 @@ TEST(Rasterizer, ABoneFarFromItsOwnTetsMovesWithTheBone) {
         S.data<std::uint8_t>()[S.index(i, j, k)] = 1;
         if (j >= 5 && j < 8 && k >= 5 && k < 8) G.data<std::uint8_t>()[G.index(i, j, k)] = 5;
       }
-  const Volume expected =
-      mapDirectly(G, grid, [&](const Eigen::Vector3d& ras) { return motion.inverse() * ras; });
-  auto dice = [&](const Volume& posed) {
-    std::int64_t a = 0, b = 0, both = 0;
-    for (std::int64_t v = 0; v < grid.numVoxels(); ++v) {
-      const bool x = posed.data<std::uint8_t>()[v] == 5, y = expected.data<std::uint8_t>()[v] == 5;
-      a += x, b += y, both += x && y;
-    }
-    return double(2 * both) / double(a + b);
-  };
-  RasterOptions options;
-  options.pieceLabels = &G;
-  options.restParts = &S;
-  const double withPieces = dice(rasterizeLabels(G, mesh, deformed, grid, options));
-  const double without = dice(rasterizeLabels(G, mesh, deformed, grid));
+  const auto [withPieces, without] = boneDice(G, S, mesh, deformed, grid, motion, 5);
   EXPECT_LT(without, 0.5);  // sheared by up to 9 voxels, a 3-voxel bone
   EXPECT_GT(withPieces, 0.99) << "without the pieces' map: " << without;
 }
