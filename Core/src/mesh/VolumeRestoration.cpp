@@ -2,6 +2,7 @@
 // exactly (VolumeRestoration.h).
 #include "repose/mesh/VolumeRestoration.h"
 
+#include "TetUntangle.h"
 #include "numerics/SparseCholesky.h"
 
 #include <Eigen/Dense>
@@ -13,24 +14,9 @@
 #include <utility>
 
 namespace repose {
-namespace {
 
-// d(volume)/d(vertex k) of the tet with corners x[0..3]: the gradient of det[b-a, c-a, d-a] / 6.
-std::array<Eigen::Vector3d, 4> volumeGradients(const std::array<Eigen::Vector3d, 4>& x) {
-  const Eigen::Vector3d b = x[1] - x[0], c = x[2] - x[0], d = x[3] - x[0];
-  std::array<Eigen::Vector3d, 4> g;
-  g[1] = c.cross(d) / 6;
-  g[2] = d.cross(b) / 6;
-  g[3] = b.cross(c) / 6;
-  g[0] = -(g[1] + g[2] + g[3]);
-  return g;
-}
-
-double volumeOf(const std::array<Eigen::Vector3d, 4>& x) {
-  return (x[1] - x[0]).cross(x[2] - x[0]).dot(x[3] - x[0]) / 6;
-}
-
-}  // namespace
+using mesh_detail::volumeGradients;
+using mesh_detail::volumeOf;
 
 VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vector<char>& movable,
                                        Eigen::MatrixX3d& deformed,
@@ -187,9 +173,9 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       worst = std::max(worst, std::fabs(r[Eigen::Index(c)]) / amount[c]);
     return worst;
   };
-  Eigen::MatrixX3d best = deformed;
-  double bestMisfit = misfit(deformed);
-  for (int round = 0; round < options.iterations; ++round) {
+  // One Gauss-Newton step from the positions at hand: the correction of every free vertex
+  // (3 unknowns each, index order).
+  auto gaussNewtonStep = [&]() -> Eigen::VectorXd {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(active.size() * 78 + edges.size() * 12 + std::size_t(unknowns));
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns);
@@ -269,7 +255,12 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     const double ridge = 1e-9 * std::max(1e-300, schur.diagonal().cwiseAbs().maxCoeff());
     schur.diagonal().array() += ridge;
     const Eigen::VectorXd mu = schur.ldlt().solve(C.transpose() * S.col(0) + partResidual);
-    const Eigen::VectorXd delta = S.col(0) - S.rightCols(constraints) * mu;
+    return S.col(0) - S.rightCols(constraints) * mu;
+  };
+  Eigen::MatrixX3d best = deformed;
+  double bestMisfit = misfit(deformed);
+  for (int round = 0; round < options.iterations; ++round) {
+    const Eigen::VectorXd delta = gaussNewtonStep();
     // A linearised step is trusted only so far: no vertex moves more than its shortest rest edge
     // in one round (a tet turned far inside out, or constraints at odds, would otherwise
     // send a vertex across the body); the next round starts from where the vertices are.
@@ -289,6 +280,42 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     if (moved < 1e-4) break;  // settled
   }
   deformed = best;
+
+  // Creases (TetUntangle.h): the tets the restoration left inside out are untangled with every
+  // held volume kept.
+  if (options.untangleRounds > 0) {
+    std::vector<int> freeVertices;
+    for (Eigen::Index v = 0; v < nv; ++v)
+      if (index[std::size_t(v)] >= 0) freeVertices.push_back(int(v));
+    std::vector<int> activeTets(active.begin(), active.end());
+    // Per summed tet, the constraints its volume enters and with what weight (volume change to
+    // constraint change), the same sums the residual makes.
+    UntangleConstraints held;
+    held.offsets.assign(std::size_t(nt) + 1, 0);
+    std::vector<std::vector<std::pair<int, double>>> perTet(static_cast<std::size_t>(nt));
+    for (const Eigen::Index t : summed) {
+      auto& rows = perTet[std::size_t(t)];
+      rows.emplace_back(partRow.at(mesh.labels[t]), 1.0);
+      if (!tissueRow.empty())
+        for (int e = tissues->offsets[std::size_t(t)]; e < tissues->offsets[std::size_t(t) + 1];
+             ++e) {
+          const auto it = tissueRow.find(tissues->entries[std::size_t(e)].first);
+          if (it != tissueRow.end())
+            rows.emplace_back(it->second,
+                              tissues->entries[std::size_t(e)].second / rest[std::size_t(t)]);
+        }
+    }
+    for (Eigen::Index t = 0; t < nt; ++t)
+      held.offsets[std::size_t(t) + 1] =
+          held.offsets[std::size_t(t)] + int(perTet[std::size_t(t)].size());
+    for (auto& rows : perTet) held.entries.insert(held.entries.end(), rows.begin(), rows.end());
+    held.amount = amount;
+    held.residual = residual(deformed);
+    UntangleOptions uo;
+    uo.sweeps = options.untangleRounds;
+    const UntangleReport u = untangleTets(mesh, freeVertices, activeTets, held, deformed, uo);
+    report.untangled = u.invertedBefore - u.invertedAfter;
+  }
 
   std::map<int, std::pair<double, double>> after;
   report.invertedAfter = 0;

@@ -109,6 +109,52 @@ int demotePiecesAcrossJoints(TransferMesh& mesh) {
     }
     if (joint) mesh.rigid[std::size_t(t)] = 0, ++demoted;
   }
+  // A soft tet whose four vertices all lie on pieces, of two parts (a joint space thinner than
+  // one tet: humerus to ulna, femur to tibia), has no vertex that may move: it follows two rigid
+  // motions that disagree and turns inside out when the joint bends, with nothing the restoration
+  // can do. The part with more piece volume at its vertices keeps them; the other part's piece
+  // tets at them go soft, so the joint space has a free layer that bends (their bone is still
+  // placed by the piece's own motion: PieceGhosts.h).
+  for (int pass = 0; pass < 4; ++pass) {
+    std::vector<std::map<int, double>> pieceAt(std::size_t(mesh.vertices.rows()));
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      if (!mesh.rigid[std::size_t(t)]) continue;
+      const double v = std::fabs(tetVolume(mesh.vertices, mesh.tets.row(t)));
+      for (int c = 0; c < 4; ++c) pieceAt[std::size_t(mesh.tets(t, c))][mesh.labels[t]] += v;
+    }
+    std::vector<std::pair<int, int>> loosen;  // (vertex, part whose piece tets at it go soft)
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      if (mesh.rigid[std::size_t(t)]) continue;
+      std::map<int, double> parts;
+      bool pinned = true;
+      for (int c = 0; c < 4 && pinned; ++c) {
+        const auto& at = pieceAt[std::size_t(mesh.tets(t, c))];
+        pinned = !at.empty();
+        for (const auto& [part, volume] : at) parts[part] += volume;
+      }
+      if (!pinned || parts.size() < 2) continue;
+      int keep = -1;
+      double most = -1;
+      for (const auto& [part, volume] : parts)
+        if (volume > most) most = volume, keep = part;
+      for (int c = 0; c < 4; ++c)
+        for (const auto& [part, volume] : pieceAt[std::size_t(mesh.tets(t, c))])
+          if (part != keep) loosen.emplace_back(mesh.tets(t, c), part);
+    }
+    if (loosen.empty()) break;
+    std::sort(loosen.begin(), loosen.end());
+    loosen.erase(std::unique(loosen.begin(), loosen.end()), loosen.end());
+    std::vector<std::vector<int>> partsToLoosen(std::size_t(mesh.vertices.rows()));
+    for (const auto& [v, part] : loosen) partsToLoosen[std::size_t(v)].push_back(part);
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      if (!mesh.rigid[std::size_t(t)]) continue;
+      bool go = false;
+      for (int c = 0; c < 4 && !go; ++c)
+        for (const int part : partsToLoosen[std::size_t(mesh.tets(t, c))])
+          go = go || part == mesh.labels[t];
+      if (go) mesh.rigid[std::size_t(t)] = 0, ++demoted;
+    }
+  }
   return demoted;
 }
 
@@ -304,6 +350,15 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(
             break;
           }
       }
+  }
+  // The tets the bends and blends turned inside out (a crease): their vertices are freed too, so
+  // the restoration's untangling (TetUntangle.h) reaches them.
+  for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
+    Eigen::Matrix3d E;
+    for (int c = 0; c < 3; ++c)
+      E.col(c) = (deformed.row(m.tets(t, c + 1)) - deformed.row(m.tets(t, 0))).transpose();
+    if (E.determinant() <= 0)
+      for (int k = 0; k < 4; ++k) zone[std::size_t(m.tets(t, k))] = 1;
   }
   // One ring of tets around the bends: the tets that span the bend's reach.
   std::vector<char> grown = zone;

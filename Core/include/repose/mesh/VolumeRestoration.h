@@ -55,6 +55,9 @@ struct VolumeRestorationOptions {
   // volume over the mean squared edge length of the free region, so it does not depend on the
   // mesh's size).
   double smoothness = 0.01;
+  // Sweeps of the untangling (TetUntangle.h) over the free vertices when tets are left inside out
+  // (a crease); 0: none.
+  int untangleRounds = 60;
 };
 
 struct VolumeRestorationReport {
@@ -66,6 +69,7 @@ struct VolumeRestorationReport {
   double worstPartBefore = 0;  // the largest |volume change| of a part, percent
   double worstPartAfter = 0;
   int invertedBefore = 0, invertedAfter = 0;
+  int untangled = 0;  // tets the untangling turned right side out
 };
 
 // `movable[v]`: whether vertex v may be moved at all (the soft tissue of the joints' bends; never

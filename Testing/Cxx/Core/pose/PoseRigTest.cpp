@@ -278,6 +278,24 @@ TEST(PoseRig, WherePiecesOfTwoPartsShareAVertexOnlyTheSmallerSideGoesSoft) {
   EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
 }
 
+TEST(PoseRig, ASoftTetPinnedBetweenPiecesOfTwoPartsGetsAFreeVertex) {
+  // A joint space thinner than one tet: the soft tet (label 1) has two vertices on part 1's piece
+  // and two on part 2's, so none may move, and it turns inside out when the joint bends. The
+  // smaller piece (part 2) gives up its tets at those vertices; the larger keeps its own.
+  TransferMesh mesh;
+  mesh.vertices.resize(8, 3);
+  mesh.vertices << 0, 0, 0, 10, 0, 0, 0, 10, 0, 0, 0, 10,  // part 1's piece: 166.7 mm^3
+      0, 0, 12, 3, 0, 12, 0, 3, 12, 0, 0, 15;              // part 2's piece: 4.5 mm^3
+  mesh.tets.resize(3, 4);
+  mesh.tets << 0, 1, 2, 3, 4, 5, 6, 7, 3, 1, 4, 5;
+  mesh.labels.resize(3);
+  mesh.labels << 1, 2, 1;
+  mesh.rigid = {11, 14, 0};
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 1);
+  EXPECT_EQ(mesh.rigid, (std::vector<int>{11, 0, 0}));
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
+}
+
 // A drag whose cage has free vertices (the left upper arm is in no group, so ARAP bends it between
 // the fixed body and the turning forearm), one degree per event: each live frame takes at most
 // kLiveCageIterations ARAP iterations from the last one and stays within a tenth of a millimetre

@@ -1,0 +1,67 @@
+// Creases: tets a bend turned inside out, untangled with the held volumes kept.
+//
+// The inner side of a bend (elbow, groin, armpit) is a contact between two sides of one body: the
+// blended rigid motions fold its soft tets over each other, and the volume restoration, which
+// linearises each tet's volume, cannot pull a tet far inside out back through zero. Each free
+// vertex near such tets is moved, one after another (Gauss-Seidel sweeps), to lower
+//
+//   sum over its tets of |S|^2 / (3 sigma(det S)^(2/3))  +  kappa * sum_c (r_c / a_c)^2,
+//
+// S = E D^-1 the tet's deformation gradient (E posed, D rest edges), sigma(d) = (d +
+// sqrt(d^2 + 4 delta^2)) / 2 the regularised determinant of Escobar et al.'s simultaneous
+// untangling and smoothing (Comput. Methods Appl. Mech. Engrg. 192, 2003): finite and smooth
+// through d = 0 and growing without bound as a tet turns inside out, so descent on it moves a
+// vertex back across the face it crossed. r_c are the residuals of the volumes the restoration
+// holds (each body part's, each tissue's), a_c their rest amounts: a vessel across the crease
+// keeps its volume while the crease opens, instead of being flattened into it.
+#pragma once
+
+#include "repose/mesh/TransferMesh.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <utility>
+#include <vector>
+
+namespace repose {
+
+namespace mesh_detail {
+// The signed volume of the tet with corners x[0..3], and its gradient in each corner (shared
+// with the restoration's rounds).
+double volumeOf(const std::array<Eigen::Vector3d, 4>& x);
+std::array<Eigen::Vector3d, 4> volumeGradients(const std::array<Eigen::Vector3d, 4>& x);
+}  // namespace mesh_detail
+
+// The volumes held while untangling: per tet, the constraints its volume enters and with what
+// weight (constraint change per mm^3 of the tet's volume change); per constraint its rest amount
+// and its residual at the positions given (the same sums as the restoration's).
+struct UntangleConstraints {
+  std::vector<int> offsets;                     // #tets + 1
+  std::vector<std::pair<int, double>> entries;  // (constraint, weight)
+  std::vector<double> amount;
+  Eigen::VectorXd residual;
+};
+
+struct UntangleOptions {
+  int sweeps = 60;      // at most; stops at a sweep with no tet inside out and none moved
+  double delta = 0.02;  // regularisation of det S (a rest tet has det S = 1)
+  // Weight of the held volumes' misfit (fractions squared). 1e7 let the armpit's untangling cost
+  // the body 0.05 % more under both arms raised 160 degrees (gap phantom, 2 mm); 1e8 keeps it
+  // within 0.03 % and still turns back 90 % of them (the frame of Quality.GapVariant2mm).
+  double kappa = 1e8;
+  int stepsPerVertex = 4;  // descent steps per vertex per sweep
+};
+
+struct UntangleReport {
+  int invertedBefore = 0, invertedAfter = 0;  // among the tets given
+  int sweeps = 0;
+};
+
+// Moves only `freeVertices`; counts and scores only `tets` (every tet with a free vertex must be
+// among them). `held.residual` is updated as vertices move.
+UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& freeVertices,
+                            const std::vector<int>& tets, UntangleConstraints& held,
+                            Eigen::MatrixX3d& deformed, const UntangleOptions& options = {});
+
+}  // namespace repose
