@@ -107,7 +107,7 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
 
   // f(p) for vertex v at p (the held residuals as they would be), and its gradient.
   std::vector<double> trial(held.amount.size());
-  const double delta = options.delta;
+  double delta = options.delta;  // lowered when the sweeps stall (see below)
   auto objective = [&](int v, const Eigen::Vector3d& p, Eigen::Vector3d* gradient) {
     double f = 0;
     if (gradient) gradient->setZero();
@@ -157,6 +157,7 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
     deformed.row(v) = p.transpose();
   };
 
+  int fewest = report.invertedBefore, stalled = 0;
   for (int sweep = 0; sweep < options.sweeps; ++sweep) {
     // The vertices of the tets inside out or nearly (det S < 0.1), and one ring around them.
     std::vector<char> near(std::size_t(nv), 0), candidate(std::size_t(nv), 0);
@@ -215,7 +216,14 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
     report.sweeps = sweep + 1;
     report.invertedAfter = countInverted();
     if (report.invertedAfter == 0 && moved < 1e-3) break;
-    if (moved < 1e-6) break;
+    // Sweeps that turn no more tets back: a sharper barrier (a smaller delta) pushes the tets
+    // still slightly inside out harder, as Escobar et al. lower delta as the mesh untangles.
+    if (report.invertedAfter < fewest) {
+      fewest = report.invertedAfter, stalled = 0;
+    } else if (++stalled >= options.stallSweeps || moved < 1e-6) {
+      if (delta <= options.smallestDelta) break;
+      delta = std::max(options.smallestDelta, delta / 4), stalled = 0;
+    }
   }
   return report;
 }

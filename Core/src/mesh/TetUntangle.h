@@ -44,11 +44,17 @@ struct UntangleConstraints {
 };
 
 struct UntangleOptions {
-  int sweeps = 60;      // at most; stops at a sweep with no tet inside out and none moved
-  double delta = 0.02;  // regularisation of det S (a rest tet has det S = 1)
+  int sweeps = 120;     // at most; stops at a sweep with no tet inside out and none moved
+  double delta = 0.02;  // regularisation of det S (a rest tet has det S = 1) to start with
+  // When `stallSweeps` sweeps in a row turn no more tets back, delta is divided by 4, down to
+  // `smallestDelta`; the sweeps stop when they stall at it.
+  // On the gap phantom at 2 mm (both arms up 160 degrees, sitting) going down to 0.00125 left 14
+  // and 1 tets inside out where staying at 0.02 left 48 and 6.
+  double smallestDelta = 0.00125;
+  int stallSweeps = 8;
   // Weight of the held volumes' misfit (fractions squared). 1e7 let the armpit's untangling cost
   // the body 0.05 % more under both arms raised 160 degrees (gap phantom, 2 mm); 1e8 keeps it
-  // within 0.03 % and still turns back 90 % of them (the frame of Quality.GapVariant2mm).
+  // within 0.03 % and still turns back most of them (that frame of Quality.GapVariant2mm).
   double kappa = 1e8;
   int stepsPerVertex = 4;  // descent steps per vertex per sweep
 };

@@ -57,7 +57,7 @@ struct VolumeRestorationOptions {
   double smoothness = 0.01;
   // Sweeps of the untangling (TetUntangle.h) over the free vertices when tets are left inside out
   // (a crease); 0: none.
-  int untangleRounds = 60;
+  int untangleRounds = 120;
 };
 
 struct VolumeRestorationReport {
