@@ -322,9 +322,13 @@ def test_output_spacing_and_out_of_core(tmp_path, phantom, elbow_rig):
     differ = np.argwhere(streamed != in_core)
     assert len(differ) <= 2e-4 * in_core.size
     bones = set(phantom_bones(g)) | {0}  # a bone, or outside the body
+    # Beside a bone in either frame: where a joint space's tets went soft (a bone end placed by its
+    # piece's motion, PieceGhosts), the stream may give a voxel to the bone that the in-core frame
+    # gives to the muscle beside it, or the other way round.
     for i, j, k in differ:
-        near = in_core[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]
-        assert bones & set(np.unique(near).tolist()), (i, j, k)
+        box = np.s_[max(i - 1, 0):i + 2, max(j - 1, 0):j + 2, max(k - 1, 0):k + 2]
+        near = set(np.unique(in_core[box]).tolist()) | set(np.unique(streamed[box]).tolist())
+        assert bones & near, (i, j, k)
 
 
 def test_label_volumes_preserved_or_sampled(phantom, elbow_rig):

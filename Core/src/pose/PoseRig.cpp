@@ -351,15 +351,6 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(
           }
       }
   }
-  // The tets the bends and blends turned inside out (a crease): their vertices are freed too, so
-  // the restoration's untangling (TetUntangle.h) reaches them.
-  for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
-    Eigen::Matrix3d E;
-    for (int c = 0; c < 3; ++c)
-      E.col(c) = (deformed.row(m.tets(t, c + 1)) - deformed.row(m.tets(t, 0))).transpose();
-    if (E.determinant() <= 0)
-      for (int k = 0; k < 4; ++k) zone[std::size_t(m.tets(t, k))] = 1;
-  }
   // One ring of tets around the bends: the tets that span the bend's reach.
   std::vector<char> grown = zone;
   for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
