@@ -49,7 +49,8 @@ struct UntangleOptions {
   // When `stallSweeps` sweeps in a row turn no more tets back, delta is divided by 4, down to
   // `smallestDelta`; the sweeps stop when they stall at it.
   // On the gap phantom at 2 mm (both arms up 160 degrees, sitting) going down to 0.00125 left 14
-  // and 1 tets inside out where staying at 0.02 left 48 and 6.
+  // and 1 tets inside out where staying at 0.02 left 48 and 6 (measured with a development build
+  // whose zone also held every inverted tet; the suite now leaves 18 and 1).
   double smallestDelta = 0.00125;
   int stallSweeps = 8;
   // Weight of the held volumes' misfit (fractions squared). Under both arms raised 160 degrees
