@@ -55,7 +55,8 @@ struct UntangleOptions {
   int stallSweeps = 8;
   // Weight of the held volumes' misfit (fractions squared). Under both arms raised 160 degrees
   // (gap phantom, 2 mm; 60 sweeps at delta 0.02) the body's change was -0.489 % with 1e7 and
-  // -0.462 % with 1e8 (-0.438 % without untangling): the weaker hold lets the fold take tissue.
+  // -0.462 % with 1e8 (-0.438 % without untangling; the same development build): the weaker hold
+  // lets the fold take tissue.
   double kappa = 1e8;
   int stepsPerVertex = 4;  // descent steps per vertex per sweep
 };
