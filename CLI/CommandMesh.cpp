@@ -90,6 +90,7 @@ int runMesh(const Args& args) {
                             {"tets_per_label", labels},
                             {"degenerate_tets_removed", report.degenerateTets},
                             {"inverted_tets_reoriented", report.invertedTets},
+                            {"short_edges_collapsed", report.collapsedEdges},
                             {"separation_vertices_added", added},
                             {"vertices_inside_cage", embedding.cageVertices.size()},
                             {"tets_inside_cage", embedding.cageTets.size()},

@@ -53,6 +53,7 @@ struct TransferMeshReport {
   int vertices = 0, tets = 0;
   int degenerateTets = 0;                         // |volume| below 1e-9 of the mean: removed
   int invertedTets = 0;                           // negative volume after meshing: reoriented
+  int collapsedEdges = 0;                         // edges merged by collapseShortEdges
   std::vector<std::pair<int, int>> tetsPerLabel;  // (label, count)
 };
 
@@ -66,6 +67,14 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
 // counts as inverted (report.invertedTets) the tets negative beyond the grid's mirroring
 // (frameSign -1 when IJK->RAS is mirrored, as for LPS grids). Fills the report's counts.
 void cleanTransferMesh(TransferMesh& mesh, double frameSign, TransferMeshReport& report);
+
+// Collapses the edges shorter than `minEdgeMm`, shortest first, each by moving one end onto the
+// other where the mesh stays a manifold (boundary included) and no tet around the moved end gets
+// flatter than `qualityFloor` (6 sqrt(2) V / l_max^3, 1 for a regular tet) or than the flattest
+// there before. Mesh_3 leaves balls of tets with edges of hundredths of a millimetre where three
+// labels meet; a pose turns them inside out (TetEdgeCollapse.cpp). Positively oriented tets in,
+// positively oriented tets out; returns the number of edges collapsed.
+int collapseShortEdges(TransferMesh& mesh, double minEdgeMm, double qualityFloor = 0.02);
 
 // Inside `region`, duplicates every vertex shared by a tet of label a and a tet of label b (on a
 // common face, as the seed says, but also along an edge or at a single vertex). Around each such
