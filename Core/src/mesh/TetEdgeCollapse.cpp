@@ -3,9 +3,9 @@
 //
 // Without protected features, Mesh_3's facet criteria cannot be met along a curve where several
 // label surfaces meet, and it refines there until it gives up: on thick slices (1.8 x 1.8 x 4.8
-// mm) balls of a few hundred tets with edges of 0.03 mm sat at each shoulder, each side of the
-// pelvis and each hand. A pose moves such a ball as a whole at the scale of millimetres, so its
-// tets turn inside out by hundreds of times their volume, and no untangling brings them back.
+// mm) balls of tets with edges of hundredths of a millimetre sat at each shoulder, each side of
+// the pelvis and each hand. A pose moves such a ball as a whole at the scale of millimetres, so
+// its tets turn far inside out, and the untangling did not bring them back.
 // They carry no voxel of their own. Each short edge (u, v) is collapsed by moving u onto v, when
 // that keeps the mesh a manifold (the link condition of Dey et al., with the boundary coned to a
 // vertex at infinity) and leaves no tet around u flatter than the flattest one there before (or

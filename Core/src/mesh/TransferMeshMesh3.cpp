@@ -215,8 +215,7 @@ TransferMesh buildTransferMesh(const Volume& parts, const TransferMeshOptions& o
   cleanTransferMesh(mesh, g.ijkToRas.block<3, 3>(0, 0).determinant() < 0 ? -1.0 : 1.0, r);
   if (mesh.tets.rows() == 0) throw Error("meshing produced only degenerate tetrahedra");
   // The balls of tiny tets where labels meet (TetEdgeCollapse.cpp): edges under half the finest
-  // voxel go. On the thick-slice phantom (1.8 x 1.8 x 4.8 mm) under arm_raise90 a quarter left 33
-  // tets inside out at the left shoulder, a half none (184 without).
+  // voxel go (docs/ARCHITECTURE.md, "The transfer mesh").
   const int collapsed = collapseShortEdges(mesh, 0.5 * frame.spacing.minCoeff());
   if (collapsed > 0) {
     const int inverted = r.invertedTets, degenerate = r.degenerateTets;
