@@ -10,6 +10,7 @@
 #include <cstdlib>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -77,6 +78,93 @@ namespace {
 // Seam half-width in voxels. Mesh_3 follows subdomain borders only to within a voxel, so a mesh
 // vertex can still land on both pieces' surfaces; demotePiecesAcrossJoints catches those.
 constexpr int kSeamVoxels = 1;
+
+// A soft vertex that caps a face of one part's piece and, across it, a face of another's (a joint
+// space one vertex thick: clavicle to first rib, humeral head to glenoid) is squeezed between two
+// rigid motions: its tets on those faces turn over as the faces meet, and it can only move
+// between them. One part's piece tets at the corners of its faces go soft, so the space gets a
+// second layer; its bone is still placed by PieceGhosts. A corner it frees capped no face of
+// the other part (that tet would have been pinned, and loosened before), so the layers do not
+// cascade through a thin bone, and a second call finds nothing
+// (PoseRig.EveryPieceMovesExactlyWithOneGroupInEveryFrame). `pieceAt` is, per vertex, the piece
+// volume of each part around it; the (vertex, part) pairs to loosen are appended to `loosen`.
+void loosenSqueezedVertices(const TransferMesh& mesh,
+                            const std::vector<std::map<int, double>>& pieceAt,
+                            std::vector<std::pair<int, int>>& loosen) {
+  // Per vertex, the piece tets at it; per part, how many piece tets it has.
+  std::vector<std::vector<int>> piecesAt(std::size_t(mesh.vertices.rows()));
+  std::map<int, int> pieceTets;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (!mesh.rigid[std::size_t(t)]) continue;
+    ++pieceTets[mesh.labels[t]];
+    for (int c = 0; c < 4; ++c) piecesAt[std::size_t(mesh.tets(t, c))].push_back(int(t));
+  }
+  // Per soft vertex, per part: the faces of that part's piece it caps.
+  std::vector<std::map<int, std::vector<std::array<int, 3>>>> capped(
+      std::size_t(mesh.vertices.rows()));
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    if (mesh.rigid[std::size_t(t)]) continue;
+    for (int apex = 0; apex < 4; ++apex) {
+      const int w = mesh.tets(t, apex);
+      if (!pieceAt[std::size_t(w)].empty()) continue;
+      std::array<int, 3> face{};
+      int n = 0;
+      for (int c = 0; c < 4; ++c)
+        if (c != apex) face[std::size_t(n++)] = mesh.tets(t, c);
+      for (const auto& [part, volume] : pieceAt[std::size_t(face[0])])
+        if (pieceAt[std::size_t(face[1])].count(part) && pieceAt[std::size_t(face[2])].count(part))
+          capped[std::size_t(w)][part].push_back(face);
+    }
+  }
+  // The unit normal of a face, turned towards the vertex that caps it.
+  const auto towards = [&](const std::array<int, 3>& f, int w) {
+    const Eigen::Vector3d a = mesh.vertices.row(f[0]).transpose();
+    Eigen::Vector3d n =
+        (mesh.vertices.row(f[1]).transpose() - a).cross(mesh.vertices.row(f[2]).transpose() - a);
+    if (n.dot(mesh.vertices.row(w).transpose() - a) < 0) n = -n;
+    return Eigen::Vector3d(n.normalized());
+  };
+  for (std::size_t w = 0; w < capped.size(); ++w) {
+    const auto& parts = capped[w];
+    if (parts.size() < 2) continue;
+    // Only faces that face a face of another part across the vertex squeeze it: their normals
+    // towards it point apart. A vertex at the rim of a joint may cap two bones' faces side by
+    // side and still move away from both. (Across the quality suites' folding frames, pairs more
+    // than 90 degrees apart left fewer tets inside out than pairs more than 120 apart.)
+    std::map<int, std::vector<std::array<int, 3>>> facing;
+    for (auto p = parts.begin(); p != parts.end(); ++p)
+      for (auto q = std::next(p); q != parts.end(); ++q)
+        for (const auto& fp : p->second)
+          for (const auto& fq : q->second)
+            if (towards(fp, int(w)).dot(towards(fq, int(w))) < 0) {
+              facing[p->first].push_back(fp);
+              facing[q->first].push_back(fq);
+            }
+    if (facing.size() < 2) continue;
+    // The part that would give up the largest share of its piece tets keeps them, so a thin
+    // bone (a humerus two tets thick on a coarse mesh) is spared and a large one gives.
+    int keep = -1;
+    double most = -1;
+    for (const auto& [part, faces] : facing) {
+      std::vector<int> corners;
+      for (const auto& f : faces) corners.insert(corners.end(), f.begin(), f.end());
+      std::sort(corners.begin(), corners.end());
+      corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+      std::vector<int> lost;
+      for (const int corner : corners)
+        for (const int t : piecesAt[std::size_t(corner)])
+          if (mesh.labels[t] == part) lost.push_back(t);
+      std::sort(lost.begin(), lost.end());
+      const double share =
+          double(std::unique(lost.begin(), lost.end()) - lost.begin()) / pieceTets[part];
+      if (share > most) most = share, keep = part;
+    }
+    for (const auto& [part, faces] : facing)
+      if (part != keep)
+        for (const auto& f : faces)
+          for (const int corner : f) loosen.emplace_back(corner, part);
+  }
+}
 }  // namespace
 
 int demotePiecesAcrossJoints(TransferMesh& mesh) {
@@ -115,7 +203,7 @@ int demotePiecesAcrossJoints(TransferMesh& mesh) {
   // can do. The part with more piece volume at its vertices keeps them; the other part's piece
   // tets at them go soft, so the joint space has a free layer that bends (their bone is still
   // placed by the piece's own motion: PieceGhosts.h).
-  for (int pass = 0; pass < 4; ++pass) {
+  for (int pass = 0; pass < 8; ++pass) {
     std::vector<std::map<int, double>> pieceAt(std::size_t(mesh.vertices.rows()));
     for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
       if (!mesh.rigid[std::size_t(t)]) continue;
@@ -141,6 +229,7 @@ int demotePiecesAcrossJoints(TransferMesh& mesh) {
         for (const auto& [part, volume] : pieceAt[std::size_t(mesh.tets(t, c))])
           if (part != keep) loosen.emplace_back(mesh.tets(t, c), part);
     }
+    loosenSqueezedVertices(mesh, pieceAt, loosen);
     if (loosen.empty()) break;
     std::sort(loosen.begin(), loosen.end());
     loosen.erase(std::unique(loosen.begin(), loosen.end()), loosen.end());

@@ -88,7 +88,10 @@ Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSetting
 // Where pieces of two body parts share a vertex (a bone end meshed onto its neighbour across a
 // joint, closer than the seam), the part with more piece volume around the vertex keeps it and
 // the other parts' piece tets at it become soft tissue, so that pieces of different parts never
-// share a vertex and each moves exactly with its group. Returns how many tets went soft.
+// share a vertex and each moves exactly with its group. A joint space thinner than a tet gets a
+// free layer: a soft tet with all four vertices on two parts' pieces, or a soft vertex pressed
+// between facing faces of two parts' pieces, makes one part's piece tets at those vertices soft.
+// Idempotent: a second call returns 0. Returns how many tets went soft.
 int demotePiecesAcrossJoints(TransferMesh& mesh);
 
 // Cage and transfer mesh of S, separated where asked; with G (organs, on S's grid) the mesh has

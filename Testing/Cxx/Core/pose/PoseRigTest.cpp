@@ -296,6 +296,45 @@ TEST(PoseRig, ASoftTetPinnedBetweenPiecesOfTwoPartsGetsAFreeVertex) {
   EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
 }
 
+TEST(PoseRig, ASoftVertexSqueezedBetweenPiecesOfTwoPartsGetsASecondFreeLayer) {
+  // A joint space one vertex thick (clavicle to first rib): soft vertex 8 caps a face of part 1's
+  // piece and, across it, a face of part 2's. When the two faces meet it cannot get out of the
+  // way, and both tets turn over. Part 1 has a second piece tet away from the joint, so it gives
+  // up the smaller share of its piece: its tet at the face's corners goes soft. Once, not layer
+  // after layer: a second call finds nothing.
+  TransferMesh mesh;
+  mesh.vertices.resize(12, 3);
+  mesh.vertices << 0, 0, 0, 10, 0, 0, 0, 10, 0, 0, 0, 10,  // part 1's piece at the joint
+      6, 6, 8, 8, 6, 6, 6, 8, 6, 9, 9, 9,                  // part 2's piece
+      5, 5, 5,                                             // the soft vertex between them
+      -10, 0, 0, 0, -10, 0, 0, 0, -10;                     // part 1's piece away from it
+  mesh.tets.resize(5, 4);
+  mesh.tets << 0, 1, 2, 3, 4, 5, 6, 7, 1, 2, 3, 8, 4, 5, 6, 8, 0, 9, 10, 11;
+  mesh.labels.resize(5);
+  mesh.labels << 1, 2, 1, 2, 1;
+  mesh.rigid = {11, 14, 0, 0, 11};
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 1);
+  EXPECT_EQ(mesh.rigid, (std::vector<int>{0, 14, 0, 0, 11}));
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
+}
+
+TEST(PoseRig, ASoftVertexAboveTwoPiecesSideBySideIsNotSqueezed) {
+  // Vertex 8 caps a face of each part's piece, but the faces lie side by side below it (the rim
+  // of a joint): it can move away from both, so no piece gives up a tet.
+  TransferMesh mesh;
+  mesh.vertices.resize(9, 3);
+  mesh.vertices << 0, 0, 0, 10, 0, 0, 0, 10, 0, 3, 3, -5,  // part 1's piece
+      20, 0, 0, 30, 0, 0, 20, 10, 0, 23, 3, -5,            // part 2's piece
+      15, 3, 5;                                            // the soft vertex above both
+  mesh.tets.resize(4, 4);
+  mesh.tets << 0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 8, 4, 5, 6, 8;
+  mesh.labels.resize(4);
+  mesh.labels << 1, 2, 1, 2;
+  mesh.rigid = {11, 14, 0, 0};
+  EXPECT_EQ(demotePiecesAcrossJoints(mesh), 0);
+  EXPECT_EQ(mesh.rigid, (std::vector<int>{11, 14, 0, 0}));
+}
+
 // A drag whose cage has free vertices (the left upper arm is in no group, so ARAP bends it between
 // the fixed body and the turning forearm), one degree per event: each live frame takes at most
 // kLiveCageIterations ARAP iterations from the last one and stays within a tenth of a millimetre
