@@ -61,6 +61,12 @@ std::vector<PointAnchor> anchorPoints(const TransferMesh& mesh, const Eigen::Mat
   return anchors;
 }
 
+PointAnchor anchorPointInTet(const TransferMesh& mesh, const Eigen::Vector3d& point, int tet) {
+  Eigen::Vector4d w;
+  if (tet < 0 || tet >= mesh.tets.rows() || !barycentric(mesh, tet, point, w)) return {};
+  return {tet, w, w.minCoeff() >= -1e-9};
+}
+
 Eigen::MatrixX3d movePoints(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,
                             const std::vector<PointAnchor>& anchors, const Eigen::MatrixX3d& rest) {
   Eigen::MatrixX3d out = rest;

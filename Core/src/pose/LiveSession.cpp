@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace repose {
 
@@ -71,8 +72,36 @@ LiveSession::LiveSession(const PoseJob& job, RigGeometry geometry, LiveInputs in
     for (std::size_t j = 0; j < joints.size(); ++j)
       jointCentres_.row(Eigen::Index(j)) = joints[j].centre.transpose();
     jointAnchors_ = anchorPoints(rig_->mesh(), jointCentres_);
+    anchorJointsInProximalBones(joints);
   }
   reportProgress(progress, 1, "embedding");
+}
+
+void LiveSession::anchorJointsInProximalBones(const std::vector<SkeletonJoint>& joints) {
+  // A joint's centre is a point of its proximal bone: anchored to the nearest piece tet of its
+  // proximal part, it moves with that bone exactly. The tet that holds it is a soft tet of the
+  // joint space, which bends with the joint (since joint spaces get free layers, the elbow's
+  // sphere drifted 4 mm off the unmoved humerus at a 90 degree bend). A part with no piece keeps
+  // the holding tet.
+  const TransferMesh& mesh = rig_->mesh();
+  if (mesh.rigid.empty()) return;
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    int part = 0;
+    for (const Label& l : inputs_.partLabels.labels())
+      if (!joints[j].parts[0].empty() && l.name == joints[j].parts[0]) part = l.value;
+    if (part == 0) continue;
+    int nearest = -1;
+    double best = std::numeric_limits<double>::infinity();
+    for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+      if (!mesh.rigid[std::size_t(t)] || mesh.labels[t] != part) continue;
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) c += mesh.vertices.row(mesh.tets(t, k)).transpose() / 4;
+      const double d = (c - joints[j].centre).squaredNorm();
+      if (d < best) best = d, nearest = int(t);
+    }
+    const PointAnchor anchor = anchorPointInTet(mesh, joints[j].centre, nearest);
+    if (anchor.tet >= 0) jointAnchors_[j] = anchor;
+  }
 }
 
 LiveSession::~LiveSession() = default;

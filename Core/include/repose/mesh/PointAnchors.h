@@ -26,6 +26,12 @@ struct PointAnchor {
 // the tets' boxes for points inside the mesh.
 std::vector<PointAnchor> anchorPoints(const TransferMesh& mesh, const Eigen::MatrixX3d& points);
 
+// `point` anchored to tet `tet`, its weights extrapolated when it lies outside. An affine map
+// carries extrapolated weights exactly, so a point fixed in a rigid piece (a joint's centre in
+// its proximal bone) anchored to one of the piece's tets follows the piece's motion exactly.
+// An anchor with no tet (-1) for a degenerate rest tet.
+PointAnchor anchorPointInTet(const TransferMesh& mesh, const Eigen::Vector3d& point, int tet);
+
 // Where the anchored points are in a frame (`deformed`: the posed TM vertices, one row per rest
 // vertex). Anchors with no tet keep their rest position `rest` (same rows as the anchors).
 Eigen::MatrixX3d movePoints(const TransferMesh& mesh, const Eigen::MatrixX3d& deformed,

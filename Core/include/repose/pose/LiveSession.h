@@ -121,6 +121,8 @@ class LiveSession {
   int restLabelAt(const Eigen::Vector3d& ras) const;
 
  private:
+  void anchorJointsInProximalBones(const std::vector<SkeletonJoint>& joints);
+
   LiveInputs inputs_;
   std::shared_ptr<const Volume> parts_;
   std::unique_ptr<PoseRig> rig_;

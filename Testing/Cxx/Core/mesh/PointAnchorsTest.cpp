@@ -79,3 +79,33 @@ TEST(PointAnchors, PointsOutsideAreExtrapolatedFromTheNearestTetAndAMeshWithoutT
   EXPECT_EQ(none[0].tet, -1);
   EXPECT_TRUE(movePoints(empty, empty.vertices, none, points).isApprox(points));
 }
+
+TEST(PointAnchors, APointAnchoredToAChosenTetFollowsThatTetsRigidMotionExactly) {
+  // A joint's centre anchored to a piece tet of its proximal bone (LiveSession): the tets of one
+  // half turn rigidly, the other half stays, and the point, outside its chosen tet, follows the
+  // chosen tet's motion and not that of the tet around it.
+  const TransferMesh mesh = test::tetBox({0, 0, 0}, {20, 10, 10}, {2, 1, 1});
+  const Eigen::Vector3d point(10, 5, 5);  // on the two halves' border
+  int chosen = -1;
+  for (Eigen::Index t = 0; t < mesh.tets.rows() && chosen < 0; ++t) {
+    bool left = true;
+    for (int k = 0; k < 4; ++k) left = left && mesh.vertices(mesh.tets(t, k), 0) <= 10;
+    if (left) chosen = int(t);
+  }
+  ASSERT_GE(chosen, 0);
+  const PointAnchor anchor = anchorPointInTet(mesh, point, chosen);
+  ASSERT_EQ(anchor.tet, chosen);
+  EXPECT_NEAR(anchor.weights.sum(), 1, 1e-12);
+  // The left half (x <= 10) turns 40 degrees about an axis through (3, 2, 1); the rest stays.
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -1, 2).normalized()).toRotationMatrix();
+  const Eigen::Vector3d pivot(3, 2, 1);
+  Eigen::MatrixX3d deformed = mesh.vertices;
+  for (Eigen::Index v = 0; v < deformed.rows(); ++v)
+    if (mesh.vertices(v, 0) <= 10)
+      deformed.row(v) = (R * (mesh.vertices.row(v).transpose() - pivot) + pivot).transpose();
+  const Eigen::MatrixX3d moved = movePoints(mesh, deformed, {anchor}, point.transpose());
+  EXPECT_LT((moved.row(0).transpose() - (R * (point - pivot) + pivot)).norm(), 1e-9);
+  EXPECT_EQ(anchorPointInTet(mesh, point, -1).tet, -1);
+  EXPECT_EQ(anchorPointInTet(mesh, point, int(mesh.tets.rows())).tet, -1);
+}
