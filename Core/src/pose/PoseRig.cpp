@@ -92,12 +92,12 @@ void loosenSqueezedVertices(const TransferMesh& mesh,
                             const std::vector<std::map<int, double>>& pieceAt,
                             std::vector<std::pair<int, int>>& loosen) {
   // Per vertex, the piece tets at it; per part, how many piece tets it has.
-  std::vector<std::vector<int>> piecesAt(std::size_t(mesh.vertices.rows()));
+  std::vector<std::vector<int>> pieceTetsAt(std::size_t(mesh.vertices.rows()));
   std::map<int, int> pieceTets;
   for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
     if (!mesh.rigid[std::size_t(t)]) continue;
     ++pieceTets[mesh.labels[t]];
-    for (int c = 0; c < 4; ++c) piecesAt[std::size_t(mesh.tets(t, c))].push_back(int(t));
+    for (int c = 0; c < 4; ++c) pieceTetsAt[std::size_t(mesh.tets(t, c))].push_back(int(t));
   }
   // Per soft vertex, per part: the faces of that part's piece it caps.
   std::vector<std::map<int, std::vector<std::array<int, 3>>>> capped(
@@ -129,8 +129,7 @@ void loosenSqueezedVertices(const TransferMesh& mesh,
     if (parts.size() < 2) continue;
     // Only faces that face a face of another part across the vertex squeeze it: their normals
     // towards it point apart. A vertex at the rim of a joint may cap two bones' faces side by
-    // side and still move away from both. (Across the quality suites' folding frames, pairs more
-    // than 90 degrees apart left fewer tets inside out than pairs more than 120 apart.)
+    // side and still move away from both.
     std::map<int, std::vector<std::array<int, 3>>> facing;
     for (auto p = parts.begin(); p != parts.end(); ++p)
       for (auto q = std::next(p); q != parts.end(); ++q)
@@ -152,7 +151,7 @@ void loosenSqueezedVertices(const TransferMesh& mesh,
       corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
       std::vector<int> lost;
       for (const int corner : corners)
-        for (const int t : piecesAt[std::size_t(corner)])
+        for (const int t : pieceTetsAt[std::size_t(corner)])
           if (mesh.labels[t] == part) lost.push_back(t);
       std::sort(lost.begin(), lost.end());
       const double share =

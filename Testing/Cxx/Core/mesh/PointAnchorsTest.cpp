@@ -82,8 +82,8 @@ TEST(PointAnchors, PointsOutsideAreExtrapolatedFromTheNearestTetAndAMeshWithoutT
 
 TEST(PointAnchors, APointAnchoredToAChosenTetFollowsThatTetsRigidMotionExactly) {
   // A joint's centre anchored to a piece tet of its proximal bone (LiveSession): the tets of one
-  // half turn rigidly, the other half stays, and the point, outside its chosen tet, follows the
-  // chosen tet's motion and not that of the tet around it.
+  // half turn rigidly, the other half stays, and the point, on the border of its chosen tet or
+  // outside it, follows the chosen tet's motion and not that of the tet around it.
   const TransferMesh mesh = test::tetBox({0, 0, 0}, {20, 10, 10}, {2, 1, 1});
   const Eigen::Vector3d point(10, 5, 5);  // on the two halves' border
   int chosen = -1;
