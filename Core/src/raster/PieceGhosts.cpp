@@ -10,35 +10,48 @@
 namespace repose::raster {
 
 std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& pieceLabels,
-                                    const std::vector<int>& pieceOf, int rings) {
+                                    const std::vector<int>& pieceOf, const Volume* restParts,
+                                    int rings) {
   std::vector<PieceGhost> out;
   const Eigen::Index nt = mesh.tets.rows(), nv = mesh.vertices.rows();
   if (mesh.rigid.size() != std::size_t(nt) || nt == 0) return out;
+  if (restParts && restParts->dims() != pieceLabels.dims()) restParts = nullptr;
   const Eigen::Matrix4d toIjk = pieceLabels.geometry().ijkToRas.inverse();
   const auto d = pieceLabels.dims();
-  auto pieceAt = [&](const Eigen::Vector3d& ras) {
+  // A piece's tissue where it is held: (piece, body part of its voxels).
+  using Held = std::pair<int, int>;
+  auto heldAt = [&](const Eigen::Vector3d& ras, int ownPart) -> Held {
     const Eigen::Vector3d p = toIjk.block<3, 3>(0, 0) * ras + toIjk.block<3, 1>(0, 3);
     std::int64_t x[3];
     for (int c = 0; c < 3; ++c) {
       x[c] = std::int64_t(std::floor(p[c] + 0.5));
-      if (x[c] < 0 || x[c] >= d[c]) return 0;
+      if (x[c] < 0 || x[c] >= d[c]) return {0, 0};
     }
-    const double v = pieceLabels.valueAsDouble(pieceLabels.index(x[0], x[1], x[2]));
-    return v > 0 && v < double(pieceOf.size()) ? pieceOf[std::size_t(v)] : 0;
+    const std::int64_t at = pieceLabels.index(x[0], x[1], x[2]);
+    const double v = pieceLabels.valueAsDouble(at);
+    const int piece = v > 0 && v < double(pieceOf.size()) ? pieceOf[std::size_t(v)] : 0;
+    if (!piece) return {0, 0};
+    return {piece, restParts ? int(restParts->valueAsDouble(at)) : ownPart};
   };
   // Per soft tet, the pieces its rest volume holds (usually none or one).
-  std::vector<std::vector<int>> holds(static_cast<std::size_t>(nt));
+  std::vector<std::vector<Held>> holds(static_cast<std::size_t>(nt));
   bool any = false;
   for (Eigen::Index t = 0; t < nt; ++t) {
     if (mesh.rigid[std::size_t(t)]) continue;
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) c += mesh.vertices.row(mesh.tets(t, k)).transpose();
+    Eigen::Vector3d x[4], c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += (x[k] = mesh.vertices.row(mesh.tets(t, k)).transpose());
     c /= 4;
-    std::set<int> found;
-    if (const int p = pieceAt(c)) found.insert(p);
-    for (int k = 0; k < 4; ++k)
-      if (const int p = pieceAt(0.5 * (c + mesh.vertices.row(mesh.tets(t, k)).transpose())))
-        found.insert(p);
+    std::set<Held> found;
+    auto sample = [&](const Eigen::Vector3d& ras) {
+      const Held h = heldAt(ras, mesh.labels[t]);
+      if (h.first) found.insert(h);
+    };
+    sample(c);
+    for (int k = 0; k < 4; ++k) {
+      sample(0.5 * (c + x[k]));
+      const Eigen::Vector3d face = (4 * c - x[k]) / 3;  // the centre of the face opposite k
+      sample(face + 0.25 * (c - face));
+    }
     holds[std::size_t(t)].assign(found.begin(), found.end());
     any = any || !found.empty();
   }
@@ -55,49 +68,50 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
       for (int k = 0; k < 4; ++k)
         around[std::size_t(fill[std::size_t(mesh.tets(t, k))]++)] = std::int32_t(t);
   }
-  // Hosts spread from the piece's own tets through the soft tets holding it, ring by ring, within
-  // one body part: a demoted bone end can be a layer of tets deep.
-  std::vector<std::map<int, std::int32_t>> host(static_cast<std::size_t>(nt));
-  for (Eigen::Index t = 0; t < nt; ++t)
-    if (const int p = mesh.rigid[std::size_t(t)]) host[std::size_t(t)][p] = std::int32_t(t);
-  for (int ring = 0; ring < rings; ++ring) {
-    std::vector<std::pair<std::int32_t, std::pair<int, std::int32_t>>> found;
-    for (Eigen::Index t = 0; t < nt; ++t)
-      for (const int p : holds[std::size_t(t)]) {
-        if (host[std::size_t(t)].count(p)) continue;
-        std::int32_t h = -1;
-        for (int k = 0; k < 4 && h < 0; ++k) {
-          const std::size_t v = std::size_t(mesh.tets(t, k));
-          for (std::int64_t a = start[v]; a < start[v + 1] && h < 0; ++a) {
-            const std::int32_t u = around[std::size_t(a)];
-            if (mesh.labels[u] != mesh.labels[t]) continue;
-            const auto it = host[std::size_t(u)].find(p);
-            if (it != host[std::size_t(u)].end()) h = it->second;
-          }
-        }
-        if (h >= 0) found.push_back({std::int32_t(t), {p, h}});
-      }
-    if (found.empty()) break;
-    for (const auto& [t, ph] : found) host[std::size_t(t)].insert(ph);
-  }
-  // A soft tet holding a piece that no piece tet reaches within the rings (a rib one voxel thick
-  // on 8 mm slices, which Mesh_3 gives a handful of tets of its own) takes any tet of that piece
-  // in its body part as host: a piece moves whole with one group, so every one of its tets has
-  // the same rigid map. Without, such a bone bent with the soft tissue around it (the ribs'
-  // Dice 0.65 under arms raised 160 degrees on the ICRP adult male's grid).
-  std::map<std::pair<int, int>, std::int32_t> anyTetOf;  // (body part, piece) -> a tet of it
+  // Hosts spread from the piece's own tets through the soft tets holding it, ring by ring: a
+  // demoted bone end can be a layer of tets deep. A piece of one body part hosts only its own
+  // part's voxels (a bone label of both sides is two pieces moving apart).
+  std::vector<std::map<Held, std::int32_t>> host(static_cast<std::size_t>(nt));
   for (Eigen::Index t = 0; t < nt; ++t)
     if (const int p = mesh.rigid[std::size_t(t)])
-      anyTetOf.try_emplace({mesh.labels[t], p}, std::int32_t(t));
+      host[std::size_t(t)][{p, mesh.labels[t]}] = std::int32_t(t);
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<std::pair<std::int32_t, std::pair<Held, std::int32_t>>> found;
+    for (Eigen::Index t = 0; t < nt; ++t)
+      for (const Held& h : holds[std::size_t(t)]) {
+        if (host[std::size_t(t)].count(h)) continue;
+        std::int32_t by = -1;
+        for (int k = 0; k < 4 && by < 0; ++k) {
+          const std::size_t v = std::size_t(mesh.tets(t, k));
+          for (std::int64_t a = start[v]; a < start[v + 1] && by < 0; ++a) {
+            const auto it = host[std::size_t(around[std::size_t(a)])].find(h);
+            if (it != host[std::size_t(around[std::size_t(a)])].end()) by = it->second;
+          }
+        }
+        if (by >= 0) found.push_back({std::int32_t(t), {h, by}});
+      }
+    if (found.empty()) break;
+    for (const auto& [t, hb] : found) host[std::size_t(t)].insert(hb);
+  }
+  // A soft tet holding a piece that no piece tet reaches within the rings (a rib one voxel thick
+  // on 8 mm slices, which Mesh_3 gives a handful of tets of its own; a pelvis in the torso's
+  // tets) takes any tet of that piece in its body part as host: a piece moves whole with one
+  // group, so every one of its tets has the same rigid map. Without, such a bone bent with the
+  // soft tissue around it (the ribs' Dice 0.65 under arms raised 160 degrees on the ICRP adult
+  // male's grid).
+  std::map<Held, std::int32_t> anyTetOf;  // (piece, body part) -> a tet of it
   for (Eigen::Index t = 0; t < nt; ++t)
-    for (const int p : holds[std::size_t(t)])
-      if (!host[std::size_t(t)].count(p)) {
-        const auto it = anyTetOf.find({mesh.labels[t], p});
-        if (it != anyTetOf.end()) host[std::size_t(t)][p] = it->second;
+    if (const int p = mesh.rigid[std::size_t(t)])
+      anyTetOf.try_emplace({p, mesh.labels[t]}, std::int32_t(t));
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (const Held& h : holds[std::size_t(t)])
+      if (!host[std::size_t(t)].count(h)) {
+        const auto it = anyTetOf.find(h);
+        if (it != anyTetOf.end()) host[std::size_t(t)][h] = it->second;
       }
   for (Eigen::Index t = 0; t < nt; ++t)
     if (!mesh.rigid[std::size_t(t)])
-      for (const auto& [p, h] : host[std::size_t(t)]) out.push_back({std::int32_t(t), h});
+      for (const auto& [h, by] : host[std::size_t(t)]) out.push_back({std::int32_t(t), by});
   return out;
 }
 

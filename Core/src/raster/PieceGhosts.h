@@ -9,6 +9,13 @@
 // the pelvis 1 % beside a bent hip). A ghost is such a soft tet placed by a neighbouring piece
 // tet's rigid map: scanned like a rim, it writes the voxels whose rest label is that body part's
 // bone where the bone itself puts them.
+//
+// The soft tet may belong to another body part than the bone's. On thick slices Mesh_3 draws the
+// parts' borders a slice or more off S's: on the ICRP adult male's grid half of the pelvis's
+// voxels lie in the torso's tets. Those voxels had moved with the torso's soft tissue: sitting
+// tilted the pelvis 25 degrees against it and 327 pelvis voxels landed off the pelvis (+1.27 %
+// beyond its resampling floor). A ghost is therefore keyed by the piece and the body part S gives
+// the piece's voxels, not by the soft tet's part.
 #pragma once
 
 #include "TetScan.h"
@@ -25,13 +32,16 @@ struct PieceGhost {
   std::int32_t host = -1;  // a tet of that piece (same body part) whose map places it
 };
 
-// The soft tets whose rest volume holds a label of a piece (sampled at the centroid and half way
-// to each vertex, on `pieceLabels`, the label map on the input's grid) and a tet of that piece in
-// the same body part within `rings` vertex-sharing steps through such tets, else any tet of that
-// piece in that body part (a piece moves whole: one rigid map). `pieceOf[label]`: the
-// piece id the label is meshed in (0: none). `input`: the grid of `pieceLabels`.
+// The soft tets whose rest volume holds a label of a piece (sampled at the centroid, half way to
+// each vertex and at each face's centre drawn a quarter of the way in, on `pieceLabels`, the
+// label map on the input's grid), each with a tet of that piece in the body part `restParts`
+// gives the sample (the soft tet's own part without it): within `rings` vertex-sharing steps
+// through soft tets of that part holding it, else any tet of that piece in that part (a piece
+// moves whole: one rigid map). `pieceOf[label]`: the piece id the label is meshed in (0: none).
+// `restParts`, when given, is on `pieceLabels`' grid.
 std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& pieceLabels,
-                                    const std::vector<int>& pieceOf, int rings = 3);
+                                    const std::vector<int>& pieceOf,
+                                    const Volume* restParts = nullptr, int rings = 3);
 
 // The ghosts as a mesh of their own: per ghost four vertices, its soft tet's rest positions
 // (input IJK, from `in`) and their images under the host tet's map (output IJK). `tets` receives

@@ -752,6 +752,26 @@ TEST(Rasterizer, ABoneEndInSoftTetsMovesWithTheBone) {
   EXPECT_GT(withPieces, 0.995) << "without the pieces' map: " << without;
 }
 
+// A bone whose end lies in another body part's soft tets (on thick slices Mesh_3 draws the parts'
+// borders a slice or more off S's: on the ICRP adult male's grid half of the pelvis lay in the
+// torso's tets) moves with its own piece there, not with that part's soft tissue: sitting had
+// tilted the pelvis 25 degrees against the torso and moved 327 of its voxels off it.
+TEST(Rasterizer, ABoneEndInAnotherPartsTetsMovesWithTheBone) {
+  BoneEnd b = boneEndInSoftTets();
+  // The bone's end beyond x = 14 is S's part 1 like the rest of it, but its tets are part 2's.
+  for (Eigen::Index t = 0; t < b.mesh.tets.rows(); ++t)
+    if (!b.mesh.rigid[std::size_t(t)]) b.mesh.labels[t] = 2;
+  const auto [withPieces, without] = boneDice(b.G, b.S, b.mesh, b.deformed, b.grid, b.motion, 5);
+  EXPECT_LT(without, 0.95);
+  EXPECT_GT(withPieces, 0.995) << "without the pieces' map: " << without;
+  // A bone of part 2 by S is not the part-1 piece's: nothing hosts it, and it stays with the soft
+  // tissue that holds it.
+  Volume S2 = b.S;
+  for (std::int64_t v = 0; v < S2.numVoxels(); ++v)
+    if (S2.data<std::uint8_t>()[v]) S2.data<std::uint8_t>()[v] = 2;
+  EXPECT_LT(boneDice(b.G, S2, b.mesh, b.deformed, b.grid, b.motion, 5).first, 0.95);
+}
+
 // A bone with only a few tets of its own (a rib one voxel thick on 8 mm slices: Mesh_3 gave the
 // ICRP grid's ribs 4 tets) lies mostly in soft tets, many rings away from them. It moves with its
 // piece all the same, where the soft tissue around it is sheared: under both arms raised 160
