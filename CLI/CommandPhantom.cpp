@@ -76,6 +76,11 @@ int runPhantom(const Args& args) {
               "with --arms-resting, the near contacts of real reference phantoms: each hand HAND "
               "mm off its thigh (a voxel or three) and each forearm FOREARM mm off the trunk and "
               "hip (default 15); the gaps stay air")
+      .option("vessel-mm", "D",
+              "with --arms-resting, every limb vessel D mm across (about a voxel on a reference "
+              "phantom's grid) instead of its anatomical 4-10 mm; they cross the axilla, the "
+              "elbow, the groin and the knee",
+              "0")
       .option("labels", "NAME",
               "phantom (its own labels, named in the file) or icrp110 (ICRP 110 organ IDs on "
               "ICRP's array order, no label table: a converted reference phantom)",
@@ -112,6 +117,12 @@ int runPhantom(const Args& args) {
     options.handGapMm = hand;
     options.forearmGapMm = forearm;
   }
+  options.limbVesselMm = parser.getDouble("vessel-mm");
+  if (!std::isfinite(options.limbVesselMm) || options.limbVesselMm < 0 || options.limbVesselMm > 20)
+    throw UsageError{"--vessel-mm expects a diameter of 0 to 20 mm, not " +
+                     parser.get("vessel-mm")};
+  if (options.limbVesselMm > 0 && !options.armsResting)
+    throw UsageError{"--vessel-mm needs --arms-resting"};
   if (parser.has("spacing")) {
     const std::string text = parser.get("spacing");
     double v[3];
@@ -189,6 +200,7 @@ int runPhantom(const Args& args) {
         {"armsResting", options.armsResting},
         {"handGapMm", options.handGapMm},
         {"forearmGapMm", options.forearmGapMm},
+        {"limbVesselMm", options.limbVesselMm},
         {"labels", labels},
         {"originRas", {o.x(), o.y(), o.z()}},
         {"numVoxels", g.numVoxels()},

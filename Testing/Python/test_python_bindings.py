@@ -137,6 +137,18 @@ def test_a_dicom_seg_reads_with_its_segments_and_its_grid_said_as_a_warning(tmp_
     assert [(l["name"], l["layer"]) for l in back.labels] == [(l["name"], l["layer"]) for l in v.labels]
 
 
+def test_the_phantom_s_limb_vessels_take_the_diameter_asked():
+    # vessel_mm reaches the phantom (repose phantom --vessel-mm): 12 mm vessels hold more voxels
+    # than the anatomical ones at 4 mm, and the option belongs to the arms-resting posture.
+    def vessel_voxels(**kw):
+        g = rp.make_phantom(4.0, arms_resting=True, **kw)["organs"]
+        values = [l["value"] for l in g.labels if "vessels" in l["name"] and l["layer"] == 0]
+        return int(np.isin(np.asarray(g.array), values).sum())
+    assert vessel_voxels(vessel_mm=12.0) > vessel_voxels()
+    with pytest.raises(Exception, match="arms-resting"):
+        rp.make_phantom(4.0, vessel_mm=3.0)
+
+
 def test_a_frame_posed_in_python_equals_the_command_lines(tmp_path, repose):
     # 4 mm, not the module's 8 mm phantom: the coarsest whose bones reach the report's
     # 1000-voxel floor, so "all met" includes bones whose rigidity was actually measured.

@@ -160,6 +160,11 @@ Phantom::Phantom(const PhantomOptions& options) : impl_(std::make_unique<Impl>()
       throw Error("phantom: a gap must be 0 to 100 mm, not " + std::to_string(gap));
   if ((options.handGapMm > 0 || options.forearmGapMm > 0) && !options.armsResting)
     throw Error("phantom: the hands' and forearms' gaps are those of the arms-resting posture");
+  if (!std::isfinite(options.limbVesselMm) || options.limbVesselMm < 0 || options.limbVesselMm > 20)
+    throw Error("phantom: the limb vessels' diameter must be 0 to 20 mm, not " +
+                std::to_string(options.limbVesselMm));
+  if (options.limbVesselMm > 0 && !options.armsResting)
+    throw Error("phantom: the limb vessels are those of the arms-resting posture");
   if (!std::isfinite(options.marginMm) || options.marginMm < 0)
     throw Error("phantom: the margin must be zero or more mm");
   if (options.threads < 0) throw Error("phantom: the thread count cannot be negative");
@@ -311,6 +316,7 @@ std::string Phantom::skeletonJson() const {
                          {"armsResting", o.armsResting},
                          {"handGapMm", o.handGapMm},
                          {"forearmGapMm", o.forearmGapMm},
+                         {"limbVesselMm", o.limbVesselMm},
                          {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
                          {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
   return skeletonToJson(skeleton(), made.dump());

@@ -69,6 +69,7 @@ constexpr double kHandThin = 0.5;  // the hand's thickness over its width
 struct Builder {
   BodyModel m;
   bool detailed = false;
+  double limbVesselR = 0;                // PhantomOptions::limbVesselMm / 2 (0: anatomical radii)
   std::vector<RoundCone> trunk, thighs;  // what a resting arm lies against
 
   void segment(std::uint8_t part, const RoundCone& c) {
@@ -428,13 +429,14 @@ void addVessels(Builder& b, const SideJoints& j) {
     };
     const V med = across(uu, P(V(-1, 0, 0))), ant = across(uu, V::UnitY());
     const V medF = across(uf, P(V(-1, 0, 0))), antF = across(uf, V::UnitY());
+    auto r = [&](double anatomical) { return b.limbVesselR > 0 ? b.limbVesselR : anatomical; };
     b.vessel({P({6, 6, 985}), P({70, 2, 1000}), s + 35 * uu + 16 * med + 6 * ant,
               e - 60 * uu + 15 * med + 10 * ant, e + 16 * ant + 4 * med},
-             4, 2.5);
+             r(4), r(2.5));
     for (const double to : {1.0, -1.0})  // ulnar (medial) and radial (lateral)
       b.vessel({e + 16 * ant + 4 * med, e + 40 * uf + 14 * antF + to * 9 * medF,
                 w - 25 * uf + 12 * antF + to * 11 * medF},
-               2.2, 2);
+               r(2.2), r(2));
     const V h = P(j.hip), k = P(j.knee), a = P(j.ankle);
     const V ut = (k - h).normalized(), us = (a - k).normalized();
     const V medT = across(ut, P(V(-1, 0, 0))), antT = across(ut, V::UnitY());
@@ -446,7 +448,7 @@ void addVessels(Builder& b, const SideJoints& j) {
               k - 20 * V::UnitY() + 5 * medT,
               k + 80 * us - 18 * V::UnitY(),
               a - 30 * us - 14 * V::UnitY() + 8 * medT},
-             5, 2.5);
+             r(5), r(2.5));
   }
 }
 
@@ -609,6 +611,7 @@ BodyModel buildBody(const PhantomOptions& options) {
   Builder b;
   BodyModel& m = b.m;
   b.detailed = options.armsResting;
+  b.limbVesselR = options.limbVesselMm / 2;
   m.spacing = options.spacing();
   // The skin is at least one voxel thick so every boundary voxel is skin at any voxel size (on a
   // thick-slice grid, the voxel's extent along the surface's normal: Phantom.cpp).

@@ -35,6 +35,11 @@ struct PhantomOptions {
   // arm still rests on the chest wall). Across these gaps the body's surfaces do not blend, so
   // the air between stays air however thin. Zero: the hands and forearms press on the body.
   double handGapMm = 0, forearmGapMm = 0;
+  // With armsResting, the diameter of every limb vessel (the arms' and legs' arteries, through
+  // the axilla, the elbow's crease, the groin and the back of the knee) instead of their
+  // anatomical 4-10 mm: about one voxel on a reference phantom's grid, where a crease squeezes
+  // them hardest (issue 64). Zero: anatomical.
+  double limbVesselMm = 0;
   PhantomLabelling labels = PhantomLabelling::Phantom;
   double marginMm = 10.0;  // empty border around the body
   int threads = 0;         // 0: all cores

@@ -389,6 +389,75 @@ TEST(Phantom, TheGapVariantHoldsHandsAndForearmsOffTheBodyByTheirGaps) {
   EXPECT_THROW(Phantom{bad}, Error);  // gaps belong to the arms-resting posture
 }
 
+// The thin-vessel variant (PhantomOptions::limbVesselMm, issue 64): each limb's artery one or two
+// voxels across, as on a reference phantom's grid, and still one unbroken vessel from the trunk to
+// the ankle and the wrist: on every slice between the hip and the knee, and between the shoulder
+// and the elbow, each side holds a voxel of it. A tube of diameter D covers a voxel centre on
+// every cross-section when D >= sqrt(3) voxels: 3.5 mm on 2 mm voxels. The anatomical vessels
+// hold more voxels (the legs' three times as many or more). Near the shoulder the artery runs in
+// the girdle and takes the trunk's vessel label, so the upper arm is checked from 60 mm below it.
+TEST(Phantom, TheThinVesselVariantRunsOneVoxelVesselsThroughTheLimbs) {
+  auto vessels = [](double mm) {
+    PhantomOptions o;
+    o.armsResting = true;
+    o.handGapMm = 4;
+    o.limbVesselMm = mm;
+    return Phantom(o);
+  };
+  const Phantom thin = vessels(3.5), anatomical = vessels(0);
+  const auto [G, S] = thin.makeVolumes();
+  const auto [G0, S0] = anatomical.makeVolumes();
+  auto count = [](const Volume& g, int label) {
+    std::int64_t n = 0;
+    for (std::int64_t v = 0; v < g.numVoxels(); ++v) n += g.data<std::uint8_t>()[v] == label;
+    return n;
+  };
+  auto valueOf = [&](const std::string& name) {
+    for (const Label& l : G.labels().labels())
+      if (l.name == name) return l.value;
+    ADD_FAILURE() << "no label " << name;
+    return -1;
+  };
+  const int legs = valueOf("blood_vessels_legs"), arms = valueOf("blood_vessels_arms");
+  for (const int label : {legs, arms}) {
+    const std::int64_t n = count(G, label), n0 = count(G0, label);
+    EXPECT_GT(n, 0) << label;
+    EXPECT_LT((label == legs ? 3 : 1) * n, n0)
+        << label << ": " << n << " voxels, anatomical " << n0;
+  }
+  const Skeleton sk = thin.skeleton();
+  auto jointZ = [&](const std::string& name) {
+    for (const auto& j : sk.joints)
+      if (j.name == name) return j.centre.z();
+    ADD_FAILURE() << "no joint " << name;
+    return 0.0;
+  };
+  const auto& d = G.dims();
+  for (const std::string side : {"_left", "_right"})
+    for (const auto& [from, to, label] :
+         {std::tuple{"hip", "knee", legs}, std::tuple{"shoulder", "elbow", arms}}) {
+      const double z0 = jointZ(to + side) + 20,
+                   z1 = jointZ(from + side) - (label == arms ? 60 : 20);
+      const double sideX = side == "_left" ? 1 : -1;
+      for (std::int64_t k = 0; k < d[2]; ++k) {
+        const double z = G.geometry().voxelToRas(0, 0, double(k)).z();
+        if (z < z0 || z > z1) continue;
+        bool found = false;
+        for (std::int64_t j = 0; j < d[1] && !found; ++j)
+          for (std::int64_t i = 0; i < d[0] && !found; ++i)
+            found = G.data<std::uint8_t>()[G.index(i, j, k)] == label &&
+                    G.geometry().voxelToRas(double(i), double(j), double(k)).x() * sideX > 0;
+        EXPECT_TRUE(found) << from << side << " to " << to << side << ": no vessel at z " << z;
+      }
+    }
+  PhantomOptions bad;
+  bad.limbVesselMm = 2;
+  EXPECT_THROW(Phantom{bad}, Error);  // the vessels belong to the arms-resting posture
+  bad.armsResting = true;
+  bad.limbVesselMm = -1;
+  EXPECT_THROW(Phantom{bad}, Error);
+}
+
 TEST(Phantom, SlabsAndPointsAgreeWithTheWholeVolume) {
   PhantomOptions o;
   o.voxelMm = 4;
