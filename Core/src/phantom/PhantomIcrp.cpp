@@ -116,10 +116,15 @@ std::uint8_t IcrpLabeller::label(std::uint8_t organ, std::uint8_t part,
       return id::kScapulae;
     case kSternum:
       return id::kSternum;
-    case kVertebrae:  // levels by height on the phantom's spine (T1 at z = 1000 mm)
+    // Levels by height on the phantom's spine (T1 at z = 1000 mm). The sacrum reaches up to the
+    // lumbosacral disc (747-758 mm, detailed anatomy), as ICRP's does to L5/S1: split lower (at
+    // 725 mm, the bone under the disc labelled lumbar) the rig put the lumbosacral joint 30 mm
+    // below the disc, in bone, and sitting's pelvic tilt ran the sacrum into the lumbar spine
+    // (22 voxels, -1.02 % on the ICRP adult male's grid).
+    case kVertebrae:
       return p.z() >= 1000  ? id::kCervical
              : p.z() >= 860 ? id::kThoracic
-             : p.z() >= 725 ? id::kLumbar
+             : p.z() >= 752 ? id::kLumbar
                             : id::kSacrum;
     case kBrain:
       return id::kBrain;

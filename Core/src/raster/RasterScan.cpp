@@ -89,7 +89,9 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
     if (options.restParts && options.restParts->dims() == input.dims)
       sh.rimParts = options.restParts;
     // Per label, the piece it is meshed in (0: none): the piece ids themselves and, through
-    // RigSettings::bonePieces, the other labels of a bone.
+    // RigSettings::bonePieces, the other labels of a bone. A bone Mesh_3 gave no tets of its own
+    // (ribs one voxel thick on 8 mm slices) is a piece all the same: its ghosts move it with
+    // its body part's other pieces (PieceGhosts.h).
     const std::set<int> ids(mesh.rigid.begin(), mesh.rigid.end());
     std::vector<int> pieceOf;
     auto assign = [&](int label, int piece) {
@@ -100,7 +102,7 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
       if (v > 0) assign(v, v);
     if (options.bonePieces)
       for (const auto& [label, piece] : *options.bonePieces)
-        if (label > 0 && ids.count(piece)) assign(label, piece);
+        if (label > 0 && piece > 0) assign(label, piece);
     sh.boneLabel.resize(pieceOf.size());
     for (std::size_t v = 0; v < pieceOf.size(); ++v) sh.boneLabel[v] = pieceOf[v] != 0;
     sh.ghosts = raster::pieceGhosts(mesh, *options.pieceLabels, pieceOf, sh.rimParts);
