@@ -104,10 +104,11 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
   for (Eigen::Index t = 0; t < nt; ++t)
     if (const int p = mesh.rigid[std::size_t(t)])
       anyTetOf.try_emplace({p, mesh.labels[t]}, std::int32_t(t));
-  // A bone with no tet of its own in that part (Mesh_3 gave the ICRP adult male's one-voxel ribs
-  // none when the limbs' vessels were a voxel thin, and raising the arms bent them with the chest
-  // wall: Dice 0.21) moves with the part's nearest piece tet: every piece of a body part moves
-  // with the part's group.
+  // A bone with no tet of its own in that part moves with the part's nearest piece tet: every
+  // piece of a body part moves with the part's group. Mesh_3 gives a one-voxel bone tets or none
+  // as the labels around it change: the ICRP grid's ribs got none once its phantom had one-voxel
+  // limb vessels and the sacrum up to its disc, and both arms up 160 degrees bent them with the
+  // chest wall (Dice 0.21).
   std::map<int, std::vector<std::pair<Eigen::Vector3d, std::int32_t>>> piecesOfPart;
   auto centroid = [&](Eigen::Index t) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();

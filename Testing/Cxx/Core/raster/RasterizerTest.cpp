@@ -772,10 +772,10 @@ TEST(Rasterizer, ABoneEndInAnotherPartsTetsMovesWithTheBone) {
   EXPECT_LT(boneDice(b.G, S2, b.mesh, b.deformed, b.grid, b.motion, 5).first, 0.95);
 }
 
-// A bone Mesh_3 gave no tet of its own (the ICRP adult male's one-voxel ribs on 8 mm slices, with
-// one-voxel vessels in the limbs) lies wholly in soft tets. It moves with its body part's other
-// pieces all the same, where the soft tissue around it is sheared: raising both arms had bent
-// the ribs with the chest wall (Dice 0.21).
+// A bone Mesh_3 gave no tet of its own (the one-voxel ribs of the ICRP grid's phantom with
+// one-voxel limb vessels and the sacrum up to its disc) lies wholly in soft tets. It moves with its
+// body part's other pieces all the same, where the soft tissue around it is sheared: raising both
+// arms had bent the ribs with the chest wall (Dice 0.21).
 TEST(Rasterizer, ABoneWithNoTetsOfItsOwnMovesWithItsPartsPieces) {
   const BoneEnd b = boneEndInSoftTets();
   Volume G = b.G;  // the bone's end beyond x = 15, in the soft tets only, is another bone: 6
