@@ -38,8 +38,8 @@ struct PieceGhost {
 // gives the sample (the soft tet's own part without it): within `rings` vertex-sharing steps
 // through soft tets holding it, else any tet of that piece in that part (a piece moves whole:
 // one rigid map), else, for a bone with no tet of its own there, the part's nearest piece tet
-// (every piece of a body part moves with its group). `pieceOf[label]`: the piece id the label is meshed in (0: none).
-// `restParts`, when given, is on `pieceLabels`' grid.
+// (every piece of a body part moves with its group). `pieceOf[label]`: the piece id the label is
+// meshed in (0: none). `restParts`, when given, is on `pieceLabels`' grid.
 std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& pieceLabels,
                                     const std::vector<int>& pieceOf,
                                     const Volume* restParts = nullptr, int rings = 3);
