@@ -108,7 +108,7 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
   // piece of a body part moves with the part's group. Mesh_3 gives a one-voxel bone tets or none
   // as the labels around it change: the ICRP grid's ribs got none once its phantom had one-voxel
   // limb vessels and the sacrum up to its disc, and both arms up 160 degrees bent them with the
-  // chest wall (Dice 0.21).
+  // chest wall.
   std::map<int, std::vector<std::pair<Eigen::Vector3d, std::int32_t>>> piecesOfPart;
   auto centroid = [&](Eigen::Index t) {
     Eigen::Vector3d c = Eigen::Vector3d::Zero();

@@ -775,7 +775,7 @@ TEST(Rasterizer, ABoneEndInAnotherPartsTetsMovesWithTheBone) {
 // A bone Mesh_3 gave no tet of its own (the one-voxel ribs of the ICRP grid's phantom with
 // one-voxel limb vessels and the sacrum up to its disc) lies wholly in soft tets. It moves with its
 // body part's other pieces all the same, where the soft tissue around it is sheared: raising both
-// arms had bent the ribs with the chest wall (Dice 0.21).
+// arms had bent the ribs with the chest wall.
 TEST(Rasterizer, ABoneWithNoTetsOfItsOwnMovesWithItsPartsPieces) {
   const BoneEnd b = boneEndInSoftTets();
   Volume G = b.G;  // the bone's end beyond x = 15, in the soft tets only, is another bone: 6
