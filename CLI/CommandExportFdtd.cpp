@@ -3,6 +3,7 @@
 // permittivity and conductivity at the frequency (Gabriel's Cole-Cole model) and its density.
 // Writes MODEL.h5, MODEL.csx.xml and MODEL.json together or not at all (docs/DOSIMETRY.md).
 #include "ArgParser.h"
+#include "StderrLine.h"
 #include "Commands.h"
 #include "InputChecks.h"
 #include "MemoryBudget.h"
@@ -100,8 +101,7 @@ int runExportFdtd(const Args& args) {
     info.warnings.push_back(std::to_string(model.overlapVoxels) +
                             " voxels where segments overlap took the last segment's tissue");
   const std::string report = writeFdtdModel(model, labels, out, info);
-  for (const std::string& w : info.warnings)
-    std::cerr << "repose export-fdtd: warning: " << w << "\n";
+  for (const std::string& w : info.warnings) stderrLine("repose export-fdtd: warning: " + w);
   if (quiet) {
     std::cout << report;
     return 0;

@@ -5,6 +5,7 @@
 // the rigidity solver), rasterizes G, S (and the image) at full resolution, exports the
 // displacement field and writes report.json with the quality checks of docs/QUALITY.md.
 #include "ArgParser.h"
+#include "StderrLine.h"
 #include "Commands.h"
 #include "FolderClaim.h"
 #include "InputChecks.h"
@@ -231,7 +232,7 @@ void setUpPose(const ArgParser& p, PoseSetup& s, bool speak, bool claim) {
   Volume& parts = s.parts.emplace(readVolume(p.get("parts"), readOptionsWithin(budget, !quiet)));
   if (const std::string w = nameBodyPartsByRigConvention(parts, p.get("parts"));
       !w.empty() && speak)
-    std::cerr << "repose pose: warning: " << w << "\n";
+    stderrLine("repose pose: warning: " + w);
   requirePoseableLabels(organs, p.get("input"));
   requirePoseableLabels(parts, p.get("parts"));
   if (speak) {
@@ -245,8 +246,7 @@ void setUpPose(const ArgParser& p, PoseSetup& s, bool speak, bool claim) {
                                     image ? &*image : nullptr);
   const PoseJob& job = *s.job;
   if (speak)
-    for (const std::string& line : job.warnings())
-      std::cerr << "repose pose: warning: " << line << "\n";
+    for (const std::string& line : job.warnings()) stderrLine("repose pose: warning: " + line);
   for (const ContactSeparation& c : job.separations().automatic.made)
     say("separating " + c.names[0] + " from " + c.names[1] +
         (c.touchingVoxels > 0
@@ -263,7 +263,7 @@ void setUpPose(const ArgParser& p, PoseSetup& s, bool speak, bool claim) {
   sceneRun.buildProgress = quiet ? ProgressFn{} : terminalProgress();
   sceneRun.say = say;
   sceneRun.note = [speak](const std::string& line) {
-    if (speak) std::cerr << "repose pose: note: " << line << std::endl;
+    if (speak) stderrLine("repose pose: note: " + line);
   };
   s.sceneRig = rigForScene(job, sceneRun);
   const PoseRig& rig = *s.sceneRig.rig;
@@ -335,7 +335,7 @@ int poseFrames(const ArgParser& p, const PoseSetup& s, SlabRanks* ranks,
     // other, folds), said on stderr as soon as it is known (stdout may be JSON).
     run.warn = [&](const std::string& line) {
       if (!ranks || ranks->root())  // every rank starts the frame; rank 0 says
-        std::cerr << "repose pose: warning: frame " << frameName << ": " << line << std::endl;
+        stderrLine("repose pose: warning: frame " + frameName + ": " + line);
     };
     const FrameOutcome outcome = runPoseFrame(job, rig, index, organs, parts, run);
     if (ranks && !ranks->root()) continue;  // rank 0 writes and says
@@ -364,8 +364,8 @@ int poseFrames(const ArgParser& p, const PoseSetup& s, SlabRanks* ranks,
     // A frame that missed a target is written all the same (users may want it), and said so in
     // one line naming what missed; the exit status says it too.
     if (!outcome.targetsMet) {
-      std::cerr << "repose pose: frame " << frameName
-                << " written, but it missed its targets: " << outcome.missedLine() << std::endl;
+      stderrLine("repose pose: frame " + frameName +
+                 " written, but it missed its targets: " + outcome.missedLine());
       ++missedFrames;
     }
     summary.push_back(report);

@@ -3,6 +3,7 @@
 // (names, densities, bones) and DIR/rig.json (what was found), together or not at all. Then
 // `repose pose --input G --parts DIR/S.nii.gz --pose P` finds the skeleton and tissues beside S.
 #include "ArgParser.h"
+#include "StderrLine.h"
 #include "Commands.h"
 #include "InputChecks.h"
 #include "MemoryBudget.h"
@@ -76,8 +77,8 @@ int runRig(const Args& args) {
   const fs::path dir(out);
   const nlohmann::json rigReport = nlohmann::json::parse(rig.reportJson);
 
-  for (const std::string& w : rig.warnings) std::cerr << "repose rig: warning: " << w << "\n";
-  for (const std::string& m : rig.missing) std::cerr << "repose rig: not rigged: " << m << "\n";
+  for (const std::string& w : rig.warnings) stderrLine("repose rig: warning: " + w);
+  for (const std::string& m : rig.missing) stderrLine("repose rig: not rigged: " + m);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (quiet) {

@@ -2,6 +2,7 @@
 // the full-resolution posed label map (and image) from a posed cage, with per-label volumes
 // before and after, so a dosimetry user sees at once whether a tissue lost or gained volume.
 #include "ArgParser.h"
+#include "StderrLine.h"
 #include "Commands.h"
 #include "InputChecks.h"
 #include "MemoryBudget.h"
@@ -127,8 +128,7 @@ void noteWarpCoordinates(const CageDeformation& deformation, const std::string& 
   summary.coordinatesNote = deformation.coordinatesNote();
   std::error_code ec;
   if (!summary.coordinatesRead && std::filesystem::exists(coordinatesFile, ec))
-    std::cerr << "repose warp: note: Green coordinates computed again: " << summary.coordinatesNote
-              << "\n";
+    stderrLine("repose warp: note: Green coordinates computed again: " + summary.coordinatesNote);
 }
 
 int runWarp(const Args& args) {

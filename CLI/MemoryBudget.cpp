@@ -1,4 +1,5 @@
 #include "MemoryBudget.h"
+#include "StderrLine.h"
 
 #include "ArgParser.h"
 #include "TerminalProgress.h"
@@ -59,7 +60,7 @@ int rankThreads(int threads) {
 ReadOptions readOptionsWithin(double budget, bool progress) {
   ReadOptions r;
   if (progress) r.progress = terminalProgress();
-  r.note = [](const std::string& n) { std::cerr << "repose: note: " << n << "\n"; };
+  r.note = [](const std::string& n) { stderrLine("repose: note: " + n); };
   // Core's rule for every front end (the workbench and Python read by it too): the budget less
   // the resident set now; never 0 (no limit), so a budget already used up refuses every read.
   r.memoryLimitBytes = memoryLeftWithin(budget);

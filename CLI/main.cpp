@@ -2,6 +2,7 @@
 // --help, writes JSON with --json, and fails with one line on stderr and a non-zero exit.
 #include "ArgParser.h"
 #include "Commands.h"
+#include "StderrLine.h"
 
 #include "repose/util/Error.h"
 #include "repose/util/Interrupt.h"
@@ -62,22 +63,23 @@ int main(int argc, char** argv) {
     } catch (const repose::cli::QuietExit& e) {
       return e.code;  // a rank of `warp --mpi` whose failure rank 0 reports
     } catch (const repose::cli::UsageError& e) {
-      std::cerr << "repose " << name << ": " << e.message << " (see repose " << name
-                << " --help)\n";
+      repose::cli::stderrLine("repose " + name + ": " + e.message + " (see repose " + name +
+                              " --help)");
       return 2;
     } catch (const repose::Cancelled&) {
       const int signal = repose::interruptSignal();
-      std::cerr << "repose " << name << ": " << (signal == SIGTERM ? "terminated" : "interrupted")
-                << "; no partial file was left\n";
+      repose::cli::stderrLine("repose " + name + ": " +
+                              (signal == SIGTERM ? "terminated" : "interrupted") +
+                              "; no partial file was left");
       return 128 + (signal > 0 ? signal : SIGINT);
     } catch (const std::bad_alloc&) {
-      std::cerr << "repose " << name << ": error: out of memory\n";
+      repose::cli::stderrLine("repose " + name + ": error: out of memory");
       return 1;
     } catch (const std::exception& e) {
-      std::cerr << "repose " << name << ": error: " << e.what() << "\n";
+      repose::cli::stderrLine("repose " + name + ": error: " + e.what());
       return 1;
     }
   }
-  std::cerr << "repose: unknown command '" << name << "' (see repose --help)\n";
+  repose::cli::stderrLine("repose: unknown command '" + name + "' (see repose --help)");
   return 2;
 }
