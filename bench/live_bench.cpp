@@ -100,13 +100,20 @@ int main(int argc, char** argv) {
     fail("live pose: " + logic->GetLastErrorMessage());
   const double prepareMs = ms(prepareStart, Clock::now());
 
-  // The group to drag: the one named, else the first the pose moves.
+  // The group to drag: the one named, else the first the pose moves (a turn or a shift in its
+  // current keyframe), else the first a user can turn; whatever the groups are called (a pose
+  // of named joints, a file written by hand).
   if (group.empty()) {
-    for (const std::string candidate : {"left forearm and hand", "left arm", "left leg"})
-      if (logic->GetPoseEdits()->GetPoseGroupTransform(pose, candidate)) {
+    const auto summary = logic->GetPoseEdits()->GetPoseSummary(pose);
+    for (const std::string& candidate : summary.movableGroups) {
+      const auto t = logic->GetPoseEdits()->GetPoseGroupTransform(pose, candidate);
+      const bool moves = t && (t->angleDeg != 0 || t->translation != std::array<double, 3>{});
+      if (moves) {
         group = candidate;
         break;
       }
+    }
+    if (group.empty() && !summary.movableGroups.empty()) group = summary.movableGroups.front();
   }
   const auto rest = logic->GetPoseEdits()->GetPoseGroupTransform(pose, group);
   if (group.empty() || !rest)
