@@ -127,6 +127,7 @@ PosedFrame frame::poseFrameFrom(FrameStart& start, const PoseRig& rig, const Vol
         *options.image, mesh, deformed, out.grid,
         options.background ? *options.background : imageBackground(*options.image), ro);
   PosedTally posed(organs, parts, &start.frame.handles, out.grid, options.threads);
+  posed.countCollisions(frame::rigidLabels(mesh, options));
   posed.addWhole(out.organs, out.parts);
   out.reportJson = frame::frameReport(start, rig, organs, parts, options, raster, pockets, posed,
                                       out.image.has_value());

@@ -68,6 +68,11 @@ void warn(FrameStart& start, const PoseFrameOptions& options, const std::string&
 RasterOptions rasterOptions(const FrameStart& start, const Volume& organs, const Volume& parts,
                             const PoseFrameOptions& options);
 
+// The labels of G that move rigidly (the rasterizer's: the mesh's pieces, and through
+// RigSettings::bonePieces the other labels of each bone, with or without tets of their own);
+// empty when the mesh has no pieces. The posed maps' tally counts collisions between them.
+std::vector<int> rigidLabels(const TransferMesh& mesh, const PoseFrameOptions& options);
+
 // The report.json object of the frame: everything but the files' own names, from the counts of
 // the rasterizer (G's), the pockets and the posed maps (complete).
 std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& organs,

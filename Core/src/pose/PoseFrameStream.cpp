@@ -192,6 +192,7 @@ std::string frame::poseFrameToFolderFrom(
       rounding.emplace(*organSlabs, std::size_t(std::max(0.0, 0.25 * freeBytes)));
     if (options.fillPockets) pockets.emplace(organs, grid);
     posed.emplace(organs, parts, &start.frame.handles, grid, options.threads);
+    posed->countCollisions(frame::rigidLabels(mesh, options));
     out.emplace(folder, write.lockFolder);
   });
   // The same slabs on every rank; over ranks at least eight per maker, so that rank 0 uses one

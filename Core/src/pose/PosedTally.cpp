@@ -3,6 +3,7 @@
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -17,6 +18,33 @@ namespace {
 struct Counts {
   std::map<int, std::int64_t> labels;
   std::vector<GroupDiceCounts> groups;
+  std::map<std::pair<PieceId, PieceId>, std::int64_t> collisions;
+};
+
+// Which labels are rigid: a table over the 16-bit range (every real map's labels), a search
+// beyond it.
+class RigidLookup {
+ public:
+  explicit RigidLookup(const std::vector<int>& sorted) : sorted_(sorted) {
+    for (const int l : sorted)
+      if (l >= kLow && l < kLow + kSpan) table_[std::size_t(l - kLow)] = 1;
+  }
+  bool any() const { return !sorted_.empty(); }
+  bool operator()(int label) const {
+    if (label >= kLow && label < kLow + kSpan) return table_[std::size_t(label - kLow)] != 0;
+    return std::binary_search(sorted_.begin(), sorted_.end(), label);
+  }
+
+ private:
+  static constexpr int kLow = -32768, kSpan = 65536;
+  const std::vector<int>& sorted_;
+  std::vector<char> table_ = std::vector<char>(kSpan, 0);
+};
+
+// The first group's rigid tissue claiming a posed voxel of the slice being counted.
+struct Claim {
+  int group = -1;
+  PieceId piece;
 };
 
 void mergeInto(std::map<int, std::int64_t>& to, const std::map<int, std::int64_t>& from) {
@@ -42,8 +70,8 @@ struct Dense {
 
 template <class TG, class TS>
 void countSlices(const Volume& G, const Volume& S, const std::vector<RigidHandle>* handles,
-                 const VolumeGeometry& grid, const TG* pg, const TS* ps, std::int64_t k0,
-                 std::int64_t ka, std::int64_t kb, Counts& out) {
+                 const RigidLookup& rigid, const VolumeGeometry& grid, const TG* pg, const TS* ps,
+                 std::int64_t k0, std::int64_t ka, std::int64_t kb, Counts& out) {
   const std::int64_t nx = grid.dims[0], ny = grid.dims[1], plane = nx * ny;
   // Labels of the posed G: small types through a dense counter, wide ones through the map.
   if constexpr (sizeof(TG) <= 2) {
@@ -59,36 +87,55 @@ void countSlices(const Volume& G, const Volume& S, const std::vector<RigidHandle
   const TS* sp = S.data<TS>();
   const auto rd = G.dims();
   out.groups.resize(handles->size());
+  // Per group, once: its parts and the map from a posed voxel to the rest continuous index
+  // (affine: one matrix for the whole grid).
+  std::vector<std::vector<char>> inParts(handles->size());
+  std::vector<Eigen::Matrix4d> toRest(handles->size());
   for (std::size_t h = 0; h < handles->size(); ++h) {
     const RigidHandle& handle = (*handles)[h];
     if (handle.parts.empty()) continue;
-    std::vector<char> inParts(1 << 16, 0);
+    inParts[h].assign(1 << 16, 0);
     for (const int p : handle.parts)
-      if (p >= 0 && p < (1 << 16)) inParts[std::size_t(p)] = 1;
-    auto partOf = [&](auto s) {
-      return s >= 0 && std::int64_t(s) < (1 << 16) && inParts[std::size_t(s)];
-    };
-    GroupDiceCounts& c = out.groups[h];
-    // Posed voxel (i,j,k) -> rest continuous index, affine: one matrix for the whole grid.
-    const Eigen::Matrix4d toRest =
-        G.geometry().ijkToRas.inverse() * handle.motion.inverse().matrix() * grid.ijkToRas;
-    for (std::int64_t k = ka; k < kb; ++k)
+      if (p >= 0 && p < (1 << 16)) inParts[h][std::size_t(p)] = 1;
+    toRest[h] = G.geometry().ijkToRas.inverse() * handle.motion.inverse().matrix() * grid.ijkToRas;
+  }
+  std::vector<Claim> claims(rigid.any() ? std::size_t(plane) : 0);
+  for (std::int64_t k = ka; k < kb; ++k) {
+    std::fill(claims.begin(), claims.end(), Claim{});
+    for (std::size_t h = 0; h < handles->size(); ++h) {
+      if (inParts[h].empty()) continue;
+      const std::vector<char>& in = inParts[h];
+      auto partOf = [&](auto s) {
+        return s >= 0 && std::int64_t(s) < (1 << 16) && in[std::size_t(s)];
+      };
+      GroupDiceCounts& c = out.groups[h];
       for (std::int64_t j = 0; j < ny; ++j)
         for (std::int64_t i = 0; i < nx; ++i) {
           const std::int64_t o = (k - k0) * plane + j * nx + i;
           const int posed = partOf(ps[o]) ? int(pg[o]) : 0;
-          const Eigen::Vector4d r = toRest * Eigen::Vector4d(double(i), double(j), double(k), 1);
+          const Eigen::Vector4d r = toRest[h] * Eigen::Vector4d(double(i), double(j), double(k), 1);
           const double ri = std::floor(r.x() + 0.5), rj = std::floor(r.y() + 0.5),
                        rk = std::floor(r.z() + 0.5);
           int expected = 0;
+          std::int64_t q = -1;
           if (ri >= 0 && rj >= 0 && rk >= 0 && ri < rd[0] && rj < rd[1] && rk < rd[2]) {
-            const std::int64_t q = G.index(std::int64_t(ri), std::int64_t(rj), std::int64_t(rk));
+            q = G.index(std::int64_t(ri), std::int64_t(rj), std::int64_t(rk));
             if (partOf(sp[q])) expected = int(g[q]);
           }
           if (posed) ++c.posed[posed];
           if (expected) ++c.expected[expected];
           if (posed && posed == expected) ++c.both[posed];
+          if (expected && !claims.empty() && rigid(expected)) {
+            Claim& first = claims[std::size_t(j * nx + i)];
+            const PieceId piece{expected, int(sp[q])};
+            if (first.group < 0)
+              first = {int(h), piece};
+            else if (first.group != int(h))
+              ++out.collisions[piece < first.piece ? std::make_pair(piece, first.piece)
+                                                   : std::make_pair(first.piece, piece)];
+          }
         }
+    }
   }
 }
 
@@ -135,6 +182,7 @@ void PosedTally::add(const void* posedOrgans, const void* posedParts, std::int64
                 ") out of order (expected from slice " + std::to_string(next_) + " of " +
                 std::to_string(grid_.dims[2]) + ")");
   std::mutex merging;
+  const RigidLookup rigid(rigid_);
   dispatchScalar(organs_.scalarType(), [&](auto* gt) {
     using TG = std::remove_pointer_t<decltype(gt)>;
     dispatchScalar(parts_.scalarType(), [&](auto* st) {
@@ -146,8 +194,8 @@ void PosedTally::add(const void* posedOrgans, const void* posedParts, std::int64
             k1 - k0, threads_,
             [&](std::int64_t a, std::int64_t b) {
               Counts local;
-              countSlices<TG, TS>(organs_, parts_, handles_, grid_, pg, ps, k0, k0 + a, k0 + b,
-                                  local);
+              countSlices<TG, TS>(organs_, parts_, handles_, rigid, grid_, pg, ps, k0, k0 + a,
+                                  k0 + b, local);
               const std::lock_guard<std::mutex> lock(merging);
               mergeInto(labels_, local.labels);
               for (std::size_t h = 0; h < local.groups.size(); ++h) {
@@ -155,6 +203,7 @@ void PosedTally::add(const void* posedOrgans, const void* posedParts, std::int64
                 mergeInto(groups_[h].expected, local.groups[h].expected);
                 mergeInto(groups_[h].both, local.groups[h].both);
               }
+              for (const auto& [pair, n] : local.collisions) collisions_[pair] += n;
             },
             1);
       }
@@ -162,6 +211,21 @@ void PosedTally::add(const void* posedOrgans, const void* posedParts, std::int64
   });
   holes_.add(posedOrgans, organs_.scalarType(), k0, k1);
   next_ = k1;
+}
+
+void PosedTally::countCollisions(const std::vector<int>& rigidLabels) {
+  if (next_ != 0) throw Error("pose report: collisions are counted from the first slice");
+  rigid_.clear();
+  for (const int l : rigidLabels)
+    if (l != 0) rigid_.push_back(l);
+  std::sort(rigid_.begin(), rigid_.end());
+  rigid_.erase(std::unique(rigid_.begin(), rigid_.end()), rigid_.end());
+}
+
+std::vector<PieceOverlap> PosedTally::collisions() const {
+  std::vector<PieceOverlap> out;
+  for (const auto& [pair, n] : collisions_) out.push_back({pair.first, pair.second, n});
+  return out;
 }
 
 void PosedTally::addWhole(const Volume& posedOrgans, const Volume& posedParts) {

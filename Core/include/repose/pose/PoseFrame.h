@@ -34,6 +34,10 @@ std::vector<std::string> labelMapFileNames(LabelMapFiles files);
 // of >= 1000 voxels and every body part the posed mesh predicts within 1 %.
 constexpr double kBodyTargetPercent = 0.5;
 constexpr double kLabelTargetPercent = 1.0;
+// Two rigid pieces may share at most this share of the smaller one's volume (at least one rest
+// voxel's): a tenth of the label target, for two voxel staircases turned against each other at a
+// joint.
+constexpr double kCollisionAllowancePercent = 0.1;
 
 // The exit status of `repose pose` and `repose sweep` when every frame was written but some
 // missed a target (report.json's "targets"): scripts tell it from success (0), an error (1), a

@@ -155,9 +155,17 @@ TEST(PoseRun, AFrameIsTheFrameOfPoseFrameCompletedByTheJobAndWritten) {
     byJoint += tets.get<std::int64_t>();
   }
   EXPECT_EQ(byJoint, written["mesh"]["inverted_tets"].get<std::int64_t>());
-  // Rigid pieces apart is a target, and agrees with the collisions it counts.
-  EXPECT_EQ(written["quality"]["pieces_apart"]["met"],
-            written["bone_collisions"]["voxels"].get<std::int64_t>() == 0);
+  // Rigid pieces apart is a target, and agrees with the collisions it counts: each pair beyond
+  // its allowance (at least a voxel) misses it.
+  std::int64_t beyond = 0;
+  for (const auto& pair : written["bone_collisions"]["pairs"]) {
+    EXPECT_GE(pair["allowed_voxels"].get<std::int64_t>(), 1);
+    EXPECT_EQ(pair["beyond_allowance"].get<bool>(),
+              pair["voxels"].get<std::int64_t>() > pair["allowed_voxels"].get<std::int64_t>());
+    if (pair["beyond_allowance"].get<bool>()) beyond += pair["voxels"].get<std::int64_t>();
+  }
+  EXPECT_EQ(beyond, written["bone_collisions"]["beyond_allowance_voxels"].get<std::int64_t>());
+  EXPECT_EQ(written["quality"]["pieces_apart"]["met"], beyond == 0);
   // The rounding says whether it held, label by label, and names those of >= 1000 voxels that
   // missed.
   std::set<int> missed;
