@@ -7,11 +7,13 @@
 #include "TestPaths.h"
 
 #include "repose/io/VolumeIO.h"
+#include "repose/phantom/Phantom.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -293,4 +295,52 @@ TEST(PoseCommand, ADicomSegIsMadeSlabBySlabOrRefusedBeforeTheWorkBeyondFourGiB) 
                            "more than the 4 GiB a DICOM object's pixel data can hold"})
     EXPECT_NE(refused.err.find(part), std::string::npos) << part << " in: " << refused.err;
   EXPECT_FALSE(std::filesystem::exists(dir.file("fine")));
+}
+
+// A body that fills its grid (no margin: the hands a voxel from the grid's sides, as in maps cut
+// to the body's box) with its left arm raised 90 degrees sideways: the hand ends far beyond the
+// input grid, and the output grid grows to hold it, so nothing is clipped (issue 65, item 4).
+TEST(PoseCommand, ABodyFillingItsGridIsPosedOntoAGrownGridThatHoldsEveryVoxel) {
+  ScratchDir dir("pose_edge");
+  ASSERT_EQ(
+      runCommand("repose", "phantom --voxel 4 --margin 0 --out " + shellQuote(dir.path().string()))
+          .exitCode,
+      0);
+  const Volume rest = readVolume(dir.file("S.nii.gz"));
+  // The input grid's box in RAS (voxel centres), and the rest body reaching its sides.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const std::int64_t i : {std::int64_t(0), rest.dims()[0] - 1})
+    for (const std::int64_t j : {std::int64_t(0), rest.dims()[1] - 1})
+      for (const std::int64_t k : {std::int64_t(0), rest.dims()[2] - 1}) {
+        lo = lo.cwiseMin(rest.geometry().voxelToRas(i, j, k));
+        hi = hi.cwiseMax(rest.geometry().voxelToRas(i, j, k));
+      }
+  const CommandResult pose =
+      runCommand("repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                               shellQuote(dir.file("S.nii.gz")) + " --pose " +
+                               shellQuote(suitePoseFile("arm_raise90")) + " --out " +
+                               shellQuote(dir.file("out")) + " --json");
+  ASSERT_EQ(pose.exitCode, 0) << pose.err;
+  const json report = json::parse(pose.out);
+  EXPECT_TRUE(report["targets"]["met"].get<bool>()) << report["targets"].dump();
+  EXPECT_EQ(report["labels_lost"], 0);
+  const Volume posed = readVolume(dir.file("out/posed_S.nii.gz"));
+  EXPECT_GT(posed.numVoxels(), rest.numVoxels());
+  // The raised hand: its voxels lie beyond the input grid's box, by more than a hand's length.
+  std::int64_t handVoxels = 0, beyond = 0;
+  double furthestMm = 0;
+  for (std::int64_t k = 0; k < posed.dims()[2]; ++k)
+    for (std::int64_t j = 0; j < posed.dims()[1]; ++j)
+      for (std::int64_t i = 0; i < posed.dims()[0]; ++i) {
+        if (posed.valueAsDouble(posed.index(i, j, k)) != kPartHandLeft) continue;
+        ++handVoxels;
+        const Eigen::Vector3d x = posed.geometry().voxelToRas(i, j, k);
+        const double out = (lo - x).cwiseMax(x - hi).maxCoeff();
+        if (out > 0) ++beyond, furthestMm = std::max(furthestMm, out);
+      }
+  EXPECT_GT(handVoxels, 100);
+  EXPECT_EQ(beyond, handVoxels) << "the whole raised hand is outside the input grid";
+  EXPECT_GT(furthestMm, 150) << "the arm's length beyond the grid's side";
+  // Nothing of the body is clipped at the grid's old sides: it keeps its volume.
+  EXPECT_LT(std::fabs(report["body"]["volume_change_percent"].get<double>()), 0.5);
 }
