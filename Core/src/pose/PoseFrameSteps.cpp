@@ -199,8 +199,9 @@ nlohmann::json collisionReport(const std::vector<PieceOverlap>& meshOverlaps,
   for (const auto& [id, n] : pieceVoxels(organs, parts, involved)) boneVoxels[pieceName(id)] += n;
   std::int64_t total = 0, beyond = 0;
   nlohmann::json pairs = nlohmann::json::array();
+  // The pair beyond its allowance with most voxels, else the one with most.
   std::pair<std::string, std::string> worst;
-  std::int64_t most = 0;
+  std::pair<bool, std::int64_t> most{false, 0};
   for (const auto& [names, n] : byName) {
     // In output voxels: the staircases' corners are the rest grid's voxels, whatever the output's.
     const double smallerMm3 =
@@ -217,21 +218,23 @@ nlohmann::json collisionReport(const std::vector<PieceOverlap>& meshOverlaps,
                      {"beyond_allowance", over}});
     total += n;
     if (over) beyond += n;
-    if (over && n > most) most = n, worst = names;
+    if (std::make_pair(over, n) > most) most = {over, n}, worst = names;
   }
   if (beyond > 0) {
     char ml[32];
-    std::snprintf(ml, sizeof ml, "%.2f", double(most) * voxelMm3 / 1000);
+    std::snprintf(ml, sizeof ml, "%.2f", double(most.second) * voxelMm3 / 1000);
     warning = "rigid pieces run into each other in " + std::to_string(total) + " voxels; most " +
-              worst.first + " and " + worst.second + " (" + std::to_string(most) + " voxels, " +
-              ml +
+              worst.first + " and " + worst.second + " (" + std::to_string(most.second) +
+              " voxels, " + ml +
               " ml): a turn about a pivot off the joint's own centre (check the skeleton's "
               "joint, or the pose's pivot), or a pose beyond the joint's range";
   }
-  return {{"voxels", total},
-          {"volume_ml", double(total) * voxelMm3 / 1000},
-          {"beyond_allowance_voxels", beyond},
-          {"pairs", pairs}};
+  nlohmann::json out = {{"voxels", total},
+                        {"volume_ml", double(total) * voxelMm3 / 1000},
+                        {"beyond_allowance_voxels", beyond},
+                        {"pairs", pairs}};
+  if (!byName.empty()) out["most"] = {worst.first, worst.second, most.second};
+  return out;
 }
 
 }  // namespace
@@ -403,16 +406,9 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
       {"rule",
        "no two rigid pieces (bones, whole organs) share more than 0.1 % of the smaller's volume "
        "(at least one rest voxel's: two voxel staircases touching at a joint)"}};
-  if (!collisions["pairs"].empty()) {
-    const nlohmann::json* most = &collisions["pairs"][0];
-    // The pair beyond its allowance with most voxels, else the one with most.
-    auto rank = [](const nlohmann::json& p) {
-      return std::make_pair(p["beyond_allowance"].get<bool>(), p["voxels"].get<std::int64_t>());
-    };
-    for (const nlohmann::json& p : collisions["pairs"])
-      if (rank(p) > rank(*most)) most = &p;
-    apart["most"] = {(*most)["a"], (*most)["b"]};
-    apart["most_voxels"] = (*most)["voxels"];
+  if (collisions.contains("most")) {
+    apart["most"] = {collisions["most"][0], collisions["most"][1]};
+    apart["most_voxels"] = collisions["most"][2];
   }
   report["quality"]["pieces_apart"] = apart;
   report["quality"]["all_met"] = report["quality"]["all_met"].get<bool>() &&
