@@ -11,12 +11,15 @@ from each frame's report.json:
   pelvis (the rhythms of docs/POSES.md).
 
 With `--out-of-core` each pose is posed again slab by slab (`repose pose --out-of-core` under a
-1.5 GiB budget, issue 56) and every file and report must equal the in-core frame's.
+1.5 GiB budget, issue 56) and every file and report must equal the in-core frame's;
+`--out-of-core-poses` names the poses that are (a suite whose other poses another suite already
+compares slab by slab).
 
 usage: pose_suite_quality.py BIN_DIR POSES_DIR WORK_DIR [phantom options...]
        [--label-bound PERCENT]  the per-label bound beyond the floor (default 1, the target)
        [--suite NAME,NAME...]   the pose files of POSES_DIR to pose (default the standard suite)
        [--out-of-core]          also slab by slab, compared file by file with the in-core frames
+       [--out-of-core-poses NAME,NAME...]  only these poses of the suite slab by slab too
        [--max-inverted-tets N]  tets the posed mesh may leave inside out in a frame (default 0,
                                 the target of issue 64; a suite not there yet names its ceiling)
 
@@ -97,6 +100,15 @@ def main():
     out_of_core = "--out-of-core" in argv
     if out_of_core:
         argv.remove("--out-of-core")
+    slab_poses = None  # every pose of the suite, with --out-of-core
+    if "--out-of-core-poses" in argv:
+        i = argv.index("--out-of-core-poses")
+        slab_poses = argv[i + 1].split(",")
+        del argv[i:i + 2]
+        out_of_core = True
+        if not set(slab_poses) <= set(suite):
+            sys.exit(f"--out-of-core-poses {','.join(slab_poses)}: not all in the suite "
+                     f"{','.join(suite)}")
     bin_dir, poses, work = argv[:3]
     phantom_args = argv[3:]
     gap_variant = "--gap-mm" in phantom_args
@@ -109,16 +121,17 @@ def main():
     run([repose, "rig", "--input", g, "--out", rig])
     failures, frames = [], 0
     for name in suite:
+        slabs_too = out_of_core and (slab_poses is None or name in slab_poses)
         out = os.path.join(work, name)
         # With --out-of-core the rig is kept in a scene folder, which the run slab by slab reuses.
-        scene = ["--scene", os.path.join(work, "scene_" + name)] if out_of_core else []
+        scene = ["--scene", os.path.join(work, "scene_" + name)] if slabs_too else []
         text, code = run([repose, "pose", "--input", g, "--parts",
                           os.path.join(rig, "S.nii.gz"), "--pose",
                           os.path.join(poses, name + ".pose.json"), "--out", out, "--json"]
                          + scene, allowed=(0, EXIT_TARGETS_MISSED))
         report = json.loads(text)
         framesOf = report.get("frames", [report])
-        if out_of_core:
+        if slabs_too:
             failures += same_out_of_core(repose, g, os.path.join(rig, "S.nii.gz"),
                                          os.path.join(poses, name + ".pose.json"), out, framesOf,
                                          scene)
