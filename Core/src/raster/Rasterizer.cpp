@@ -146,11 +146,30 @@ VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d&
   if (deformed.rows() == 0 || !deformed.allFinite())
     throw Error("rasterizer: no finite deformed vertex to size the output grid");
   Eigen::Matrix3d M = input.ijkToRas.block<3, 3>(0, 0);
-  if (spacingMm > 0) M = input.directions() * spacingMm;
+  // Output voxel k's centre lies at input.origin() + M (k + offset): with the input's spacing on
+  // its centres (offset 0), with another spacing s as far from the input's faces as the two
+  // spacings allow. Along an axis of input spacing r = (p/q) s (p/q in lowest terms), the
+  // output's centres lie at one distance from the lattice of step s/q that holds every input
+  // face: half a step puts them s/(2q) clear of every face (a whole ratio, q = 1: the output's
+  // corners on the input's, each input voxel subdivided). The input's first face is r/2 before
+  // its origin. Spacings without a small ratio (2.137 mm at 1 mm) are taken as q = 1.
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  if (spacingMm > 0) {
+    M = input.directions() * spacingMm;
+    const Eigen::Vector3d inputSpacing = input.spacing();
+    for (int c = 0; c < 3; ++c) {
+      const double ratio = inputSpacing[c] / spacingMm;
+      int q = 1;
+      // Spacings come from files as single precision: a ratio within 1e-6 is taken as exact.
+      while (q < 64 && std::fabs(q * ratio - std::round(q * ratio)) > 1e-6 * q * ratio) ++q;
+      if (q == 64) q = 1;
+      offset[c] = 1 / (2.0 * q) - ratio / 2;
+    }
+  }
   const Eigen::Matrix3d Minv = M.inverse();
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
-    const Eigen::Vector3d u = Minv * (deformed.row(v).transpose() - input.origin());
+    const Eigen::Vector3d u = Minv * (deformed.row(v).transpose() - input.origin()) - offset;
     lo = lo.cwiseMin(u), hi = hi.cwiseMax(u);
   }
   VolumeGeometry g;
@@ -175,7 +194,7 @@ VolumeGeometry deformedGrid(const VolumeGeometry& input, const Eigen::MatrixX3d&
   }
   g.ijkToRas = Eigen::Matrix4d::Identity();
   g.ijkToRas.block<3, 3>(0, 0) = M;
-  g.ijkToRas.block<3, 1>(0, 3) = input.origin() + M * start;
+  g.ijkToRas.block<3, 1>(0, 3) = input.origin() + M * (start + offset);
   return g;
 }
 
