@@ -27,6 +27,7 @@ from typing import NamedTuple, Optional
 from ._repose import (  # noqa: F401  (re-exported)
     Cancelled,
     Error,
+    LiveSession,
     Pose,
     PosedFrame,
     Rig,
@@ -43,7 +44,7 @@ from ._repose import (  # noqa: F401  (re-exported)
 from . import _repose
 
 __all__ = [
-    "Cancelled", "Error", "Pose", "PosedFrame", "Rig", "RiggedBody", "Scene", "Skeleton",
+    "Cancelled", "Error", "LiveSession", "Pose", "PosedFrame", "Rig", "RiggedBody", "Scene", "Skeleton",
     "Volume", "__version__", "average_sar", "build_rig", "from_nibabel", "load_scene",
     "make_phantom", "read_volume", "rig_body", "to_nibabel", "volume_from_array",
     "write_volume",

@@ -5,7 +5,9 @@
 
 #include <pybind11/pybind11.h>
 
+#include "repose/util/Error.h"
 #include "repose/util/Progress.h"
+#include "repose/volume/Volume.h"
 
 #include <memory>
 
@@ -28,9 +30,28 @@ class PythonProgress {
   std::shared_ptr<py::error_already_set> error_;
 };
 
+// Runs `work` with the GIL released and the callback bridged; a cancellation raised by the
+// callback (or Ctrl+C) comes back as that Python exception, else as repose.Cancelled.
+template <class F>
+auto withProgress(const py::object& progress, F&& work) {
+  PythonProgress p(progress);
+  try {
+    py::gil_scoped_release release;
+    return work(p.fn());
+  } catch (const Cancelled&) {
+    p.rethrow();
+    throw;
+  }
+}
+
+// The Volume a rig's or session's `organs` argument holds, its type checked with a message that
+// names the argument (pybind's cast error would not say which argument it was).
+const Volume& organsVolume(const py::object& organs);
+
 void bindVolumes(py::module_& m);
 void bindPoses(py::module_& m);
 void bindRigs(py::module_& m);
+void bindLive(py::module_& m);
 void bindDosimetry(py::module_& m);
 
 }  // namespace repose::python

@@ -64,5 +64,6 @@ PYBIND11_MODULE(_repose, m) {
   bindVolumes(m);
   bindRigs(m);
   bindPoses(m);
+  bindLive(m);
   bindDosimetry(m);
 }

@@ -56,15 +56,6 @@ PoseJobRequest requestFrom(const std::string& tissuesPath, bool tissuesAuto,
   return request;
 }
 
-// The Volume a rig's `organs` argument holds. It is taken as an object (its read_notes are read
-// too), so the type is checked here: pybind's cast error would not say which argument it was.
-const Volume& organsVolume(const py::object& organs) {
-  if (!py::isinstance<Volume>(organs))
-    throw py::type_error("organs: expected a repose.Volume (read_volume, volume_from_array), got " +
-                         std::string(py::str(py::type::of(organs).attr("__name__"))));
-  return organs.cast<const Volume&>();
-}
-
 // What read_volume's reader said about G (Volume.read_notes; none for a Volume made otherwise),
 // for the job's reports ("input_notes", as `repose pose` keeps them). A user may set the
 // attribute, so its type is checked with a message that names it.
@@ -91,20 +82,6 @@ void issueWarnings(const std::string& frame, const std::vector<std::string>& lin
   const py::object warn = py::module_::import("warnings").attr("warn");
   for (const std::string& line : lines)
     warn("frame " + frame + ": " + line, py::arg("stacklevel") = 2);
-}
-
-// Runs `work` with the GIL released and the callback bridged; a cancellation raised by the
-// callback (or Ctrl+C) comes back as that Python exception, else as repose.Cancelled.
-template <class F>
-auto withProgress(const py::object& progress, F&& work) {
-  PythonProgress p(progress);
-  try {
-    py::gil_scoped_release release;
-    return work(p.fn());
-  } catch (const Cancelled&) {
-    p.rethrow();
-    throw;
-  }
 }
 
 PoseTransform transformFrom(const py::dict& t, const PoseTransform& base) {
@@ -209,6 +186,15 @@ FrameOutcome runFrame(const Rig& r, const Volume& organs, const Volume& parts, s
 }
 
 }  // namespace
+
+// The Volume a rig's `organs` argument holds. It is taken as an object (its read_notes are read
+// too), so the type is checked here: pybind's cast error would not say which argument it was.
+const Volume& organsVolume(const py::object& organs) {
+  if (!py::isinstance<Volume>(organs))
+    throw py::type_error("organs: expected a repose.Volume (read_volume, volume_from_array), got " +
+                         std::string(py::str(py::type::of(organs).attr("__name__"))));
+  return organs.cast<const Volume&>();
+}
 
 void bindPoses(py::module_& m) {
   py::class_<Pose>(m, "Pose", R"doc(

@@ -504,3 +504,58 @@ def test_a_pose_is_edited_by_the_workbenchs_rules(phantom):
     # The edited pose round-trips as a file.
     back = rp.Pose.from_json(p.to_json(), "back")
     assert back.to_json() == p.to_json()
+
+
+def test_a_live_session_drags_a_group_and_gives_the_three_slices(phantom):
+    """repose.LiveSession (Core's pose/LiveSession.h, what the workbench drives while a user drags):
+    a rig prepared once, a frame per drag, the axial, coronal and sagittal slices through a point
+    as numpy arrays of G's labels, S's parts or the image."""
+    g, s = phantom["organs"], phantom["parts"]
+    pose = rp.Pose.read(str(POSES / "elbow90.pose.json"))
+    live = rp.LiveSession(g, s, pose, skeleton=phantom["skeleton"], image=phantom["image"],
+                          cage_vertices=200)
+    assert not live.has_frame
+    assert live.slices() == {"axial": None, "coronal": None, "sagittal": None}
+    forearm = "left forearm and hand"
+    # The session's pose has its joints resolved: the elbow's pivot is a place (RAS mm).
+    elbow = live.pose.transform(forearm)["pivot"]
+
+    def in_front(slices):
+        """Labelled pixels of the axial slice in front of the rest body (RAS y beyond its box)."""
+        lo, hi = live.bounds
+        axial = slices["axial"]
+        pixel = max(hi[0] - lo[0], hi[1] - lo[1]) / 256
+        y = lo[1] + (np.arange(axial.shape[1]) + 0.5) * pixel
+        return int(np.count_nonzero(axial[:, y > rest_front]))
+
+    live.drag(forearm, angle_deg=0)
+    assert live.has_frame and live.frame_ms > 0
+    assert live.deformed.shape[1] == 3 and live.posed_cage.shape[1] == 3
+    assert np.all(live.bounds[0] < elbow) and np.all(elbow < live.bounds[1])
+    rest_front = live.bounds[1][1]
+    straight = live.slices(point=elbow)
+    labels = set(np.unique(np.concatenate([a.ravel() for a in straight.values()])))
+    assert labels <= set(g.label_volumes_ml()) | {0} and len(labels) > 5
+    for name, a in straight.items():
+        assert a.ndim == 2 and a.dtype == g.array.dtype, name
+    assert in_front(straight) == 0
+    # Dragged to 90 degrees the forearm points forward, out of the rest body's box.
+    live.drag(forearm, angle_deg=90)
+    bent = live.slices(point=elbow)
+    assert live.bounds[1][1] > rest_front + 100
+    assert in_front(bent) > 50
+    assert live.pose.transform(forearm)["angle_deg"] == 90
+    # S's parts and the image on the same planes; the prediction of the export's volumes.
+    parts = live.slices(point=elbow, layer="parts")
+    assert set(np.unique(parts["axial"])) <= set(s.label_volumes_ml()) | {0}
+    image = live.slices(point=elbow, layer="image")
+    assert all(image[k].shape == bent[k].shape for k in bent)
+    p = live.prediction
+    assert p["met"] and abs(p["body_change_percent"]) < 0.5 and p["missed"] == ""
+    # A pose file with its joint names is resolved as the prepared one was; other groups are not
+    # this session's.
+    assert live.solves(pose)
+    live.set_pose(pose)
+    assert live.has_frame
+    with pytest.raises(rp.Error, match="not those the rig was prepared for"):
+        live.set_pose(rp.Pose.new("other"))
