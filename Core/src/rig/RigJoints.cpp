@@ -203,8 +203,11 @@ V orientedAway(const V& axis, const V& from, const V& to) {
 }
 
 // A hinge (the elbow, the knee): the proximal bone's condyles roll about their line at the
-// joint; the line from the condyles when they say it, else the body's left-right line.
-FittedJoint fitHinge(const Bone& proximal, const V& along, const Bone& distal, const V& distalAxis,
+// joint; the line from the condyles when they say it, else the body's left-right line. Without
+// a distal bone (a map that labels the humerus and femur but not the forearm and shank bones, as
+// TotalSegmentator's `total` task does) the fit is the condyles' alone, the distal segment taken
+// along the proximal bone (`distalAxis` = `along`), and the method says so.
+FittedJoint fitHinge(const Bone& proximal, const V& along, const Bone* distal, const V& distalAxis,
                      JointKind kind, const V& anterior, const V& superior, int side, double voxel,
                      double minReach, const std::string& condyleName, const std::string& boneName,
                      const std::string& partnerName) {
@@ -216,14 +219,21 @@ FittedJoint fitHinge(const Bone& proximal, const V& along, const Bone& distal, c
   V axis = condyles ? *condyles : flexion;
   if (axis.dot(flexion) < 0) axis = -axis;
   const EndFit e = fitEnd(proximal, tip, -along, reach, &axis, voxel);
-  j.centre = e.ok ? e.centre : V(0.5 * (proximal.extreme(along) + distal.extreme(-along)));
+  // Without a fit: the gap to the distal bone, else the proximal bone's end.
+  j.centre = e.ok ? e.centre
+                  : (distal ? V(0.5 * (proximal.extreme(along) + distal->extreme(-along))) : tip);
   std::ostringstream method;
   if (e.ok)
     method << (condyles ? "roll of the " + condyleName + " about their line"
                         : "roll of the distal " + boneName + " about the body's left-right line")
            << " (radius " << std::lround(e.radius * 10) / 10.0 << " mm, " << e.points << " points)";
-  else
+  else if (distal)
     method << "middle of the gap between " << boneName << " and " << partnerName;
+  else
+    method << "the distal end of the " << boneName;
+  if (!distal)
+    method << "; no " << partnerName << " labelled: the segment beyond taken along the "
+           << boneName;
   j.method = method.str();
   j.rms = e.ok ? e.rms : -1;
   if (condyles) j.flexion = axis;
@@ -415,13 +425,20 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
     }
     if (H && F) {
       uf = orientedAway(F->axis, H->centroid, F->centroid);
-      add(fitHinge(*H, uh, *F, uf, JointKind::Elbow, ant, up, side, voxel, 20.0, "humeral condyles",
+      add(fitHinge(*H, uh, F, uf, JointKind::Elbow, ant, up, side, voxel, 20.0, "humeral condyles",
                    "humerus", "forearm bones"),
           JointKind::Elbow, "elbow" + sfx, side, partOf(BoneKind::Humerus, side),
           partOf(BoneKind::Forearm, side));
     } else if (H) {
-      missing.push_back("elbow" + sfx + ", wrist" + sfx + ": no " + sideWord +
-                        " radius or ulna found (the forearm stays with the upper arm)");
+      // The elbow from the humerus alone; the forearm (and the hand, without a wrist) is the arm
+      // beyond its plane.
+      add(fitHinge(*H, uh, nullptr, uh, JointKind::Elbow, ant, up, side, voxel, 20.0,
+                   "humeral condyles", "humerus", "radius or ulna"),
+          JointKind::Elbow, "elbow" + sfx, side, partOf(BoneKind::Humerus, side),
+          partOf(BoneKind::Forearm, side));
+      missing.push_back("wrist" + sfx + ": no " + sideWord +
+                        " radius or ulna found (the elbow is fitted from the humerus alone; the "
+                        "hand stays with the forearm)");
     }
     if (F && Hd) {
       const V uhd = orientedAway(Hd->axis, F->centroid, Hd->centroid);
@@ -468,13 +485,18 @@ std::vector<FittedJoint> fitJoints(const Bones& bones, std::vector<std::string>&
     }
     if (Fe && T) {
       ut = orientedAway(T->axis, Fe->centroid, T->centroid);
-      add(fitHinge(*Fe, ufe, *T, ut, JointKind::Knee, ant, up, side, voxel, 25.0,
-                   "femoral condyles", "femur", "tibia"),
+      add(fitHinge(*Fe, ufe, T, ut, JointKind::Knee, ant, up, side, voxel, 25.0, "femoral condyles",
+                   "femur", "tibia"),
           JointKind::Knee, "knee" + sfx, side, partOf(BoneKind::Femur, side),
           partOf(BoneKind::Shank, side));
     } else if (Fe) {
-      missing.push_back("knee" + sfx + ", ankle" + sfx + ": no " + sideWord +
-                        " tibia or fibula found (the shank stays with the thigh)");
+      add(fitHinge(*Fe, ufe, nullptr, ufe, JointKind::Knee, ant, up, side, voxel, 25.0,
+                   "femoral condyles", "femur", "tibia or fibula"),
+          JointKind::Knee, "knee" + sfx, side, partOf(BoneKind::Femur, side),
+          partOf(BoneKind::Shank, side));
+      missing.push_back("ankle" + sfx + ": no " + sideWord +
+                        " tibia or fibula found (the knee is fitted from the femur alone; the "
+                        "foot stays with the shank)");
     }
     if (T && Ft) {
       V ufoot = Ft->axis.dot(ant) >= 0 ? Ft->axis : V(-Ft->axis);  // heel to toes

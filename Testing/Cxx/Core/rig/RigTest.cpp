@@ -270,6 +270,82 @@ TEST(Rig, AnOrganSegmentationIsGivenItsBodyByTheScanItWasMadeFrom) {
   }
 }
 
+// TotalSegmentator's `total` task labels the humerus and the femur but no radius, ulna, hand,
+// tibia, fibula or foot bones (issue 65 item 2): the elbow and the knee are fitted from the
+// humeral and femoral condyles alone, within 10 mm of the full-label rig's (on this phantom the
+// same places: the full rig's fits are the condyles' too), rig.json says so per joint, and the
+// forearm and shank are the limb beyond their planes (the hand and foot with them, having no
+// wrist or ankle). Before, the rig made neither joint: the forearm stayed with the upper arm and
+// the shank with the thigh.
+TEST(Rig, AMapWithoutForearmAndShankBonesFitsElbowAndKneeFromTheHumerusAndFemur) {
+  PhantomOptions o;
+  o.voxelMm = 4;
+  o.armsResting = true;
+  const Phantom phantom(o);
+  const auto [G, S] = phantom.makeVolumes();
+  RigOptions ro;
+  ro.source = "total";
+  const RigResult full = rigBody(G, ro);
+  Volume organs = G;
+  int muscle = 0;
+  for (const Label& l : G.labels().labels())
+    if (l.name == "muscle") muscle = l.value;
+  ASSERT_GT(muscle, 0);
+  std::int64_t relabelled = 0;
+  for (std::int64_t i = 0; i < organs.numVoxels(); ++i) {
+    const Label* l = G.labels().find(int(G.valueAsDouble(i)));
+    const std::string name = l ? l->name : "";
+    if (name.rfind("radius_ulna", 0) == 0 || name.rfind("tibia_fibula", 0) == 0 ||
+        name == "hand_bones" || name == "foot_bones") {
+      organs.data<std::uint8_t>()[i] = std::uint8_t(muscle);
+      ++relabelled;
+    }
+  }
+  ASSERT_GT(relabelled, 1000);
+  const RigResult rig = rigBody(organs, ro);
+  const nlohmann::json joints = nlohmann::json::parse(rig.reportJson)["joints"];
+  for (const char* name : {"elbow_left", "elbow_right", "knee_left", "knee_right"}) {
+    SCOPED_TRACE(name);
+    const SkeletonJoint* a = full.skeleton.find(name);
+    const SkeletonJoint* b = rig.skeleton.find(name);
+    ASSERT_NE(a, nullptr);
+    ASSERT_NE(b, nullptr);
+    EXPECT_LT((a->centre - b->centre).norm(), 10.0);
+    bool said = false;
+    for (const auto& j : joints)
+      if (j["name"] == name)
+        said = j["method"].get<std::string>().find("labelled: the segment beyond taken along") !=
+               std::string::npos;
+    EXPECT_TRUE(said) << joints.dump();
+  }
+  for (const char* name : {"wrist_left", "wrist_right", "ankle_left", "ankle_right"})
+    EXPECT_EQ(rig.skeleton.find(name), nullptr) << name;
+  EXPECT_EQ(rig.missing.size(), 4u);
+  // The forearm (with the hand) and the shank (with the foot) are where the full rig puts them
+  // (here 96 % of the forearm and hand, 99.7 % of the shank and foot).
+  auto part = [&](const std::string& name) {
+    for (const Label& l : full.parts.labels().labels())
+      if (l.name == name) return l.value;
+    ADD_FAILURE() << "no part " << name;
+    return -1;
+  };
+  for (const std::string side : {"_left", "_right"}) {
+    const int upper = part("upper_arm" + side), forearm = part("forearm" + side),
+              hand = part("hand" + side), shank = part("shank" + side), foot = part("foot" + side);
+    std::int64_t distal = 0, same = 0, leg = 0, legSame = 0, upperArm = 0, upperSame = 0;
+    for (std::int64_t i = 0; i < S.numVoxels(); ++i) {
+      const int f = int(full.parts.valueAsDouble(i)), r = int(rig.parts.valueAsDouble(i));
+      if (f == forearm || f == hand) ++distal, same += r == forearm;
+      if (f == shank || f == foot) ++leg, legSame += r == shank;
+      if (f == upper) ++upperArm, upperSame += r == upper;
+    }
+    EXPECT_GT(distal, 1000);
+    EXPECT_GE(double(same) / double(distal), 0.95) << side;
+    EXPECT_GE(double(legSame) / double(leg), 0.95) << side;
+    EXPECT_GE(double(upperSame) / double(upperArm), 0.95) << side;
+  }
+}
+
 // 3D Slicer hands a CLI module its label maps as plain NRRD, without names: S's values are named
 // as the rig names them only when S has no table and every value is one of the rig's parts.
 TEST(Rig, AnUnnamedBodyPartMapIsNamedByTheRigsConventionOnlyWhenItFits) {
