@@ -1,7 +1,8 @@
 // A live session: one body's rig prepared once for interaction, then one frame per change of the
 // pose (warm-started from the last, at preview precision) and the slices a workbench's views ask
 // for, in one call. What the workbench's Logic drives while a user drags the cage; a script
-// drives it the same way (Python's repose.LiveSession, docs/PYTHON.md). It holds parsed poses only: an edit hands it a Pose, never text.
+// drives it the same way (Python's repose.LiveSession, docs/PYTHON.md). It holds parsed poses only:
+// an edit hands it a Pose, never text.
 //
 // Preparing (the constructor: Green coordinates, the factorizations, the joints' anchors) is the
 // long step, for a worker thread. setPose and the queries are for one thread at a time.
