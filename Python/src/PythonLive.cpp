@@ -22,6 +22,9 @@ namespace repose::python {
 namespace {
 
 struct Live {
+  // The session's own copies of G and S, which the job reads by reference: declared first, so
+  // they outlive the job and the session (a script may change or drop its Volumes meanwhile).
+  std::shared_ptr<const Volume> organs, parts;
   std::unique_ptr<PoseJob> job;
   std::unique_ptr<LiveSession> session;
   Pose pose;  // the last pose set (else the prepared one), its joints resolved: what drag edits
@@ -77,20 +80,20 @@ milliseconds to a fraction of a second. Frames are for one thread at a time.)doc
              request.settings.threads = threads;
              auto live = std::make_unique<Live>();
              live->skeleton = request.skeleton;
-             // The session keeps its own copies of G (and the image): a script may change or
-             // drop its Volumes while the session lives.
+             live->organs = std::make_shared<const Volume>(organs);
+             live->parts = std::make_shared<const Volume>(parts);
              LiveInputs inputs;
-             inputs.labels = std::make_shared<const Volume>(organs);
+             inputs.labels = live->organs;
              inputs.partLabels = parts.labels();
              inputs.skeleton = request.skeleton;
              if (!image.is_none())
                inputs.image = std::make_shared<const Volume>(image.cast<const Volume&>());
              withProgress(progress, [&](const ProgressFn& fn) {
                live->job =
-                   std::make_unique<PoseJob>(pose, *inputs.labels, parts, std::move(request));
+                   std::make_unique<PoseJob>(pose, *live->organs, *live->parts, std::move(request));
                live->session = std::make_unique<LiveSession>(
                    *live->job, live->job->buildGeometry(fn), std::move(inputs), fn);
-               live->session->setParts(std::make_shared<const Volume>(parts));
+               live->session->setParts(live->parts);
                live->pose = live->job->userPose();
                return 0;
              });
