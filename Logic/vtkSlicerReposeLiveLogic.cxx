@@ -12,6 +12,7 @@
 #include "vtkSlicerReposeMeshConversion.h"
 #include "vtkSlicerReposeVolumeConversion.h"
 
+#include <repose/pose/LivePredictionWorker.h>
 #include <repose/pose/LiveSession.h>
 #include <repose/pose/PoseJob.h>
 #include <repose/util/Error.h>
@@ -26,7 +27,8 @@ namespace Inputs = vtkSlicerReposeLogicInputs;
 
 vtkStandardNewMacro(vtkSlicerReposeLiveLogic);
 
-vtkSlicerReposeLiveLogic::vtkSlicerReposeLiveLogic() = default;
+vtkSlicerReposeLiveLogic::vtkSlicerReposeLiveLogic()
+    : Predictions(std::make_unique<repose::LivePredictionWorker>()) {}
 
 vtkSlicerReposeLiveLogic::~vtkSlicerReposeLiveLogic() {
   this->ReleaseLivePose();
@@ -146,6 +148,8 @@ void vtkSlicerReposeLiveLogic::OnLivePoseModified() {
 void vtkSlicerReposeLiveLogic::ReleaseLivePose() {
   if (this->Pose) this->Pose->RemoveObserver(this->PoseObserverTag);
   this->Pose = nullptr;
+  this->Predictions->cancel();
+  ++this->FrameSerial;
   this->Session.reset();
   this->Cage = this->Body = nullptr;
 }
@@ -166,6 +170,9 @@ bool vtkSlicerReposeLiveLogic::UpdateLiveFrame() {
 }
 
 bool vtkSlicerReposeLiveLogic::SolveLiveFrame() {
+  // A prediction of the last frame is stale now: stopped, so it leaves the cores to the drag.
+  this->Predictions->cancel();
+  ++this->FrameSerial;
   const bool solved = this->Context->Guarded<bool>(false, [&] {
     // The node's pose, as the last edit left it: parsed when it was read, never here.
     this->Session->setPose(Inputs::PoseOf(this->Pose),
@@ -217,10 +224,10 @@ std::vector<std::pair<int, std::string>> vtkSlicerReposeLiveLogic::GetLiveBodyPa
   return parts;
 }
 
-vtkSlicerReposeLiveLogic::LivePrediction vtkSlicerReposeLiveLogic::GetLivePrediction() {
-  if (!this->Session || !this->Session->hasFrame()) return {};
-  const repose::LivePrediction& p = this->Session->prediction();
-  LivePrediction out;
+namespace {
+
+vtkSlicerReposeLiveLogic::LivePrediction toLogic(const repose::LivePrediction& p) {
+  vtkSlicerReposeLiveLogic::LivePrediction out;
   out.valid = true;
   out.bodyChangePercent = p.bodyChangePercent;
   out.worstPart = p.worstPart;
@@ -228,6 +235,29 @@ vtkSlicerReposeLiveLogic::LivePrediction vtkSlicerReposeLiveLogic::GetLivePredic
   out.worstPartChangePercent = p.worstPartChangePercent;
   out.met = p.met;
   out.missed = p.missed;
+  return out;
+}
+
+}  // namespace
+
+vtkSlicerReposeLiveLogic::LivePrediction vtkSlicerReposeLiveLogic::GetLivePrediction() {
+  if (!this->Session || !this->Session->hasFrame()) return {};
+  // The worker's, if it predicts this frame; else computed here.
+  if (this->Predictions->state(this->FrameSerial) != repose::LivePredictionWorker::State::None)
+    if (const auto p = this->Predictions->wait(this->FrameSerial)) return toLogic(*p);
+  return toLogic(this->Session->prediction());
+}
+
+void vtkSlicerReposeLiveLogic::RequestLivePrediction() {
+  if (!this->Session || !this->Session->hasFrame()) return;
+  this->Predictions->start(this->FrameSerial, this->Session->predictionJob());
+}
+
+vtkSlicerReposeLiveLogic::LivePrediction vtkSlicerReposeLiveLogic::PeekLivePrediction() {
+  if (const auto p = this->Predictions->ready(this->FrameSerial)) return toLogic(*p);
+  LivePrediction out;
+  out.pending =
+      this->Predictions->state(this->FrameSerial) == repose::LivePredictionWorker::State::Running;
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include <vtkSmartPointer.h>
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -21,7 +22,8 @@
 
 namespace repose {
 class LiveSession;
-}
+class LivePredictionWorker;
+}  // namespace repose
 class vtkMRMLReposePoseNode;
 struct vtkSlicerReposeLogicContext;
 
@@ -58,10 +60,13 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLiveLogic : public vt
   std::vector<int> GetLiveCageVerticesOfPart(int label) const;
   std::vector<std::pair<int, std::string>> GetLiveBodyParts() const;
   // What the live frame predicts of the export's volumes (repose::LivePrediction: the frame
-  // restored as the export restores it, then the volume change per part), once per frame when
-  // asked: the panel asks when a drag ends.
+  // restored as the export restores it, then the volume change per part), once per frame.
+  // The panel asks for it when a drag ends (RequestLivePrediction: on a worker thread, a new
+  // frame cancels it) and shows it when PeekLivePrediction has it, so its event loop never waits
+  // on it; GetLivePrediction waits (scripts, tests).
   struct LivePrediction {
     bool valid = false;
+    bool pending = false;  // PeekLivePrediction: being computed for the frame at hand
     double bodyChangePercent = 0;
     std::string worstPart, draggedBy;
     double worstPartChangePercent = 0;
@@ -69,6 +74,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLiveLogic : public vt
     std::string missed;  // one line, "" when met
   };
   LivePrediction GetLivePrediction();
+  void RequestLivePrediction();
+  LivePrediction PeekLivePrediction();
   // The data probe's input side: G at rest at a RAS point (the nearest voxel's label; -1 outside
   // its grid or without a live pose), a label's display name, a body part's name.
   int GetLiveRestLabelAt(double r, double a, double s) const;
@@ -119,6 +126,8 @@ class VTK_SLICER_REPOSE_MODULE_LOGIC_EXPORT vtkSlicerReposeLiveLogic : public vt
 
   std::shared_ptr<vtkSlicerReposeLogicContext> Context;
   std::shared_ptr<repose::LiveSession> Session;
+  std::unique_ptr<repose::LivePredictionWorker> Predictions;
+  std::uint64_t FrameSerial = 0;  // one per solved frame: which frame a prediction is of
   vtkSmartPointer<vtkMRMLReposePoseNode> Pose;
   unsigned long PoseObserverTag = 0;
   vtkSmartPointer<vtkPolyData> Cage, Body;

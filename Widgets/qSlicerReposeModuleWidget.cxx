@@ -47,6 +47,8 @@ class qSlicerReposeModuleWidgetPrivate : public Ui_qSlicerReposeModuleWidget {
   unsigned long LogicObserverTag = 0;
   unsigned long NodeObserverTag = 0;
   QTimer JobTimer;
+  // Polls the live prediction the worker computes after a drag (the event loop never waits).
+  QTimer PredictionTimer;
   enum class Step { None, OrganRig, Rig, Refine, Live, Export } RunningStep = Step::None;
   QString JobStatus = "Idle.";
   bool Updating = false;
@@ -127,6 +129,9 @@ qSlicerReposeModuleWidget::qSlicerReposeModuleWidget(QWidget* parent)
   d->setupUi(this);
   d->JobTimer.setInterval(100);
   connect(&d->JobTimer, &QTimer::timeout, this, &qSlicerReposeModuleWidget::onJobTimer);
+  d->PredictionTimer.setInterval(25);
+  connect(&d->PredictionTimer, &QTimer::timeout, this,
+          &qSlicerReposeModuleWidget::onPredictionTimer);
   d->JobStatusLabel->setWordWrap(true);  // "Rigged (...)", errors: whole, not cut at the edge
   d->LiveStatusLabel->setWordWrap(true);
   // The Joint row, under the Angle row of the Pose section.
@@ -602,6 +607,13 @@ QString qSlicerReposeModuleWidget::jobStatusText() const {
   return d->JobStatus;
 }
 
+void qSlicerReposeModuleWidget::onPredictionTimer() {
+  Q_D(qSlicerReposeModuleWidget);
+  if (d->Logic && d->Logic->GetLive()->PeekLivePrediction().pending) return;
+  d->PredictionTimer.stop();
+  this->updateWidgetFromMRML();  // the prediction, or the next frame's request
+}
+
 void qSlicerReposeModuleWidget::onJobTimer() {
   Q_D(qSlicerReposeModuleWidget);
   using Step = qSlicerReposeModuleWidgetPrivate::Step;
@@ -946,14 +958,19 @@ void qSlicerReposeModuleWidget::updateWidgetFromMRML() {
   QString liveText = pose ? "Build the cage and mesh to pose live." : "No pose loaded.";
   if (live) {
     // What the export will show, predicted from the live frame's transfer mesh: after a drag,
-    // not during it (it costs about as much as the frame and the three slices together).
+    // not during it (it costs about as much as the frame and the three slices together), on the
+    // Logic's worker: shown when it is ready (onPredictionTimer), "predicting" meanwhile.
     const bool dragging =
         d->AngleSlider->isSliderDown() || d->Logic->GetPoseEdits()->IsPoseInteractionActive();
-    const vtkSlicerReposeLiveLogic::LivePrediction p =
-        dragging ? vtkSlicerReposeLiveLogic::LivePrediction{}
-                 : d->Logic->GetLive()->GetLivePrediction();
+    vtkSlicerReposeLiveLogic::LivePrediction p;
+    if (!dragging) {
+      d->Logic->GetLive()->RequestLivePrediction();
+      p = d->Logic->GetLive()->PeekLivePrediction();
+    }
+    if (p.pending && !d->PredictionTimer.isActive()) d->PredictionTimer.start();
     liveText = QString("Live: frame solved in %1 ms")
                    .arg(d->Logic->GetLive()->GetLiveFrameMilliseconds(), 0, 'f', 1);
+    if (p.pending) liveText += "; predicting the export's volumes...";
     if (p.valid) {
       liveText += QString("; body volume %1%2 % (predicted)")
                       .arg(p.bodyChangePercent >= 0 ? "+" : "")

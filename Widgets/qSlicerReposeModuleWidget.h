@@ -102,6 +102,7 @@ class QSLICER_REPOSE_MODULE_WIDGETS_EXPORT qSlicerReposeModuleWidget : public QW
   void onPosePathEditingFinished();
   void onPoseBrowseClicked();
   void onJobTimer();
+  void onPredictionTimer();
   void onAngleSliderPressed();
   void onAngleSliderReleased();
   void onAngleChanged(int angle);

@@ -215,6 +215,7 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
     }
     report.sweeps = sweep + 1;
     report.invertedAfter = countInverted();
+    if (options.cancel && options.cancel->load()) break;
     if (report.invertedAfter == 0 && moved < 1e-3) break;
     // Sweeps that turn no more tets back: a sharper barrier (a smaller delta) pushes the tets
     // still slightly inside out harder, as Escobar et al. lower delta as the mesh untangles.

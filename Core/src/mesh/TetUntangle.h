@@ -21,6 +21,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <atomic>
 #include <utility>
 #include <vector>
 
@@ -58,7 +59,8 @@ struct UntangleOptions {
   // -0.462 % with 1e8 (-0.438 % without untangling; the same development build): the weaker hold
   // lets the fold take tissue.
   double kappa = 1e8;
-  int stepsPerVertex = 4;  // descent steps per vertex per sweep
+  int stepsPerVertex = 4;                     // descent steps per vertex per sweep
+  const std::atomic<bool>* cancel = nullptr;  // set by another thread: stop after the sweep
 };
 
 struct UntangleReport {

@@ -20,6 +20,12 @@ double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
+// A label's name in `table`, else its number.
+std::string nameIn(const LabelTable& table, int value) {
+  if (const Label* l = table.find(value); l && !l->name.empty()) return l->name;
+  return std::to_string(value);
+}
+
 // CT's soft-tissue window when the values are Hounsfield units (air near -1000), else the
 // 1st..99th percentile of a sample of at most about 200,000 voxels.
 std::optional<LiveSession::ImageWindow> windowOf(const Volume& image, double background) {
@@ -163,44 +169,52 @@ std::optional<LiveSession::ImageWindow> LiveSession::imageWindow() const {
 }
 
 std::string LiveSession::partName(int value) const {
-  if (const Label* l = inputs_.partLabels.find(value); l && !l->name.empty()) return l->name;
-  return std::to_string(value);
+  return nameIn(inputs_.partLabels, value);
 }
 
 const LivePrediction& LiveSession::prediction() const {
   if (prediction_) return *prediction_;
-  if (!hasFrame()) throw Error("no live frame to predict from");
-  Eigen::MatrixX3d restored = deformed_;
-  rig_->restoreFrameVolumes(restored, handles_);
-  const VolumePrediction p = predictVolumeChange(rig_->mesh(), restored);
-  LivePrediction out;
-  out.bodyChangePercent = p.changePercent();
-  auto name = [&](int part) { return part == 0 ? std::string() : partName(part); };
-  out.worstPart = name(p.worstPart);
-  out.draggedBy = name(p.draggedBy);
-  for (const PartVolumeChange& c : p.parts)
-    if (c.part == p.worstPart) out.worstPartChangePercent = c.changePercent();
-  // The part furthest from its volume in percent, against the per-part target.
-  const PartVolumeChange* furthest = nullptr;
-  for (const PartVolumeChange& c : p.parts)
-    if (c.restMm3 > 0 &&
-        (!furthest || std::fabs(c.changePercent()) > std::fabs(furthest->changePercent())))
-      furthest = &c;
-  char text[160];
-  if (std::fabs(out.bodyChangePercent) > kBodyTargetPercent) {
-    std::snprintf(text, sizeof text, "body %+.2f %% (target within 0.5 %%)", out.bodyChangePercent);
-    out.missed = text;
-  }
-  if (furthest && std::fabs(furthest->changePercent()) > kLabelTargetPercent) {
-    std::snprintf(text, sizeof text, "%s %+.2f %% (target within 1 %%)",
-                  name(furthest->part).c_str(), furthest->changePercent());
-    out.missed += (out.missed.empty() ? "" : "; ") + std::string(text);
-    out.worstPart = name(furthest->part);
-    out.worstPartChangePercent = furthest->changePercent();
-  }
-  out.met = out.missed.empty();
-  prediction_ = out;
+  prediction_ = predictionJob()(nullptr);
   return *prediction_;
+}
+
+LiveSession::PredictionJob LiveSession::predictionJob() const {
+  if (!hasFrame()) throw Error("no live frame to predict from");
+  // By value: the frame, the handles, the part names; the rig by a share of it.
+  return [rig = rig_, restored = deformed_, handles = handles_, names = inputs_.partLabels](
+             const std::atomic<bool>* cancel) mutable -> std::optional<LivePrediction> {
+    const VolumeRestorationReport r = rig->restoreFrameVolumes(restored, handles, cancel);
+    if (r.cancelled || (cancel && cancel->load())) return std::nullopt;
+    const VolumePrediction p = predictVolumeChange(rig->mesh(), restored);
+    LivePrediction out;
+    out.bodyChangePercent = p.changePercent();
+    auto name = [&](int part) { return part == 0 ? std::string() : nameIn(names, part); };
+    out.worstPart = name(p.worstPart);
+    out.draggedBy = name(p.draggedBy);
+    for (const PartVolumeChange& c : p.parts)
+      if (c.part == p.worstPart) out.worstPartChangePercent = c.changePercent();
+    // The part furthest from its volume in percent, against the per-part target.
+    const PartVolumeChange* furthest = nullptr;
+    for (const PartVolumeChange& c : p.parts)
+      if (c.restMm3 > 0 &&
+          (!furthest || std::fabs(c.changePercent()) > std::fabs(furthest->changePercent())))
+        furthest = &c;
+    char text[160];
+    if (std::fabs(out.bodyChangePercent) > kBodyTargetPercent) {
+      std::snprintf(text, sizeof text, "body %+.2f %% (target within 0.5 %%)",
+                    out.bodyChangePercent);
+      out.missed = text;
+    }
+    if (furthest && std::fabs(furthest->changePercent()) > kLabelTargetPercent) {
+      std::snprintf(text, sizeof text, "%s %+.2f %% (target within 1 %%)",
+                    name(furthest->part).c_str(), furthest->changePercent());
+      out.missed += (out.missed.empty() ? "" : "; ") + std::string(text);
+      out.worstPart = name(furthest->part);
+      out.worstPartChangePercent = furthest->changePercent();
+    }
+    out.met = out.missed.empty();
+    return out;
+  };
 }
 
 std::vector<LiveJoint> LiveSession::joints() const {

@@ -367,7 +367,8 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
                                   {"worst_part_after_percent", vr.worstPartAfter},
                                   {"inverted_tets_before", vr.invertedBefore},
                                   {"inverted_tets_after", vr.invertedAfter},
-                                  {"untangled_tets", vr.untangled}};
+                                  {"untangled_tets", vr.untangled},
+                                  {"untangle_relaxed", vr.relaxedUntangle}};
   report["bone_collisions"] = collisions;
   report.update(nlohmann::json::parse(poseReportJson(ri)));
   // The labels whose rounding did not hold: named, and said (docs/FORMATS.md).

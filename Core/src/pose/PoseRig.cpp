@@ -411,8 +411,9 @@ PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partL
 
 PoseRig::~PoseRig() = default;
 
-VolumeRestorationReport PoseRig::restoreFrameVolumes(
-    Eigen::MatrixX3d& deformed, const std::vector<RigidHandle>& handles) const {
+VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
+                                                     const std::vector<RigidHandle>& handles,
+                                                     const std::atomic<bool>* cancel) const {
   if (!restoreVolumes_) return {};
   const TransferMesh& m = geometry_.mesh;
   std::vector<char> zone = bends_.empty() ? std::vector<char>(std::size_t(m.vertices.rows()), 0)
@@ -454,7 +455,9 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(
   }
   if (!anything) return {};
   std::vector<char> held = bends_.empty() ? std::vector<char>() : bends_.reachTets(m, handles);
-  return restoreVolumes(m, grown, deformed, {}, held, tissues_.empty() ? nullptr : &tissues_);
+  VolumeRestorationOptions options;
+  options.cancel = cancel;
+  return restoreVolumes(m, grown, deformed, options, held, tissues_.empty() ? nullptr : &tissues_);
 }
 
 std::vector<std::pair<std::string, int>> PoseRig::invertedTetsByJoint(

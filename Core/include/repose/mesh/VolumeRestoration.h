@@ -25,6 +25,7 @@
 
 #include <Eigen/Core>
 
+#include <atomic>
 #include <utility>
 #include <vector>
 
@@ -58,6 +59,16 @@ struct VolumeRestorationOptions {
   // Sweeps of the untangling (TetUntangle.h) over the free vertices when tets are left inside out
   // (a crease); 0: none.
   int untangleRounds = 120;
+  // When tets are still inside out after those sweeps: up to this many sweeps again under this
+  // weaker hold of the volumes (TetUntangle.h's kappa, which is 1e8 in the first sweeps; 0:
+  // none). 1e6 let the tissue go more (body -0.56 % against -0.55 % at 3e6, both arms up 160
+  // degrees on the 2 mm phantom); 1e7 left 2 of those 6 tets inside out.
+  double relaxedKappa = 3e6;
+  int relaxedSweeps = 600;
+  // Set by another thread to stop early (a live prediction a new drag made stale): checked
+  // between rounds and sweeps; the positions are then left wherever they are and `cancelled` is
+  // reported.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct VolumeRestorationReport {
@@ -70,6 +81,10 @@ struct VolumeRestorationReport {
   double worstPartAfter = 0;
   int invertedBefore = 0, invertedAfter = 0;
   int untangled = 0;  // tets the untangling turned right side out
+  // Tets were still inside out after the untangling's sweeps, and it swept again under the
+  // weaker hold (kept only when that left fewer inside out).
+  bool relaxedUntangle = false;
+  bool cancelled = false;  // stopped by VolumeRestorationOptions::cancel: the result means nothing
 };
 
 // `movable[v]`: whether vertex v may be moved at all (the soft tissue of the joints' bends; never

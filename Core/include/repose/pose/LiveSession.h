@@ -19,7 +19,9 @@
 
 #include <Eigen/Core>
 
+#include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -109,6 +111,13 @@ class LiveSession {
 
   // Computed once per frame, when asked (the restoration and a pass over every tet).
   const LivePrediction& prediction() const;
+  // The same prediction as a job for another thread, so a workbench's event loop never waits on
+  // it (a few hundred milliseconds on a whole body): it holds a copy of the frame at hand and a
+  // share of the rig, so the session may solve further frames, or be dropped, while it runs.
+  // Setting `cancel` stops it at its next round (a new drag made it stale): it then returns
+  // nothing.
+  using PredictionJob = std::function<std::optional<LivePrediction>(const std::atomic<bool>*)>;
+  PredictionJob predictionJob() const;
   // The skeleton's joints where the frame puts them: centres anchored once in the rest mesh,
   // axes turned by the deformation gradient of the tissue there. Empty without a skeleton.
   std::vector<LiveJoint> joints() const;
@@ -126,7 +135,7 @@ class LiveSession {
 
   LiveInputs inputs_;
   std::shared_ptr<const Volume> parts_;
-  std::unique_ptr<PoseRig> rig_;
+  std::shared_ptr<const PoseRig> rig_;  // shared with prediction jobs still running
   std::vector<std::uint8_t> outerFaces_;
   Eigen::MatrixX3d deformed_, posedCage_;
   std::vector<RigidHandle> handles_;  // the frame's groups with their motions

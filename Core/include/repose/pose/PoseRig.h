@@ -209,8 +209,10 @@ class PoseRig {
   // motions say which joints bend). It acts in the joints' bends only, the soft tissue the bends
   // place and one ring of tets around them: tissue dragged along elsewhere (two parts tied along
   // a contact no cut freed) keeps the volume change that says so. Nothing when it is off.
+  // `cancel`: VolumeRestorationOptions::cancel.
   VolumeRestorationReport restoreFrameVolumes(Eigen::MatrixX3d& deformed,
-                                              const std::vector<RigidHandle>& handles) const;
+                                              const std::vector<RigidHandle>& handles,
+                                              const std::atomic<bool>* cancel = nullptr) const;
 
  private:
   enum class CageStart { Rest, LastLiveFrame };

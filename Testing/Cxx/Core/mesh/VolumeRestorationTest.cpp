@@ -153,3 +153,37 @@ TEST(VolumeRestoration, ACreaseFoldedInsideOutIsUntangledWithItsPartsVolumesKept
   }
   EXPECT_LT(b.worstPartAfter, 0.1);
 }
+
+// A fold pinned by vertices that may not move (a bone's, here a plate crushed with the tissue
+// and held where the crush put it): the untangling cannot turn every tet back. Its second sweeps
+// under a weaker hold (VolumeRestorationOptions::relaxedKappa) are tried and never leave more
+// tets inside out than the first did; unpinned, the first sweeps suffice and no second is tried.
+TEST(VolumeRestoration, ASecondUntanglingUnderAWeakerHoldNeverLeavesMoreTetsInsideOut) {
+  const TransferMesh m = twoParts();
+  const Eigen::Vector3d centre(40, 20, 20);
+  const Eigen::MatrixX3d folded = crushed(m, centre, 18, -0.8);
+  std::vector<char> free(std::size_t(m.vertices.rows()), 0), pinned;
+  for (Eigen::Index v = 0; v < m.vertices.rows(); ++v) {
+    const Eigen::Vector3d p = m.vertices.row(v);
+    free[std::size_t(v)] =
+        (p - centre).norm() < 30 && p.y() > 1 && p.y() < 39 && p.z() > 1 && p.z() < 39;
+  }
+  pinned = free;
+  for (Eigen::Index v = 0; v < m.vertices.rows(); ++v) {
+    const Eigen::Vector3d p = m.vertices.row(v);
+    if (std::fabs(p.z() - 20) < 1 && std::fabs(p.x() - 40) < 12) pinned[std::size_t(v)] = 0;
+  }
+  VolumeRestorationOptions strictOnly;
+  strictOnly.relaxedKappa = 0;
+  Eigen::MatrixX3d a = folded, b = folded, c = folded;
+  const VolumeRestorationReport strict = restoreVolumes(m, pinned, a, strictOnly);
+  const VolumeRestorationReport both = restoreVolumes(m, pinned, b);
+  ASSERT_GT(strict.invertedAfter, 0);
+  EXPECT_FALSE(strict.relaxedUntangle);
+  EXPECT_TRUE(both.relaxedUntangle);
+  EXPECT_LE(both.invertedAfter, strict.invertedAfter);
+  EXPECT_LT(both.worstPartAfter, 0.1);
+  const VolumeRestorationReport unpinned = restoreVolumes(m, free, c);
+  EXPECT_EQ(unpinned.invertedAfter, 0);
+  EXPECT_FALSE(unpinned.relaxedUntangle);
+}

@@ -5,6 +5,7 @@
 #include "TestPoses.h"
 
 #include "repose/phantom/Phantom.h"
+#include "repose/pose/LivePredictionWorker.h"
 #include "repose/pose/LiveSession.h"
 #include "repose/pose/PoseEdit.h"
 #include "repose/pose/PoseJob.h"
@@ -205,4 +206,37 @@ TEST(LiveSession, AnImageLayerAndItsWindow) {
   ASSERT_GT(tissue, 0);
   EXPECT_GT(double(air), 0.9 * double(empty));
   EXPECT_GT(double(dense), 0.9 * double(tissue));
+}
+
+// The prediction off the caller's thread (LivePredictionWorker, what the workbench's panel uses
+// when a drag ends): the same figures as prediction(), while the session goes on solving frames;
+// a newer frame's job cancels the older one, whose answer is never given; a set cancel flag
+// stops a job with nothing.
+TEST(LiveSession, PredictionJobsRunOffTheCallersThreadAndANewerFrameCancelsTheOlder) {
+  LiveSession& live = *body().session;
+  live.setPose(elbowAt(90), 0);
+  const LivePrediction expected = live.prediction();
+  LivePredictionWorker worker;
+  EXPECT_EQ(worker.state(1), LivePredictionWorker::State::None);
+  worker.start(1, live.predictionJob());
+  live.setPose(elbowAt(45), 0);  // the session solves on while the job runs on its own copy
+  const std::optional<LivePrediction> got = worker.wait(1);
+  ASSERT_TRUE(got);
+  EXPECT_EQ(worker.state(1), LivePredictionWorker::State::Ready);
+  EXPECT_DOUBLE_EQ(got->bodyChangePercent, expected.bodyChangePercent);
+  EXPECT_EQ(got->worstPart, expected.worstPart);
+  EXPECT_EQ(got->met, expected.met);
+
+  worker.start(2, live.predictionJob());
+  worker.start(3, live.predictionJob());  // frame 2's job is cancelled
+  EXPECT_EQ(worker.state(2), LivePredictionWorker::State::None);
+  EXPECT_FALSE(worker.ready(2));
+  const std::optional<LivePrediction> third = worker.wait(3);
+  ASSERT_TRUE(third);
+  EXPECT_DOUBLE_EQ(third->bodyChangePercent, live.prediction().bodyChangePercent);
+
+  std::atomic<bool> cancelled{true};
+  EXPECT_FALSE(live.predictionJob()(&cancelled));
+  worker.cancel();
+  EXPECT_EQ(worker.state(3), LivePredictionWorker::State::None);
 }
