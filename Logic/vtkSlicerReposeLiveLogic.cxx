@@ -250,6 +250,9 @@ vtkSlicerReposeLiveLogic::LivePrediction vtkSlicerReposeLiveLogic::GetLivePredic
 
 void vtkSlicerReposeLiveLogic::RequestLivePrediction() {
   if (!this->Session || !this->Session->hasFrame()) return;
+  // The panel asks on every update: the job (a copy of the frame) is made once per frame.
+  if (this->Predictions->state(this->FrameSerial) != repose::LivePredictionWorker::State::None)
+    return;
   this->Predictions->start(this->FrameSerial, this->Session->predictionJob());
 }
 

@@ -85,10 +85,4 @@ std::optional<LivePrediction> LivePredictionWorker::wait(std::uint64_t frame) {
   return current_->shared->result;
 }
 
-std::string LivePredictionWorker::error(std::uint64_t frame) const {
-  if (!current_ || current_->frame != frame) return {};
-  const std::lock_guard<std::mutex> lock(current_->shared->mutex);
-  return current_->shared->error;
-}
-
 }  // namespace repose

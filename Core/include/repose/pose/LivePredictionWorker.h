@@ -32,14 +32,14 @@ class LivePredictionWorker {
   // Cancels the running job, if any (a new frame is being solved).
   void cancel();
   enum class State { None, Running, Ready, Failed };
-  // Frame `frame`'s job: never started (or cancelled), running, done, or failed (`error`).
+  // Frame `frame`'s job: never started (or cancelled), running, done, or failed (it threw: the
+  // caller's own LiveSession::prediction() says why).
   State state(std::uint64_t frame) const;
   // Its prediction when Ready, without waiting.
   std::optional<LivePrediction> ready(std::uint64_t frame) const;
   // Waits for frame `frame`'s job if it runs; its prediction, or nothing (never started,
   // cancelled, failed).
   std::optional<LivePrediction> wait(std::uint64_t frame);
-  std::string error(std::uint64_t frame) const;
 
  private:
   struct Shared {
