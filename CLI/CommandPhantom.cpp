@@ -81,6 +81,10 @@ int runPhantom(const Args& args) {
               "phantom's grid) instead of its anatomical 4-10 mm; they cross the axilla, the "
               "elbow, the groin and the knee",
               "0")
+      .flag("girdles-touching",
+            "with --arms-resting, the clavicles' medial ends meet over the manubrium, so the two "
+            "shoulder girdles touch across the sternum (as on reference phantoms whose clavicles "
+            "reach the midline); both arms raised pull them apart")
       .option("labels", "NAME",
               "phantom (its own labels, named in the file) or icrp110 (ICRP 110 organ IDs on "
               "ICRP's array order, no label table: a converted reference phantom)",
@@ -123,6 +127,9 @@ int runPhantom(const Args& args) {
                      parser.get("vessel-mm")};
   if (options.limbVesselMm > 0 && !options.armsResting)
     throw UsageError{"--vessel-mm needs --arms-resting"};
+  options.girdlesTouching = parser.has("girdles-touching");
+  if (options.girdlesTouching && !options.armsResting)
+    throw UsageError{"--girdles-touching needs --arms-resting"};
   if (parser.has("spacing")) {
     const std::string text = parser.get("spacing");
     double v[3];
@@ -201,6 +208,7 @@ int runPhantom(const Args& args) {
         {"handGapMm", options.handGapMm},
         {"forearmGapMm", options.forearmGapMm},
         {"limbVesselMm", options.limbVesselMm},
+        {"girdlesTouching", options.girdlesTouching},
         {"labels", labels},
         {"originRas", {o.x(), o.y(), o.z()}},
         {"numVoxels", g.numVoxels()},

@@ -261,7 +261,7 @@ that needs more is refused with the numbers before anything is allocated.)doc");
   m.def(
       "make_phantom",
       [](double voxelMm, bool armsTouching, bool image, bool armsResting, const py::object& spacing,
-         double handGapMm, double forearmGapMm, double vesselMm) {
+         double handGapMm, double forearmGapMm, double vesselMm, bool girdlesTouching) {
         PhantomOptions o;
         o.voxelMm = voxelMm;
         o.armsTouching = armsTouching;
@@ -269,6 +269,7 @@ that needs more is refused with the numbers before anything is allocated.)doc");
         o.handGapMm = handGapMm;
         o.forearmGapMm = forearmGapMm;
         o.limbVesselMm = vesselMm;
+        o.girdlesTouching = girdlesTouching;
         if (!spacing.is_none()) o.spacingMm = spacing.cast<Eigen::Vector3d>();
         std::pair<Volume, Volume> maps;
         std::optional<Volume> ct;
@@ -290,13 +291,15 @@ that needs more is refused with the numbers before anything is allocated.)doc");
       py::arg("voxel_mm") = 2.0, py::arg("arms_touching") = false, py::arg("image") = false,
       py::arg("arms_resting") = false, py::arg("spacing_mm") = py::none(),
       py::arg("hand_gap_mm") = 0.0, py::arg("forearm_gap_mm") = 0.0, py::arg("vessel_mm") = 0.0,
+      py::arg("girdles_touching") = false,
       R"doc(The synthetic mannequin in memory: {'organs': G, 'parts': S, 'skeleton': Skeleton[,
 'image': CT]} (`repose phantom` writes the same to files). arms_resting: the arms against the
 trunk, hands on the thighs, thighs touching, with vessels and bone marrow; spacing_mm: (x, y, z)
 voxel sizes instead of voxel_mm; hand_gap_mm, forearm_gap_mm (with arms_resting): the hands and
 forearms held that far off the thighs and the trunk, as in real reference phantoms; vessel_mm
 (with arms_resting): every limb vessel that many mm across, about a voxel as in reference
-phantoms (0: anatomical).)doc");
+phantoms (0: anatomical); girdles_touching (with arms_resting): the clavicles meet over the
+manubrium, so the two shoulder girdles touch across the sternum.)doc");
 }
 
 }  // namespace repose::python

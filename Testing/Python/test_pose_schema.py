@@ -14,7 +14,7 @@ SUITE = sorted((REPO / "bench" / "poses").glob("*.pose.json"))
 
 
 def test_the_suite_is_valid():
-    assert len(SUITE) == 7
+    assert len(SUITE) == 8
     for path in SUITE:
         jsonschema.validate(json.loads(path.read_text()), SCHEMA)
 

@@ -137,6 +137,24 @@ def test_a_dicom_seg_reads_with_its_segments_and_its_grid_said_as_a_warning(tmp_
     assert [(l["name"], l["layer"]) for l in back.labels] == [(l["name"], l["layer"]) for l in v.labels]
 
 
+def test_the_phantom_s_clavicles_meet_at_the_midline_when_the_girdles_touch():
+    # girdles_touching reaches the phantom (repose phantom --girdles-touching): the clavicles'
+    # medial ends come to a few mm of the midline instead of a joint beside the manubrium, and
+    # the option belongs to the arms-resting posture.
+    def medial_gap_mm(**kw):
+        ph = rp.make_phantom(2.0, arms_resting=True, **kw)
+        g = ph["organs"]
+        value = [l["value"] for l in g.labels if l["name"] == "clavicle" and l["layer"] == 0]
+        assert value, [l["name"] for l in g.labels]
+        ijk = np.argwhere(np.isin(np.asarray(g.array), value))
+        ras = ijk @ np.asarray(g.affine)[:3, :3].T + np.asarray(g.affine)[:3, 3]
+        midline = ph["skeleton"].centre("pelvis")[0]
+        return float(np.abs(ras[:, 0] - midline).min())
+    assert medial_gap_mm(girdles_touching=True) < 6.0 < 15.0 < medial_gap_mm()
+    with pytest.raises(Exception, match="arms-resting"):
+        rp.make_phantom(4.0, girdles_touching=True)
+
+
 def test_the_phantom_s_limb_vessels_take_the_diameter_asked():
     # vessel_mm reaches the phantom (repose phantom --vessel-mm): 12 mm vessels hold more voxels
     # than the anatomical ones at 4 mm, and the option belongs to the arms-resting posture.

@@ -7,8 +7,9 @@ from each frame's report.json:
   floor; each bone (all its labels) Dice >= 0.95; no new holes; no label lost; and no two bones
   run into each other (issue 21: with the rig's joint centres the standard poses must not
   collide). With `--gap-mm` (hands and forearms held off the body) a moving hand must be cut from
-  its thigh across the gap; `arms_up160` must turn both shoulder girdles and `sitting` tilt the
-  pelvis (the rhythms of docs/POSES.md).
+  its thigh across the gap; both arms up (`arms_up160`, `arms_up180`) must turn both shoulder girdles and `sitting` tilt the
+  pelvis (the rhythms of docs/POSES.md). With `--girdles-touching` (the clavicles meet over the
+  manubrium) both arms up must cut the two girdles apart across the sternum.
 
 With `--out-of-core` each pose is posed again slab by slab (`repose pose --out-of-core` under a
 1.5 GiB budget, issue 56) and every file and report must equal the in-core frame's;
@@ -112,6 +113,7 @@ def main():
     bin_dir, poses, work = argv[:3]
     phantom_args = argv[3:]
     gap_variant = "--gap-mm" in phantom_args
+    girdles_touching = "--girdles-touching" in phantom_args
     repose = os.path.join(bin_dir, "repose")
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
@@ -192,12 +194,17 @@ def main():
             # The gap variant: a hand that moves is cut from the thigh it hangs beside, across
             # the air between them, and both arms up and sitting turn the girdles and the pelvis.
             made = [set(m["parts"]) for m in seps.get("made", [])]
-            if gap_variant and name in ("elbow90", "arm_raise90", "arms_up160"):
+            if gap_variant and name in ("elbow90", "arm_raise90", "arms_up160", "arms_up180"):
                 if {"hand_left", "thigh_left"} not in made:
                     failures.append(f"{where}: the left hand was not cut from its thigh")
             applied = " ".join(f.get("rhythms", {}).get("applied", []))
-            if name == "arms_up160" and applied.count("scapulohumeral rhythm") != 2:
+            if name in ("arms_up160", "arms_up180") and applied.count("scapulohumeral rhythm") != 2:
                 failures.append(f"{where}: the shoulder girdles did not turn with the arms")
+            # Girdles that touch across the sternum part there when both arms go up: the body
+            # reproduces the contact only if the pose had to cut it.
+            if (girdles_touching and name in ("arms_up160", "arms_up180")
+                    and {"shoulder_girdle_left", "shoulder_girdle_right"} not in made):
+                failures.append(f"{where}: the shoulder girdles were not cut apart at the sternum")
             if name == "sitting" and "lumbopelvic rhythm" not in applied:
                 failures.append(f"{where}: the pelvis did not tilt with the thighs")
             # Creases: the tets the frame's mesh left inside out, counted at the nearest joint.

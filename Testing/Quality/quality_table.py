@@ -9,7 +9,7 @@ import json
 import pathlib
 import sys
 
-ORDER = ["elbow90", "arm_raise90", "leg_step30", "walk", "arms_up160", "sitting"]
+ORDER = ["elbow90", "arm_raise90", "leg_step30", "walk", "arms_up160", "arms_up180", "sitting"]
 
 
 def row(r):

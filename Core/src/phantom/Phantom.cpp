@@ -165,6 +165,8 @@ Phantom::Phantom(const PhantomOptions& options) : impl_(std::make_unique<Impl>()
                 std::to_string(options.limbVesselMm));
   if (options.limbVesselMm > 0 && !options.armsResting)
     throw Error("phantom: the limb vessels are those of the arms-resting posture");
+  if (options.girdlesTouching && !options.armsResting)
+    throw Error("phantom: the shoulder girdles are those of the arms-resting posture");
   if (!std::isfinite(options.marginMm) || options.marginMm < 0)
     throw Error("phantom: the margin must be zero or more mm");
   if (options.threads < 0) throw Error("phantom: the thread count cannot be negative");
@@ -317,6 +319,7 @@ std::string Phantom::skeletonJson() const {
                          {"handGapMm", o.handGapMm},
                          {"forearmGapMm", o.forearmGapMm},
                          {"limbVesselMm", o.limbVesselMm},
+                         {"girdlesTouching", o.girdlesTouching},
                          {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
                          {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
   return skeletonToJson(skeleton(), made.dump());

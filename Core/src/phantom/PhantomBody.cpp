@@ -70,6 +70,7 @@ struct Builder {
   BodyModel m;
   bool detailed = false;
   double limbVesselR = 0;                // PhantomOptions::limbVesselMm / 2 (0: anatomical radii)
+  bool girdlesTouching = false;          // PhantomOptions::girdlesTouching
   std::vector<RoundCone> trunk, thighs;  // what a resting arm lies against
 
   void segment(std::uint8_t part, const RoundCone& c) {
@@ -478,8 +479,9 @@ void addShoulderGirdle(Builder& b, const SideJoints& j) {
     };
     const V s = P(j.shoulder);
     // The clavicle: medial end a few millimetres of joint beside the manubrium, lateral end at the
-    // acromion.
-    const V c0 = P({26, 36, 1022}), c1 = P({75, 32, 1038}), c2 = P({126, 6, 1050});
+    // acromion; with the girdles touching, the medial ends meet over the manubrium's notch.
+    const V c0 = P({b.girdlesTouching ? 11.0 : 26.0, 36, b.girdlesTouching ? 1030.0 : 1022.0}),
+            c1 = P({75, 32, 1038}), c2 = P({126, 6, 1050});
     bone(kClavicle, RoundCone::make(c0, c1, 7, 6.5));
     bone(kClavicle, RoundCone::make(c1, c2, 6.5, 6));
     // The acromion over the humeral head (its underside 13 + 3 + 3 mm above the joint).
@@ -612,6 +614,7 @@ BodyModel buildBody(const PhantomOptions& options) {
   BodyModel& m = b.m;
   b.detailed = options.armsResting;
   b.limbVesselR = options.limbVesselMm / 2;
+  b.girdlesTouching = options.girdlesTouching;
   m.spacing = options.spacing();
   // The skin is at least one voxel thick so every boundary voxel is skin at any voxel size (on a
   // thick-slice grid, the voxel's extent along the surface's normal: Phantom.cpp).

@@ -120,14 +120,16 @@ PosedFrame frame::poseFrameFrom(FrameStart& start, const PoseRig& rig, const Vol
   ro.preserveLabelVolumes = false;  // S's parts are as sampled: they only name where G's tissue is
   out.parts = rasterizeLabels(parts, mesh, deformed, out.grid, ro);
   out.field = rasterizeDisplacement(mesh, deformed, organs.geometry(), out.grid, ro);
+  const std::vector<int> rigid = frame::rigidLabels(mesh, options);
   PocketReport pockets;
-  if (options.fillPockets) pockets = fillPosePockets(out.organs, organs, out.field, &out.parts);
+  if (options.fillPockets)
+    pockets = fillPosePockets(out.organs, organs, out.field, &out.parts, rigid);
   if (options.image)
     out.image = rasterizeImage(
         *options.image, mesh, deformed, out.grid,
         options.background ? *options.background : imageBackground(*options.image), ro);
   PosedTally posed(organs, parts, &start.frame.handles, out.grid, options.threads);
-  posed.countCollisions(frame::rigidLabels(mesh, options));
+  posed.countCollisions(rigid);
   posed.addWhole(out.organs, out.parts);
   out.reportJson = frame::frameReport(start, rig, organs, parts, options, raster, pockets, posed,
                                       out.image.has_value());

@@ -370,6 +370,27 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
                                   {"untangled_tets", vr.untangled},
                                   {"untangle_relaxed", vr.relaxedUntangle}};
   report["bone_collisions"] = collisions;
+  // Groups moved off a joint whose bones the turn drove together (JointClearance.h).
+  nlohmann::json cleared = nlohmann::json::array();
+  for (const JointClearance::Shift& c : frame.clearances) {
+    const std::string group = std::size_t(c.group) < groupNames.size()
+                                  ? groupNames[std::size_t(c.group)]
+                                  : std::to_string(c.group);
+    cleared.push_back({{"joint", c.joint},
+                       {"group", group},
+                       {"shift_mm", {c.shiftMm.x(), c.shiftMm.y(), c.shiftMm.z()}},
+                       {"distance_mm", c.shiftMm.norm()},
+                       {"voxels_before", c.voxelsBefore},
+                       {"voxels_after", c.voxelsAfter}});
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "%s: the turn drove the bones together in %lld voxels; \"%s\" moved %.1f mm "
+                  "off the joint along its bone (%lld left)",
+                  c.joint.c_str(), static_cast<long long>(c.voxelsBefore), group.c_str(),
+                  c.shiftMm.norm(), static_cast<long long>(c.voxelsAfter));
+    warn(start, options, line);
+  }
+  report["joint_clearance"] = cleared;
   report.update(nlohmann::json::parse(poseReportJson(ri)));
   // The labels whose rounding did not hold: named, and said (docs/FORMATS.md).
   if (report.contains("label_rounding_missed")) {

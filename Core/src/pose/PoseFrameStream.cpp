@@ -190,7 +190,7 @@ std::string frame::poseFrameToFolderFrom(
     // The rounding's candidates beyond a quarter of what is free go to a temporary file.
     if (options.preserveLabelVolumes)
       rounding.emplace(*organSlabs, std::size_t(std::max(0.0, 0.25 * freeBytes)));
-    if (options.fillPockets) pockets.emplace(organs, grid);
+    if (options.fillPockets) pockets.emplace(organs, grid, frame::rigidLabels(mesh, options));
     posed.emplace(organs, parts, &start.frame.handles, grid, options.threads);
     posed->countCollisions(frame::rigidLabels(mesh, options));
     out.emplace(folder, write.lockFolder);

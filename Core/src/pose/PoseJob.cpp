@@ -248,6 +248,13 @@ std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, const Pose& pose
       bendJoints(skeleton_ ? &*skeleton_ : nullptr, parts_->labels()));
   rig->setRhythms(pose, rhythms_);
   rig->setVolumeRestoration(request_.volumeRestoration);
+  // Bones a joint's turn drives into each other are parted (JointClearance.h): every rigid label,
+  // a bone's other labels too.
+  if (skeleton_ && organs_ && parts_) {
+    std::vector<int> rigid = settings_.rigidLabels;
+    for (const auto& [label, piece] : settings_.bonePieces) rigid.push_back(label);
+    rig->setJointClearance(JointClearance(rig->pose(), *skeleton_, *organs_, *parts_, rigid));
+  }
   if (skeleton_) {
     std::vector<std::pair<int, int>> jointed;
     auto label = [&](const std::string& name) {

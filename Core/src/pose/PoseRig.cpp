@@ -549,7 +549,9 @@ PoseRig::Frame PoseRig::solveFrame(const std::string& name,
   Frame f;
   f.name = name;
   f.handles = handles_;
-  setMotions(f.handles, motions);
+  std::vector<Eigen::Isometry3d> cleared = motions;
+  f.clearances = clearance_.apply(cleared);
+  setMotions(f.handles, cleared);
   f.cage = posedCage(f.handles, start);
   f.deformed = deformation_->deform(f.cage, influence_, f.handles,
                                     tetMaps == FrameMaps::With ? &f.tetMaps : nullptr, precision);

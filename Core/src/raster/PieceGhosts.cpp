@@ -34,24 +34,43 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
     if (!piece) return {0, 0};
     return {piece, restParts ? int(restParts->valueAsDouble(at)) : ownPart};
   };
-  // Per soft tet, the pieces its rest volume holds (usually none or one).
+  // Per soft tet, the pieces its rest volume holds (usually none or one). Per piece tet, the
+  // pieces of other body parts it holds: Mesh_3 lets a bone of one part into another part's piece
+  // tets where they lie on each other (a scapula's tets on the ribs of an 8 mm grid); the piece
+  // tet does not write them (Rasterizer.cpp, foreignPiece), so their own part's ghost does. A
+  // bone one voxel thick slips between a soft tet's 13 samples less often than between a piece
+  // tet's, and the piece tets are few: theirs are sampled on a lattice of about half a voxel.
+  const double voxelMm = pieceLabels.geometry().spacing().minCoeff();
   std::vector<std::vector<Held>> holds(static_cast<std::size_t>(nt));
   bool any = false;
   for (Eigen::Index t = 0; t < nt; ++t) {
-    if (mesh.rigid[std::size_t(t)]) continue;
+    const bool piece = mesh.rigid[std::size_t(t)] != 0;
+    if (piece && !restParts) continue;
     Eigen::Vector3d x[4], c = Eigen::Vector3d::Zero();
     for (int k = 0; k < 4; ++k) c += (x[k] = mesh.vertices.row(mesh.tets(t, k)).transpose());
     c /= 4;
     std::set<Held> found;
     auto sample = [&](const Eigen::Vector3d& ras) {
       const Held h = heldAt(ras, mesh.labels[t]);
-      if (h.first) found.insert(h);
+      if (h.first && (!piece || h.second != mesh.labels[t])) found.insert(h);
     };
     sample(c);
     for (int k = 0; k < 4; ++k) {
       sample(0.5 * (c + x[k]));
       const Eigen::Vector3d face = (4 * c - x[k]) / 3;  // the centre of the face opposite k
       sample(face + 0.25 * (c - face));
+    }
+    if (piece) {
+      double edge = 0;
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) edge = std::max(edge, (x[a] - x[b]).norm());
+      const int n = std::clamp(int(std::ceil(2 * edge / voxelMm)), 2, 16);
+      for (int a = 0; a <= n; ++a)
+        for (int b = 0; a + b <= n; ++b)
+          for (int e = 0; a + b + e <= n; ++e)
+            sample((double(a) * x[1] + double(b) * x[2] + double(e) * x[3] +
+                    double(n - a - b - e) * x[0]) /
+                   double(n));
     }
     holds[std::size_t(t)].assign(found.begin(), found.end());
     any = any || !found.empty();
@@ -135,8 +154,8 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
       host[std::size_t(t)][h] = nearest;
     }
   for (Eigen::Index t = 0; t < nt; ++t)
-    if (!mesh.rigid[std::size_t(t)])
-      for (const auto& [h, by] : host[std::size_t(t)]) out.push_back({std::int32_t(t), by});
+    for (const auto& [h, by] : host[std::size_t(t)])
+      if (by != std::int32_t(t) && by >= 0) out.push_back({std::int32_t(t), by});
   return out;
 }
 

@@ -16,6 +16,11 @@
 // tilted the pelvis 25 degrees against it and 327 pelvis voxels landed off the pelvis (+1.27 %
 // beyond its resampling floor). A ghost is therefore keyed by the piece and the body part S gives
 // the piece's voxels, not by the soft tet's part.
+//
+// A piece tet can hold another part's bone too: on an 8 mm grid a scapula's tets lie on the ribs
+// and take a slice of them. The piece tet does not copy that bone (it would move it with the
+// shoulder girdle: the ribs +1.6 % under both arms raised); a ghost of it hosted by the bone's own
+// part writes it where that part puts it (issue 64).
 #pragma once
 
 #include "TetScan.h"
@@ -34,7 +39,9 @@ struct PieceGhost {
 
 // The soft tets whose rest volume holds a label of a piece (sampled at the centroid, half way to
 // each vertex and at each face's centre drawn a quarter of the way in, on `pieceLabels`, the
-// label map on the input's grid), each with a tet of that piece in the body part `restParts`
+// label map on the input's grid), and with `restParts` the piece tets whose rest volume holds a
+// piece of another body part (sampled also on a lattice of about half a voxel), each with a tet
+// of that piece in the body part `restParts`
 // gives the sample (the soft tet's own part without it): within `rings` vertex-sharing steps
 // through soft tets holding it, else any tet of that piece in that part (a piece moves whole:
 // one rigid map), else, for a bone with no tet of its own there, the part's nearest piece tet

@@ -61,8 +61,16 @@ struct PosePockets::Impl {
   std::vector<std::int64_t> pocketOrgans, pocketParts;
   std::int64_t next = 0;
 
-  Impl(const Volume& r, const VolumeGeometry& p)
-      : rest(r), posed(p), restOutside(outsideBackground(r)), trace(p.dims) {}
+  std::vector<std::int64_t> rigid;  // sorted
+
+  Impl(const Volume& r, const VolumeGeometry& p, const std::vector<int>& rigidLabels)
+      : rest(r),
+        posed(p),
+        restOutside(outsideBackground(r)),
+        trace(p.dims),
+        rigid(rigidLabels.begin(), rigidLabels.end()) {
+    std::sort(rigid.begin(), rigid.end());
+  }
 
   std::array<std::int64_t, 6> neighbours(std::int64_t voxel) const {
     const auto d = posed.dims;
@@ -75,10 +83,13 @@ struct PosePockets::Impl {
 
   // Fills the pockets layer by layer from their walls: each takes the most common non-zero label
   // among its 6 neighbours not waiting to be filled (ties to the smaller label), `wall(n, q)`
-  // giving neighbour n (of the pocket's OpenVoxel) voxel q's label when q is no pocket.
+  // giving neighbour n (of the pocket's OpenVoxel) voxel q's label when q is no pocket. A label
+  // of `avoid` (sorted: G's rigid pieces) is taken only by a pocket that no other label can reach:
+  // a gap a pose opens between a bone and its neighbour (a scapula lifted off the ribs) is soft
+  // tissue, and a rigid label keeps its count (issue 64).
   template <class Wall>
-  std::vector<std::int64_t> fillFromWalls(const std::vector<std::size_t>& entries,
-                                          Wall&& wall) const {
+  std::vector<std::int64_t> fillFromWalls(const std::vector<std::size_t>& entries, Wall&& wall,
+                                          const std::vector<std::int64_t>& avoid) const {
     std::vector<std::int64_t> value(pockets.size(), 0);
     std::vector<char> waiting(pockets.size(), 1);
     std::vector<std::size_t> pending(pockets.size());
@@ -87,32 +98,48 @@ struct PosePockets::Impl {
       const auto it = std::lower_bound(pockets.begin(), pockets.end(), q);
       return it != pockets.end() && *it == q ? it - pockets.begin() : -1;
     };
+    auto avoided = [&](std::int64_t label) {
+      return std::binary_search(avoid.begin(), avoid.end(), label);
+    };
+    auto mostCommon = [](const std::map<std::int64_t, int>& votes) {
+      std::int64_t best = votes.begin()->first;
+      int most = 0;
+      for (const auto& [label, count] : votes)
+        if (count > most) most = count, best = label;
+      return best;
+    };
     while (!pending.empty()) {
-      std::vector<std::pair<std::size_t, std::int64_t>> layer;
+      std::vector<std::pair<std::size_t, std::int64_t>> layer, avoidedOnly;
       std::vector<std::size_t> rest;
       for (const std::size_t p : pending) {
         const OpenVoxel& o = open[entries[p]];
         const std::array<std::int64_t, 6> around = neighbours(o.voxel);
-        std::map<std::int64_t, int> votes;
+        std::map<std::int64_t, int> votes, avoidedVotes;
         for (int n = 0; n < 6; ++n) {
           const std::int64_t q = around[std::size_t(n)];
           if (q == kNoVoxel) continue;  // beyond the grid
           const std::ptrdiff_t at = pocketIndex(q);
           const std::int64_t v =
               at >= 0 ? (waiting[std::size_t(at)] ? 0 : value[std::size_t(at)]) : wall(o, n, q);
-          if (v != 0) ++votes[v];
+          if (v != 0) ++(avoided(v) ? avoidedVotes : votes)[v];
         }
-        if (votes.empty()) {
+        if (!votes.empty()) {
+          layer.emplace_back(p, mostCommon(votes));
+        } else {
+          if (!avoidedVotes.empty()) avoidedOnly.emplace_back(p, mostCommon(avoidedVotes));
           rest.push_back(p);
-          continue;
         }
-        std::int64_t best = votes.begin()->first;
-        int most = 0;
-        for (const auto& [label, count] : votes)
-          if (count > most) most = count, best = label;
-        layer.emplace_back(p, best);
       }
-      if (layer.empty()) break;  // a pocket with no labelled wall (cannot happen when enclosed)
+      // Walled by rigid labels alone, and no other label will come nearer: take them.
+      if (layer.empty()) {
+        if (avoidedOnly.empty()) break;  // no labelled wall (cannot happen when enclosed)
+        layer.swap(avoidedOnly);
+        rest.clear();
+        std::vector<char> taken(pockets.size(), 0);
+        for (const auto& pl : layer) taken[pl.first] = 1;
+        for (const std::size_t p : pending)
+          if (!taken[p]) rest.push_back(p);
+      }
       for (const auto& [p, label] : layer) value[p] = label, waiting[p] = 0;
       pending.swap(rest);
     }
@@ -120,10 +147,11 @@ struct PosePockets::Impl {
   }
 };
 
-PosePockets::PosePockets(const Volume& rest, const VolumeGeometry& posed) {
+PosePockets::PosePockets(const Volume& rest, const VolumeGeometry& posed,
+                         const std::vector<int>& rigidLabels) {
   if (!isIntegerType(rest.scalarType()))
     throw Error("pockets are filled in label maps, not in float volumes");
-  impl_ = std::make_unique<Impl>(rest, posed);
+  impl_ = std::make_unique<Impl>(rest, posed, rigidLabels);
 }
 
 PosePockets::~PosePockets() = default;
@@ -226,13 +254,17 @@ PocketReport PosePockets::fill(
     }
   }
   report.filled = std::int64_t(r.pockets.size());
-  r.pocketOrgans = r.fillFromWalls(entries, [&](const OpenVoxel& o, int n, std::int64_t q) {
-    const std::int64_t sampled = o.organs[std::size_t(n)];
-    return sampled != 0 && finalOrgan ? finalOrgan(q, sampled) : sampled;
-  });
+  r.pocketOrgans = r.fillFromWalls(
+      entries,
+      [&](const OpenVoxel& o, int n, std::int64_t q) {
+        const std::int64_t sampled = o.organs[std::size_t(n)];
+        return sampled != 0 && finalOrgan ? finalOrgan(q, sampled) : sampled;
+      },
+      r.rigid);
   if (r.withParts)
     r.pocketParts = r.fillFromWalls(
-        entries, [&](const OpenVoxel& o, int n, std::int64_t) { return o.parts[std::size_t(n)]; });
+        entries, [&](const OpenVoxel& o, int n, std::int64_t) { return o.parts[std::size_t(n)]; },
+        {});
   // Only the pockets are needed from here on.
   r.open.clear(), r.open.shrink_to_fit();
   return report;
@@ -253,7 +285,7 @@ void PosePockets::apply(std::int64_t k0, std::int64_t k1, void* organs, void* pa
 }
 
 PocketReport fillPosePockets(Volume& posed, const Volume& rest, const std::vector<float>& field,
-                             Volume* posedParts) {
+                             Volume* posedParts, const std::vector<int>& rigidLabels) {
   if (!isIntegerType(posed.scalarType()) || !isIntegerType(rest.scalarType()))
     throw Error("pockets are filled in label maps, not in float volumes");
   if (posed.scalarType() != rest.scalarType())
@@ -264,7 +296,7 @@ PocketReport fillPosePockets(Volume& posed, const Volume& rest, const std::vecto
   if (posedParts && posedParts->dims() != posed.dims())
     throw Error("the posed parts map is on another grid");
   // One slab of every slice: a frame made slab by slab fills the same voxels with the same labels.
-  PosePockets pockets(rest, posed.geometry());
+  PosePockets pockets(rest, posed.geometry(), rigidLabels);
   void* parts = posedParts ? posedParts->layerData(0) : nullptr;
   const ScalarType partsType = posedParts ? posedParts->scalarType() : ScalarType::UInt8;
   pockets.addSlab(0, posed.dims()[2], nullptr, posed.layerData(0), nullptr, nullptr, parts, nullptr,

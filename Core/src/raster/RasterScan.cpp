@@ -106,6 +106,7 @@ Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const Vol
     sh.boneLabel.resize(pieceOf.size());
     for (std::size_t v = 0; v < pieceOf.size(); ++v) sh.boneLabel[v] = pieceOf[v] != 0;
     sh.ghosts = raster::pieceGhosts(mesh, *options.pieceLabels, pieceOf, sh.rimParts);
+    sh.pieceOf = std::move(pieceOf);
     sh.pieceMm = pieceReachMm(mesh, input);
     const Eigen::Matrix3d Minv = output.ijkToRas.block<3, 3>(0, 0).inverse();
     for (int c = 0; c < 3; ++c) sh.pieceGrowth[c] = sh.pieceMm * Minv.row(c).norm();

@@ -68,6 +68,7 @@ struct Shell {
   double pieceMm = 0;
   std::array<double, 3> pieceGrowth{0, 0, 0};
   std::vector<char> boneLabel;  // per label value: some tet is a piece of it
+  std::vector<int> pieceOf;     // per label value: the piece it is meshed in (0: none)
   // Soft tets holding a piece's tissue, written like rims through their piece's map
   // (raster/PieceGhosts.h): a bone end a joint demoted to soft tissue still moves rigidly.
   std::vector<raster::PieceGhost> ghosts;
@@ -376,7 +377,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           const std::int64_t j0 = bands ? s0 : 0, j1 = bands ? s1 : in.dims[1];
           // Voxels of this work item already written, row by row (rows j0..j1 of slices k0..k1).
           const std::int64_t rows = j1 - j0;
-          // 1: written by soft tissue, 2: by a whole piece (its tets or its rim).
+          // 1: written by soft tissue, 2: by a whole piece's tets, 3: by a rim or a ghost.
           if (withShell || withRims)
             covered.assign(static_cast<std::size_t>(nx * rows * (k1 - k0)), 0);
           ScanTet s;
@@ -413,18 +414,23 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
           }
           // Writes, over soft tissue, the voxels of the prepared region `s` whose rest label is
           // bone of piece tet t's body part, through t's map (a rim, or a ghost hosted by t).
-          auto scanRim = [&](std::int32_t t) {
-            raster::scanTet(s, k0, k1, j0, j1,
-                            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
-                                const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
-                              std::uint8_t* cv = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
-                              for (std::int64_t a = i0; a <= i1; ++a) {
-                                const Eigen::Vector3d p = rest0 + double(a - i0) * step;
-                                if (cv[a] == 2 || !shell.rimTakes(t, p, *shell.tetParts)) continue;
-                                cv[a] = 2;
-                                sink(k, j, a, a, p, step, t);
-                              }
-                            });
+          // `overPieces`: a ghost of a piece tet that held another part's bone (PieceGhosts.h)
+          // also writes over the voxels piece tets wrote (3 marks a rim's or a ghost's voxel):
+          // the piece tet that held the bone did not copy it, and may still cover its place.
+          auto scanRim = [&](std::int32_t t, bool overPieces) {
+            raster::scanTet(
+                s, k0, k1, j0, j1,
+                [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                    const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
+                  std::uint8_t* cv = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
+                  for (std::int64_t a = i0; a <= i1; ++a) {
+                    const Eigen::Vector3d p = rest0 + double(a - i0) * step;
+                    if (cv[a] >= (overPieces ? 3 : 2) || !shell.rimTakes(t, p, *shell.tetParts))
+                      continue;
+                    cv[a] = 3;
+                    sink(k, j, a, a, p, step, t);
+                  }
+                });
           };
           // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
           // follows its surface to within a voxel) move with the piece, over the soft tissue
@@ -437,7 +443,7 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                 !raster::prepareShell(in, n.v, rim, shell.pieceMm, shell.normalToMm,
                                       shell.pieceGrowth, s))
               continue;
-            scanRim(t);
+            scanRim(t, false);
           }
           // The ghosts: piece tissue in soft tets (a bone end a joint demoted), where the piece
           // puts it.
@@ -447,7 +453,8 @@ void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& optio
                                       shell.normalToMm, shell.pieceGrowth, s) ||
                 s.hi[2] < k0 || s.lo[2] >= k1 || s.hi[1] < j0 || s.lo[1] >= j1)
               continue;
-            scanRim(t);
+            const std::int32_t soft = shell.ghosts[g].soft;
+            scanRim(t, withPieces && (*in.pieces)[std::size_t(soft)] != 0);
           }
           for (std::size_t m = 0; m < mine.size() && withShell; ++m) {
             if (shell.outer[candidates[std::size_t(mine[m])].tet]) fetchAhead(m);

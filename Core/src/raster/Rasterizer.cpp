@@ -262,9 +262,10 @@ struct LabelSource {
         back.leftCols<3>() * Eigen::Vector3d(double(i), double(j), double(k)) + back.col(3);
     return (r - x).cwiseAbs().maxCoeff() > 0.5;
   }
-  // The most common value around `at` that no piece owns (`at` itself if there is none), looking
-  // one voxel around first, then two.
-  std::int64_t aroundPiece(std::int64_t at) const {
+  // The most common value around `at` among the voxels `skip` does not skip (`at` itself if
+  // there is none), looking one voxel around first, then two.
+  template <class Skip>
+  std::int64_t mostCommonAround(std::int64_t at, Skip&& skip) const {
     const std::int64_t x = at % d[0], y = (at / d[0]) % d[1], z = at / (d[0] * d[1]);
     for (int r = 1; r <= 2; ++r) {
       std::map<double, int> votes;
@@ -275,7 +276,7 @@ struct LabelSource {
             const std::int64_t u = x + a, v = y + b, w = z + c;
             if (u < 0 || v < 0 || w < 0 || u >= d[0] || v >= d[1] || w >= d[2]) continue;
             const std::int64_t n = u + d[0] * (v + d[1] * w);
-            if (setup.owner[std::size_t(n)] >= 0) continue;
+            if (skip(n)) continue;
             const double value = double(src[n]);
             if (++votes[value] == 1) where[value] = n;
           }
@@ -287,12 +288,41 @@ struct LabelSource {
     }
     return at;
   }
+  // The most common value around `at` that no piece owns.
+  std::int64_t aroundPiece(std::int64_t at) const {
+    return mostCommonAround(at, [&](std::int64_t n) { return setup.owner[std::size_t(n)] >= 0; });
+  }
+  // Whether rest voxel `at`, written through piece tet `tet` (its own volume, a rim or a ghost it
+  // hosts), is a piece's tissue of another body part: a bone that Mesh_3 let into the tet (a
+  // scapula's tets lying on the ribs of an 8 mm grid). Its own part's pieces put it where it goes
+  // (their tets, rims or ghosts); copied here, it would move with this part too (the ribs +1.6 %
+  // under both arms raised, issue 64). A piece of the same part moves with the same group, and
+  // rims and ghosts write only their own part's bone (Shell::rimTakes).
+  bool foreignPiece(std::int64_t at, std::int32_t tet) const {
+    const Volume* restParts = setup.shell.rimParts;
+    const std::vector<int>& pieceOf = setup.shell.pieceOf;
+    const T value = src[at];
+    if (!restParts || !(value > T(0)) || double(value) >= double(pieceOf.size())) return false;
+    return pieceOf[std::size_t(value)] != 0 && restParts->valueAsDouble(at) != mesh.labels[tet];
+  }
+  // The most common tissue around `at` that is no piece's label (`at` itself if there is none),
+  // one voxel around first, then two: what a piece tet writes in place of another part's bone.
+  // (Piece tets own every voxel they cover at rest, soft ones too, so aroundPiece would find
+  // nothing inside them.)
+  std::int64_t aroundBone(std::int64_t at) const {
+    const std::vector<int>& pieceOf = setup.shell.pieceOf;
+    return mostCommonAround(at, [&](std::int64_t n) {
+      const T value = src[n];
+      return !(value > T(0)) ||
+             (double(value) < double(pieceOf.size()) && pieceOf[std::size_t(value)] != 0);
+    });
+  }
   std::int64_t operator()(std::int64_t i, std::int64_t j, std::int64_t k, const Eigen::Vector3d& p,
                           std::int32_t tet) const {
     std::int64_t at = nearestVoxel(p, d);
-    if (at >= 0 && !setup.owner.empty() && !mesh.rigid[std::size_t(tet)] && movedAway(at, i, j, k))
-      at = aroundPiece(at);
-    return at;
+    if (at < 0 || setup.owner.empty()) return at;
+    if (mesh.rigid[std::size_t(tet)]) return foreignPiece(at, tet) ? aroundBone(at) : at;
+    return movedAway(at, i, j, k) ? aroundPiece(at) : at;
   }
 };
 

@@ -40,6 +40,11 @@ struct PhantomOptions {
   // anatomical 4-10 mm: about one voxel on a reference phantom's grid, where a crease squeezes
   // them hardest (issue 64). Zero: anatomical.
   double limbVesselMm = 0;
+  // With armsResting, the clavicles' medial ends meet over the manubrium instead of standing a
+  // joint beside it, as on reference phantoms whose clavicles reach the midline: the two shoulder
+  // girdles a rig makes then touch across the sternum, and both arms raised pull them apart
+  // there (a contact the cage must cut, issue 64).
+  bool girdlesTouching = false;
   PhantomLabelling labels = PhantomLabelling::Phantom;
   double marginMm = 10.0;  // empty border around the body
   int threads = 0;         // 0: all cores

@@ -10,6 +10,7 @@
 #include "repose/mesh/VolumeRestoration.h"
 #include "repose/mesh/Refinement.h"
 #include "repose/mesh/RigiditySolver.h"
+#include "repose/pose/JointClearance.h"
 #include "repose/pose/Pose.h"
 #include "repose/pose/PoseRhythm.h"
 #include "repose/util/Progress.h"
@@ -141,6 +142,8 @@ class PoseRig {
     std::vector<Eigen::Matrix3d> tetMaps;  // B_t of every tet (empty with FrameMaps::Without)
     // What the volume restoration did (nothing in a live frame, or when it is off).
     VolumeRestorationReport restoration;
+    // Groups moved off joints whose bones the turn drove together (JointClearance.h).
+    std::vector<JointClearance::Shift> clearances;
   };
   std::size_t frameCount() const { return frames_.size(); }
   const std::string& frameName(std::size_t index) const { return frames_.at(index).first; }
@@ -189,6 +192,10 @@ class PoseRig {
   // Whether frame() restores the soft tissue's volumes after the solve and the bends
   // (VolumeRestoration.h; on by default). Live frames never do: they are previews.
   void setVolumeRestoration(bool on) { restoreVolumes_ = on; }
+  // Parts the bones each frame drives together at a joint (JointClearance.h), in every frame
+  // solved from now on: made by PoseJob from G and S at rest.
+  void setJointClearance(JointClearance clearance) { clearance_ = std::move(clearance); }
+  const JointClearance& jointClearance() const { return clearance_; }
   // The tissues of G each soft tet holds at rest (tetTissues): with them the restoration holds
   // each tissue's volume at the joints as well as each body part's. Without, parts only.
   void setTetTissues(TetTissues tissues) { tissues_ = std::move(tissues); }
@@ -233,6 +240,7 @@ class PoseRig {
   std::vector<RigidHandle> handles_;
   HandleInfluence influence_;
   JointBends bends_;
+  JointClearance clearance_;
   std::vector<char> movable_;  // per TM vertex: not a whole piece's
   bool restoreVolumes_ = true;
   TetTissues tissues_;

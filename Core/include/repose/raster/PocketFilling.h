@@ -8,7 +8,9 @@
 // outside of the rest body (its rest position, through the inverse map, is background joined to
 // the rest grid's border) or from nowhere (no tet covers it); background that comes from a cavity
 // of the rest body (enclosed there too) is kept. Filled voxels take the most common non-zero
-// label among their 6 neighbours, layer by layer from the pocket's wall inwards.
+// label among their 6 neighbours, layer by layer from the pocket's wall inwards; a rigid label
+// (a bone, whose count is exact in every posture) only where no other label reaches the pocket:
+// a gap opened between a bone and its neighbour is soft tissue.
 #pragma once
 
 #include "repose/volume/Volume.h"
@@ -28,9 +30,11 @@ struct PocketReport {
 // posedLabels: the posed label map (layer 0 is examined and filled). restLabels: the rest map it
 // was posed from. displacement: the inverse map on the posed grid, as rasterizeDisplacement
 // gives it (3 floats per voxel, RAS mm to the rest position). posedParts, when given, is filled in
-// the same voxels with its own neighbours' labels.
+// the same voxels with its own neighbours' labels. rigidLabels: G's labels a pocket takes only
+// when no other label walls it.
 PocketReport fillPosePockets(Volume& posedLabels, const Volume& restLabels,
-                             const std::vector<float>& displacement, Volume* posedParts = nullptr);
+                             const std::vector<float>& displacement, Volume* posedParts = nullptr,
+                             const std::vector<int>& rigidLabels = {});
 
 // The same for a frame made slab by slab (fillPosePockets is this over one slab): pass 1 traces
 // the posed background slab by slab (BackgroundTrace.h) and notes, for each voxel not yet known to
@@ -39,7 +43,9 @@ PocketReport fillPosePockets(Volume& posedLabels, const Volume& restLabels,
 class PosePockets {
  public:
   // `rest`: G at rest (integer, layer 0 examined); `posed`: the posed grid. Both are kept.
-  PosePockets(const Volume& rest, const VolumeGeometry& posed);
+  // `rigidLabels`: G's labels a pocket takes only when no other label walls it.
+  PosePockets(const Volume& rest, const VolumeGeometry& posed,
+              const std::vector<int>& rigidLabels = {});
   ~PosePockets();
   PosePockets(const PosePockets&) = delete;
   PosePockets& operator=(const PosePockets&) = delete;

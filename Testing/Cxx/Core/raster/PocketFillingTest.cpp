@@ -146,3 +146,47 @@ TEST(PocketFilling, SlabsFillTheWholeGridsPockets) {
                Error);
   EXPECT_THROW(pockets.fill(), Error);
 }
+
+// A gap a pose opens between a bone and the tissue beside it (a scapula lifted off the ribs) is
+// filled with the soft tissue, not the bone: a rigid label keeps its count in every posture
+// (issue 64). Only a pocket no other label reaches takes a rigid one.
+TEST(PocketFilling, RigidLabelsFillOnlyPocketsNoOtherLabelReaches) {
+  const std::vector<int> rigid = {5};
+  Volume rest = block(5, 1);  // bone 5 in the middle, soft tissue 1 on both sides
+  const std::vector<float> identity(3 * rest.numVoxels(), 0.0f);
+
+  // Two voxels walled by more bone than soft tissue: without the rule they took the bone.
+  Volume posed = rest;
+  at(posed, 4, 5, 5) = at(posed, 5, 5, 5) = 0;  // bone's edge: bone on four, soft on one side
+  Volume plain = posed;
+  fillPosePockets(plain, rest, identity);
+  EXPECT_EQ(at(plain, 5, 5, 5), 5);
+  PocketReport r = fillPosePockets(posed, rest, identity, nullptr, rigid);
+  EXPECT_EQ(r.filled, 2);
+  EXPECT_EQ(at(posed, 4, 5, 5), 1);
+  EXPECT_EQ(at(posed, 5, 5, 5), 1);  // reached through the soft voxel filled before it
+  EXPECT_EQ(countEnclosedBackground(posed), 0);
+
+  // A pocket inside the bone, walled by nothing else: the bone.
+  Volume inside = rest;
+  at(inside, 5, 5, 5) = 0;
+  r = fillPosePockets(inside, rest, identity, nullptr, rigid);
+  EXPECT_EQ(r.filled, 1);
+  EXPECT_EQ(at(inside, 5, 5, 5), 5);
+
+  // Slab by slab the same.
+  Volume slabbed = rest;
+  at(slabbed, 4, 5, 5) = at(slabbed, 5, 5, 5) = 0;
+  const auto d = slabbed.dims();
+  const std::int64_t plane = d[0] * d[1];
+  PosePockets pockets(rest, slabbed.geometry(), rigid);
+  const std::uint8_t* g = slabbed.data<std::uint8_t>();
+  for (std::int64_t k = 0; k < d[2]; ++k)
+    pockets.addSlab(k, k + 1, k > 0 ? g + (k - 1) * plane : nullptr, g + k * plane,
+                    k + 1 < d[2] ? g + (k + 1) * plane : nullptr, nullptr, nullptr, nullptr,
+                    ScalarType::UInt8, identity.data() + 3 * k * plane);
+  EXPECT_EQ(pockets.fill().filled, 2);
+  pockets.apply(0, d[2], slabbed.layerData(0), nullptr);
+  EXPECT_EQ(at(slabbed, 4, 5, 5), 1);
+  EXPECT_EQ(at(slabbed, 5, 5, 5), 1);
+}

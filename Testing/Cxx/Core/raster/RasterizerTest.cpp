@@ -918,6 +918,58 @@ TEST(Rasterizer, ABoneFarFromItsOwnTetsMovesWithTheBone) {
   EXPECT_GT(withPieces, 0.99) << "without the pieces' map: " << without;
 }
 
+// A bone of one body part that lies inside another part's piece tets (on 8 mm slices a scapula's
+// tets lie on the ribs and take a slice of them) stays with its own part: the piece tets that
+// hold it write the tissue around it instead, and its part's pieces place it (a ghost). Copied
+// by the moving piece, it had moved with the shoulder girdle: the ribs +1.6 % under both arms
+// raised on the ICRP grid with the girdles touching (issue 64).
+TEST(Rasterizer, AnotherPartsBoneInsideAPiecesTetsStaysWithItsOwnPart) {
+  TransferMesh mesh = tetBox({2, 2, 2}, {62, 11, 11}, {20, 3, 3});
+  mesh.rigid.assign(std::size_t(mesh.tets.rows()), 0);
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    double x = 0;
+    for (int c = 0; c < 4; ++c) x += mesh.vertices(mesh.tets(t, c), 0) / 4;
+    mesh.labels[t] = x < 32 ? 1 : 2;
+    if (x < 29) mesh.rigid[std::size_t(t)] = 5;  // part 1's bone, moving
+    if (x > 44) mesh.rigid[std::size_t(t)] = 7;  // part 2's bone, still
+  }
+  // Part 1 lifted 20 voxels; part 2 still; the soft tets between stretch.
+  Eigen::MatrixX3d deformed = mesh.vertices;
+  for (Eigen::Index v = 0; v < deformed.rows(); ++v) {
+    const double x = mesh.vertices(v, 0);
+    deformed(v, 1) += 20 * std::clamp((44 - x) / 12, 0.0, 1.0);
+  }
+  const VolumeGeometry grid = unitGrid({66, 40, 14});
+  Volume G(grid, ScalarType::UInt8), S(grid, ScalarType::UInt8);
+  std::int64_t rest6 = 0;
+  for (std::int64_t k = 2; k < 11; ++k)
+    for (std::int64_t j = 2; j < 11; ++j)
+      for (std::int64_t i = 2; i < 62; ++i) {
+        const bool six = i >= 20 && i < 22;  // a plate of part 2's bone 6, two voxels thick
+        std::uint8_t g = i < 29 ? 5 : i > 45 ? 7 : 1;
+        if (i >= 18 && i < 24) g = 1;  // soft tissue around the plate
+        if (six) g = 6, ++rest6;
+        G.data<std::uint8_t>()[G.index(i, j, k)] = g;
+        S.data<std::uint8_t>()[S.index(i, j, k)] = six || i >= 32 ? 2 : 1;
+      }
+  const std::map<int, int> bonePieces = {{5, 5}, {6, 6}, {7, 7}};
+  RasterOptions options;
+  options.pieceLabels = &G;
+  options.restParts = &S;
+  options.bonePieces = &bonePieces;
+  const Volume posed = rasterizeLabels(G, mesh, deformed, grid, options);
+  std::int64_t inPlace = 0, moved = 0, five = 0, rest5 = 0;
+  for (std::int64_t v = 0; v < grid.numVoxels(); ++v) {
+    rest5 += G.data<std::uint8_t>()[v] == 5;
+    five += posed.data<std::uint8_t>()[v] == 5;
+    if (posed.data<std::uint8_t>()[v] != 6) continue;
+    (G.data<std::uint8_t>()[v] == 6 ? inPlace : moved) += 1;
+  }
+  EXPECT_EQ(inPlace, rest6);  // where part 2 keeps it
+  EXPECT_EQ(moved, 0);        // none lifted with part 1's bone
+  EXPECT_EQ(five, rest5);     // the piece that held it keeps its own count
+}
+
 // Voxels no tet covers point one voxel centre past the input grid's nearest face (or nowhere when
 // they lie a voxel beyond it already): nearest-neighbour resampling gives them background, and
 // the field has no jump of metres beside the body (3D Slicer interpolates a grid transform with a

@@ -155,6 +155,45 @@ TEST(Rig, ACsvConventionGivesThePhantomsRig) {
   }
 }
 
+// The girdles-touching variant (PhantomOptions::girdlesTouching, issue 64): the clavicles reach
+// the midline over the manubrium, as on reference phantoms, so the two shoulder girdles the rig
+// makes touch across the sternum (the contact both arms raised must cut); the anatomical phantom's
+// girdles stand apart there. Either way each girdle has its sternoclavicular joint.
+TEST(Rig, GirdlesThatMeetAcrossTheSternumAreRiggedTouching) {
+  constexpr int kGirdleLeft = 15,
+                kGirdleRight = 16;  // the rig's S: 15-16 shoulder_girdle_left/right
+  auto girdleFaces = [](bool touching) {
+    PhantomOptions o;
+    o.spacingMm = Eigen::Vector3d(1.8, 1.8, 4.8);
+    o.armsResting = true;
+    o.girdlesTouching = touching;
+    auto [G, S] = Phantom(o).makeVolumes();
+    const RigResult rig = rigBody(G);
+    for (const char* j : {"sternoclavicular_left", "sternoclavicular_right"})
+      EXPECT_NE(rig.skeleton.find(j), nullptr) << j << (touching ? " (touching)" : "");
+    const Volume& P = rig.parts;
+    const auto d = P.dims();
+    const std::int64_t step[3] = {1, d[0], d[0] * d[1]};
+    std::int64_t faces = 0;
+    for (std::int64_t k = 0; k + 1 < d[2]; ++k)
+      for (std::int64_t j = 0; j + 1 < d[1]; ++j)
+        for (std::int64_t i = 0; i + 1 < d[0]; ++i) {
+          const std::int64_t v = P.index(i, j, k);
+          for (const std::int64_t s : step) {
+            const int a = int(P.valueAsDouble(v)), b = int(P.valueAsDouble(v + s));
+            faces +=
+                (a == kGirdleLeft && b == kGirdleRight) || (a == kGirdleRight && b == kGirdleLeft);
+          }
+        }
+    return faces;
+  };
+  EXPECT_GE(girdleFaces(true), 20);
+  EXPECT_EQ(girdleFaces(false), 0);
+  PhantomOptions bad;
+  bad.girdlesTouching = true;
+  EXPECT_THROW(Phantom{bad}, Error);  // the girdle belongs to the arms-resting posture
+}
+
 TEST(Rig, ABodyWithoutArmsIsRiggedForItsLegsAndSaysSo) {
   PhantomOptions o;
   o.voxelMm = 3;
