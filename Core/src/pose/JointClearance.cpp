@@ -49,6 +49,7 @@ JointClearance::JointClearance(const Pose& pose, const Skeleton& skeleton, const
   };
   const Eigen::Matrix4d toIjk = grid_.ijkToRas.inverse();
   const auto d = grid_.dims;
+  const Eigen::Vector3d half = 0.5 * grid_.spacing();  // a voxel's box around its centre
   for (const SkeletonJoint& j : skeleton.joints) {
     const int a = labelOf(j.parts[0]), b = labelOf(j.parts[1]);
     if (a <= 0 || b <= 0 || !groupOf.count(a) || !groupOf.count(b)) continue;
@@ -85,8 +86,6 @@ JointClearance::JointClearance(const Pose& pose, const Skeleton& skeleton, const
           if ((s != a && s != b) || !isRigid(organs.valueAsDouble(v))) continue;
           const Eigen::Vector3d ras = grid_.voxelToRas(double(i), double(jj), double(k));
           if ((ras - j.centre).norm() > reach) continue;
-          // The voxel's box, half a voxel each way around its centre (rest IJK -> RAS).
-          const Eigen::Vector3d half = 0.5 * grid_.spacing();
           if (s == a) {
             site.proximalBone.push_back(v);
             site.proximalBox.extend(ras - half), site.proximalBox.extend(ras + half);
@@ -162,8 +161,9 @@ std::vector<JointClearance::Shift> JointClearance::apply(
     const Eigen::Isometry3d distal = motions[std::size_t(site.distal)];
     if ((proximal.inverse() * distal).matrix().isApprox(Eigen::Matrix4d::Identity(), 1e-12))
       continue;  // the joint does not move
-    // What the collision target allows (docs/QUALITY.md: 0.1 % of the smaller bone, at least a
-    // voxel) is left as posed: a frame within its targets is not moved.
+    // What the collision target allows is left as posed: 0.1 % of the smaller bone end within
+    // reach of the joint, at least a voxel (docs/QUALITY.md's target takes 0.1 % of the whole
+    // smaller bone, so this is the stricter of the two).
     const std::int64_t allowed = std::max<std::int64_t>(
         1,
         std::int64_t(0.001 * double(std::min(site.distalBone.size(), site.proximalBone.size()))));

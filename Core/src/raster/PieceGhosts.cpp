@@ -38,8 +38,8 @@ std::vector<PieceGhost> pieceGhosts(const TransferMesh& mesh, const Volume& piec
   // pieces of other body parts it holds: Mesh_3 lets a bone of one part into another part's piece
   // tets where they lie on each other (a scapula's tets on the ribs of an 8 mm grid); the piece
   // tet does not write them (Rasterizer.cpp, foreignPiece), so their own part's ghost does. A
-  // bone one voxel thick slips between a soft tet's 13 samples less often than between a piece
-  // tet's, and the piece tets are few: theirs are sampled on a lattice of about half a voxel.
+  // bone one voxel thick can slip between 13 samples, and the piece tets are few: theirs are also
+  // sampled on a lattice of about half a voxel.
   const double voxelMm = pieceLabels.geometry().spacing().minCoeff();
   std::vector<std::vector<Held>> holds(static_cast<std::size_t>(nt));
   bool any = false;
