@@ -39,7 +39,7 @@ struct TetShape {
 
 // The tet's energy and its gradient in corner `corner`.
 double tetEnergy(const std::array<Eigen::Vector3d, 4>& x, const TetShape& shape, double delta,
-                 int corner, Eigen::Vector3d* gradient) {
+                 double volumeWeight, int corner, Eigen::Vector3d* gradient) {
   Eigen::Matrix3d E;
   for (int c = 0; c < 3; ++c) E.col(c) = x[std::size_t(c) + 1] - x[0];
   const Eigen::Matrix3d S = E * shape.restInverse;
@@ -47,7 +47,7 @@ double tetEnergy(const std::array<Eigen::Vector3d, 4>& x, const TetShape& shape,
   const double root = std::sqrt(d * d + 4 * delta * delta);
   const double sigma = (d + root) / 2;
   const double s23 = std::cbrt(sigma * sigma);
-  const double energy = F / (3 * s23);
+  const double energy = F / (3 * s23) + volumeWeight * (d - 1) * (d - 1);
   if (gradient) {
     Eigen::Matrix3d cof;
     cof.col(0) = E.col(1).cross(E.col(2));
@@ -56,7 +56,8 @@ double tetEnergy(const std::array<Eigen::Vector3d, 4>& x, const TetShape& shape,
     const double dSigma = 0.5 * (1 + d / root);
     const Eigen::Matrix3d dE =
         2 * S * shape.restInverse.transpose() / (3 * s23) -
-        (2.0 / 9.0) * F / (s23 * sigma) * dSigma * shape.restInverseDet * cof;
+        ((2.0 / 9.0) * F / (s23 * sigma) * dSigma - 2 * volumeWeight * (d - 1)) *
+            shape.restInverseDet * cof;
     *gradient =
         corner == 0 ? Eigen::Vector3d(-dE.rowwise().sum()) : Eigen::Vector3d(dE.col(corner - 1));
   }
@@ -118,7 +119,8 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
       const double before = volumeOf(x);
       x[std::size_t(k)] = p;
       Eigen::Vector3d g;
-      f += tetEnergy(x, shape[std::size_t(t)], delta, k, gradient ? &g : nullptr);
+      f += tetEnergy(x, shape[std::size_t(t)], delta, options.volumeWeight, k,
+                     gradient ? &g : nullptr);
       if (gradient) *gradient += g;
       const int from = held.offsets[std::size_t(t)], to = held.offsets[std::size_t(t) + 1];
       if (from == to) continue;

@@ -59,6 +59,9 @@ struct UntangleOptions {
   // -0.462 % with 1e8 (-0.438 % without untangling; the same development build): the weaker hold
   // lets the fold take tissue.
   double kappa = 1e8;
+  // Weight of each tet's own volume, (det S - 1)^2, beside its shape. The shape term is scale
+  // invariant and, regularised, costs nothing for a tet crushed towards a point; this term does.
+  double volumeWeight = 0;
   int stepsPerVertex = 4;                     // descent steps per vertex per sweep
   const std::atomic<bool>* cancel = nullptr;  // set by another thread: stop after the sweep
 };

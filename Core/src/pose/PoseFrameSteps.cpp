@@ -368,7 +368,8 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
                                   {"inverted_tets_before", vr.invertedBefore},
                                   {"inverted_tets_after", vr.invertedAfter},
                                   {"untangled_tets", vr.untangled},
-                                  {"untangle_relaxed", vr.relaxedUntangle}};
+                                  {"untangle_relaxed", vr.relaxedUntangle},
+                                  {"untangle_crushed", vr.crushedUntangle}};
   report["bone_collisions"] = collisions;
   // Groups moved off a joint whose bones the turn drove together (JointClearance.h).
   nlohmann::json cleared = nlohmann::json::array();

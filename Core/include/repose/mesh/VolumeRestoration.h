@@ -65,6 +65,11 @@ struct VolumeRestorationOptions {
   // degrees on the 2 mm phantom); 1e7 left 2 of those 6 tets inside out.
   double relaxedKappa = 3e6;
   int relaxedSweeps = 600;
+  // When tets are inside out after both: the weaker hold's sweeps again with this weight on each
+  // tet's own volume (TetUntangle.h's volumeWeight; 0: none), which lifts tets crushed towards a
+  // point. 10 turned back all 12 tets the first two left on the adult female's grid (both arms
+  // up 160 degrees); 1 left 5 and 0.1 left 8.
+  double crushedVolumeWeight = 10;
   // Set by another thread to stop early (a live prediction a new drag made stale): checked
   // between rounds and sweeps; the positions are then left wherever they are and `cancelled` is
   // reported.
@@ -84,6 +89,9 @@ struct VolumeRestorationReport {
   // Tets were still inside out after the untangling's sweeps, and it swept again under the
   // weaker hold (kept only when that left fewer inside out).
   bool relaxedUntangle = false;
+  // Tets were inside out after both, and it swept a third time with each tet's own volume
+  // weighed (kept only when that left fewer inside out).
+  bool crushedUntangle = false;
   bool cancelled = false;  // stopped by VolumeRestorationOptions::cancel: the result means nothing
 };
 
