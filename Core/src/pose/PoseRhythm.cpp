@@ -212,6 +212,15 @@ Pose PoseRhythms::apply(const Pose& pose, std::vector<std::string>* notes) const
         const double elevation = std::acos(std::clamp(moved.dot(gd.distal), -1.0, 1.0)) / kDeg;
         const double phi = girdleTurnDeg(elevation);
         Eigen::Vector3d axis = gd.distal.cross(moved);
+        // Straight up (180 degrees) the two directions are opposite and say no plane: the turn's
+        // own path does, through the direction halfway along it. A fallback that picked any axis
+        // turned the girdles down instead of up, into the ribs and the organs below them.
+        if (axis.norm() < 1e-6) {
+          const Eigen::AngleAxisd whole(t.isometry().linear());
+          const Eigen::Vector3d halfway =
+              Eigen::AngleAxisd(whole.angle() / 2, whole.axis()) * gd.distal;
+          axis = gd.distal.cross(halfway);
+        }
         if (axis.norm() < 1e-9) axis = gd.distal.unitOrthogonal();
         girdleT.push_back(turn(axis, phi, gd.sc));
         newArmT.push_back(onCarrier(t, girdleT.back()));

@@ -158,6 +158,34 @@ TEST(PoseRhythm, AnArmRaisedBeyond90TurnsItsGirdleAndKeepsItsOrientation) {
   EXPECT_EQ(rhythms.apply(own).groups.size(), 3u);
 }
 
+// Straight up (180 degrees) the arm's rest and posed directions are opposite and say no plane of
+// elevation; the girdle then turns in the plane of the turn's own path, as it does a hair below
+// (arms_up180.pose.json turned both girdles 30 degrees down into the ribs and organs before).
+TEST(PoseRhythm, AnArmStraightUpTurnsItsGirdleUpAsJustBelowIt) {
+  // An arm that hangs a little forward and out, as a fitted one does (the fallback of old picked
+  // an axis square to it, which only an arm hanging straight down along z made the right one).
+  Skeleton s = body();
+  for (SkeletonJoint& j : s.joints)
+    if (j.name == "shoulder_left")
+      j.axes = jointAxes(JointKind::Shoulder, Eigen::Vector3d(-0.3, 0.2, -1).normalized(),
+                         Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(), -1);
+  const SkeletonJoint& shoulder = *s.find("shoulder_left");
+  const PoseRhythms rhythms(s, parts());
+  auto girdleAt = [&](double angle) {
+    Pose pose;
+    pose.name = "up";
+    pose.groups = {
+        limb("left arm", {"upper_arm_left", "forearm_left"}, shoulder, "abduction", angle), rest()};
+    const Pose applied = rhythms.apply(pose);
+    return motion(applied, "shoulder_girdle_left (scapulohumeral rhythm)");
+  };
+  const Eigen::Isometry3d up = girdleAt(180), below = girdleAt(179.99);
+  EXPECT_NEAR(Eigen::AngleAxisd(up.linear()).angle() / kDeg, 30, 1e-9);
+  EXPECT_LT((up.linear() - below.linear()).norm(), 1e-3);
+  // The shoulder rides up with its girdle, as at 150 degrees.
+  EXPECT_GT((up * shoulder.centre).z(), shoulder.centre.z() + 10);
+}
+
 TEST(PoseRhythm, HipsFlexedBeyond60TiltThePelvisBackAndTheThighsKeepTheirOrientation) {
   const Skeleton s = body();
   const SkeletonJoint& left = *s.find("hip_left");
