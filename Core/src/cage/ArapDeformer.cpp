@@ -2,7 +2,7 @@
 // factorization of L_ff made in setHandles; the local step fits one rotation per vertex.
 #include "repose/cage/ArapDeformer.h"
 
-#include "numerics/SparseCholesky.h"
+#include "repose/numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
 
 #include <Eigen/Geometry>

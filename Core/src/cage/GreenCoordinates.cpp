@@ -3,7 +3,7 @@
 // an edge's line so the coordinates stay finite.
 #include "repose/cage/GreenCoordinates.h"
 
-#include "TriangleClosestPoint.h"
+#include "repose/cage/TriangleClosestPoint.h"
 
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"

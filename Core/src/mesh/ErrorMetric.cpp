@@ -2,7 +2,7 @@
 // all barycentric coordinates >= 0; it runs once per refinement step, not per frame.
 #include "repose/mesh/ErrorMetric.h"
 
-#include "TetAdjacency.h"
+#include "repose/mesh/TetAdjacency.h"
 #include "repose/util/Error.h"
 
 #include <Eigen/LU>

@@ -1,8 +1,8 @@
 #include "repose/mesh/RigidHandles.h"
 
-#include "TetAdjacency.h"
-#include "cage/TriangleClosestPoint.h"
-#include "numerics/SparseCholesky.h"
+#include "repose/mesh/TetAdjacency.h"
+#include "repose/cage/TriangleClosestPoint.h"
+#include "repose/numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 

@@ -5,8 +5,8 @@
 
 #include "CompactGreenMatrix.h"
 #include "GreenCoordinatesFile.h"
-#include "TetAdjacency.h"
-#include "numerics/SparseCholesky.h"
+#include "repose/mesh/TetAdjacency.h"
+#include "repose/numerics/SparseCholesky.h"
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
 

@@ -1,5 +1,5 @@
 // Adjacency by sorting (face key, tet) and (edge key, tet) pairs: O(T log T), no hash maps.
-#include "TetAdjacency.h"
+#include "repose/mesh/TetAdjacency.h"
 
 #include <algorithm>
 #include <array>

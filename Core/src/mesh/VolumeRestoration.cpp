@@ -3,7 +3,7 @@
 #include "repose/mesh/VolumeRestoration.h"
 
 #include "TetUntangle.h"
-#include "numerics/SparseCholesky.h"
+#include "repose/numerics/SparseCholesky.h"
 
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>

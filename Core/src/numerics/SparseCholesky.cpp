@@ -1,6 +1,6 @@
 // CHOLMOD through Eigen's CholmodSupport; the cholmod_common lives inside the Eigen solver, so
 // one SparseCholesky owns exactly one CHOLMOD context (RAII, no global state).
-#include "SparseCholesky.h"
+#include "repose/numerics/SparseCholesky.h"
 
 #include "repose/util/Error.h"
 

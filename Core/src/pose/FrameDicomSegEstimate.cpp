@@ -10,7 +10,7 @@
 // and the pockets. The estimate counts, per slice, the segments whose extent holds it (at least
 // one: an empty slice's frame), and once each segment with none.
 #include "PoseFrameSteps.h"
-#include "raster/RasterScan.h"
+#include "repose/raster/RasterReach.h"
 
 #include "repose/io/DicomSegIO.h"
 #include "repose/util/Memory.h"

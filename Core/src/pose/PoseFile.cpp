@@ -4,7 +4,7 @@
 #include "repose/io/AtomicOutput.h"
 #include "repose/pose/Pose.h"
 #include "repose/util/Error.h"
-#include "util/JsonFields.h"
+#include "repose/util/JsonFields.h"
 
 #include <nlohmann/json.hpp>
 

@@ -1,5 +1,5 @@
 // From a pose file's groups to rigid handles of one cage and transfer mesh, and the posed cage.
-#include "mesh/TetAdjacency.h"
+#include "repose/mesh/TetAdjacency.h"
 #include "repose/cage/ArapDeformer.h"
 #include "repose/pose/Pose.h"
 #include "repose/util/Error.h"

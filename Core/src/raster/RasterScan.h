@@ -6,6 +6,7 @@
 
 #include "PieceGhosts.h"
 #include "TetScan.h"
+#include "repose/raster/RasterReach.h"
 #include "repose/raster/Rasterizer.h"
 #include "repose/util/Error.h"
 #include "repose/util/Parallel.h"
@@ -108,13 +109,6 @@ struct Shell {
 // Per piece tet, bit f for face f (opposite vertex f) when the tet across it is not a tet of the
 // same piece label (soft tissue, another piece, or nothing).
 std::vector<std::uint8_t> pieceRimFaces(const TransferMesh& mesh);
-
-// How far beyond its tets a whole piece writes its rim and ghosts (mm): the larger of the input's
-// voxel size and the one the mesh was made from (Mesh_3 puts a piece's surface that close).
-double pieceReachMm(const TransferMesh& mesh, const VolumeGeometry& input);
-// The shell's width (mm): options.shellMm, or when it is < 0 twice pieceReachMm.
-double shellWidthMm(const TransferMesh& mesh, const VolumeGeometry& input,
-                    const RasterOptions& options);
 
 // The shell and rims of one scan (RasterOptions: shellMm, outerFaces, restParts, pieceLabels,
 // bonePieces) for a mesh posed from `input` onto `output`.

@@ -1,5 +1,6 @@
 // A sparse symmetric positive definite factorization kept for repeated solves (CHOLMOD's
-// supernodal LLT through Eigen). Private to Core: public headers show only Eigen dense types.
+// supernodal LLT through Eigen). Shared by Core's solvers (cage, mesh); no header of Core's
+// public interface includes it, so those show only Eigen's dense types.
 #pragma once
 
 #include <Eigen/Core>
