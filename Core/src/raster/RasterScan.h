@@ -17,6 +17,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -115,14 +117,31 @@ std::vector<std::uint8_t> pieceRimFaces(const TransferMesh& mesh);
 Shell makeShell(const TransferMesh& mesh, const VolumeGeometry& input, const VolumeGeometry& output,
                 const RasterOptions& options);
 
-// Runs the scan over slabs of output slices on all cores. Each slab is written by one thread,
-// tets in index order, so overlapping (folded) tets resolve the same way on every run; then the
-// shell pass writes the voxels of the slab still uncovered.
+// Runs the scan over slabs of output slices on all cores (RasterScanRun.cpp). Each slab is
+// written by one thread, tets in index order, so overlapping (folded) tets resolve the same way on
+// every run; then the shell pass writes the voxels of the slab still uncovered.
 //
-// `write(k, j, i0, i1, rest0, step, tet)` writes a row interval. A writer that batches its
-// writes has worker(): each thread then writes through its own worker object, in order, and
-// calls its flush() when its work items are done (every voxel is in one work item, so a worker's
-// late writes race with no other thread).
+// Where it writes: a sink per thread, each written in order, row interval by row interval
+// (`write(k, j, i0, i1, rest0, step, tet)`), and flushed when its thread's work items are done
+// (every voxel is in one work item, so a sink's late writes race with no other thread).
+class ScanSink {
+ public:
+  virtual ~ScanSink() = default;
+  virtual void write(std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+                     const Eigen::Vector3d& rest0, const Eigen::Vector3d& step,
+                     std::int32_t tet) = 0;
+  virtual void flush() {}
+};
+using ScanSinks = std::function<std::unique_ptr<ScanSink>()>;  // called once per thread
+
+// Only slices [kBegin, kEnd) are scanned (the out-of-core path's slab; kEnd < 0: to the last), in
+// the full grid's coordinates, so a slab's voxels get exactly the values the whole grid would.
+void runScanWith(const ScanInput& in, const Shell& shell, const RasterOptions& options,
+                 const std::string& stage, RasterReport* report, double frameSign,
+                 const ScanSinks& sinks, std::int64_t kBegin = 0, std::int64_t kEnd = -1);
+
+// runScan with a writer: a callable `write(k, j, i0, i1, rest0, step, tet)`, or one that batches
+// its writes and gives each thread its own worker() (a callable with flush()).
 template <class W, class = void>
 struct HasWorker : std::false_type {};
 template <class W>
@@ -146,362 +165,31 @@ auto workerOf(Write& write) {
     return DirectWorker<Write>{write};
 }
 
+template <class Worker>
+class ScanSinkOf final : public ScanSink {
+ public:
+  explicit ScanSinkOf(Worker worker) : worker_(std::move(worker)) {}
+  void write(std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
+             const Eigen::Vector3d& rest0, const Eigen::Vector3d& step, std::int32_t tet) override {
+    worker_(k, j, i0, i1, rest0, step, tet);
+  }
+  void flush() override { worker_.flush(); }
+
+ private:
+  Worker worker_;
+};
+
 template <class Write>
 void runScan(const ScanInput& in, const Shell& shell, const RasterOptions& options,
              const std::string& stage, RasterReport* report, double frameSign, Write&& write,
              std::int64_t kBegin = 0, std::int64_t kEnd = -1) {
-  // Only slices [kBegin, kEnd) are scanned (the out-of-core path's slab), in the full grid's
-  // coordinates, so a slab's voxels get exactly the values the whole grid would.
-  if (kEnd < 0) kEnd = in.dims[2];
-  const Eigen::Index nt = in.tets->rows();
-  const std::int64_t nx = in.dims[0];
-  // Each tet's box in j and k (grown for the shell if it has an outer face), to skip it cheaply
-  // outside a work item. Only tets whose box meets the grid are kept: for a live slice, the few
-  // crossing it, found with plain comparisons first since every tet is looked at.
-  const bool withShell = !shell.outer.empty();
-  const bool withRims = !shell.pieceFaces.empty();
-  Eigen::MatrixX4i ghostTets;
-  const ScanInput ghostIn =
-      withRims ? raster::ghostScanInput(in, shell.ghosts, ghostTets) : ScanInput();
-  // Outcodes (Cohen-Sutherland) of the vertices against the scanned rows and slices: a tet whose
-  // four vertices share a bit lies wholly on one side, found from four bytes. Bits 0-3 use the
-  // bounds grown by the largest box growth and one voxel more (so rounding cannot reject a tet the
-  // box test below keeps), for tets that grow (an outer face's shell, a piece's rim); bits 4-7 the
-  // exact bounds, for the rest. A live slice keeps a few thousand of 200K tets.
-  double gyMax = 0, gzMax = 0;
-  if (withShell) gyMax = shell.boxGrowth[1], gzMax = shell.boxGrowth[2];
-  if (withRims)
-    gyMax = std::max(gyMax, shell.pieceGrowth[1]), gzMax = std::max(gzMax, shell.pieceGrowth[2]);
-  const double zBelow = double(kBegin) - gzMax - 1, zAbove = double(kEnd - 1) + gzMax + 1;
-  const double yBelow = -gyMax - 1, yAbove = double(in.dims[1] - 1) + gyMax + 1;
-  const double zFirst = double(kBegin), zLast = double(kEnd - 1), yLast = double(in.dims[1] - 1);
-  std::vector<std::uint8_t> outcode(in.out.size());
-  for (std::size_t v = 0; v < in.out.size(); ++v) {
-    const double y = in.out[v].y(), z = in.out[v].z();
-    outcode[v] =
-        std::uint8_t((z < zBelow) | (z > zAbove) << 1 | (y < yBelow) << 2 | (y > yAbove) << 3 |
-                     (z < zFirst) << 4 | (z > zLast) << 5 | (y < 0) << 6 | (y > yLast) << 7);
-  }
-  // On a grid one slice thick (a live slice) a tet that does not grow holds voxels only where
-  // its cross-section with the slice's plane does: its rows are those the section spans, and it
-  // is dropped when the section holds no voxel centre. The section's corners are rounded, so the
-  // bounds are widened by kSectionSlack voxels (the scan decides the voxels themselves exactly).
-  const bool onePlane = kEnd - kBegin == 1;
-  constexpr double kSectionSlack = 1e-6;
-  // Selected in parallel chunks, then joined in tet order (the order folds are resolved in).
-  // Per candidate: its box's rows and slices (grown for a growing tet), and the rows the tet
-  // itself is scanned over (mjmin > mjmax: none, a growing tet that only its shell brings to
-  // the scanned region).
-  struct Candidate {
-    std::int32_t tet;
-    raster::TetVertices v;
-    std::int32_t jmin, jmax, kmin, kmax, mjmin, mjmax;
-  };
-  const int selectThreads = resolveThreads(options.threads);
-  std::vector<std::vector<Candidate>> parts(static_cast<std::size_t>(selectThreads));
-  const std::uint8_t* outerFaces = withShell ? shell.outer.data() : nullptr;
-  const std::uint8_t* rimFaces = withRims ? shell.pieceFaces.data() : nullptr;
-  auto growsAt = [outerFaces, rimFaces](Eigen::Index t) {
-    return (outerFaces && outerFaces[t]) || (rimFaces && rimFaces[t]);
-  };
-  parallelFor(
-      selectThreads, selectThreads,
-      [&](std::int64_t pb, std::int64_t pe) {
-        for (std::int64_t part = pb; part < pe; ++part) {
-          std::vector<Candidate>& c = parts[static_cast<std::size_t>(part)];
-          const Eigen::Index tBegin = nt * part / selectThreads,
-                             tEnd = nt * (part + 1) / selectThreads;
-          // First the outcodes alone, in a loop that does nothing else and has no branch: all
-          // but one in ten tets of a live slice stop here, scattered over the mesh. The vertex
-          // indices of those kept are copied here: read again below, each was a cache miss.
-          const std::size_t span = static_cast<std::size_t>(tEnd - tBegin) + 1;
-          // Not zeroed: only the first `kept` entries are ever read.
-          const std::unique_ptr<std::int32_t[]> hits(new std::int32_t[span]);
-          const std::unique_ptr<raster::TetVertices[]> hitVertices(new raster::TetVertices[span]);
-          std::size_t kept = 0;
-          {
-            const std::uint8_t* oc = outcode.data();
-            const int *T0 = in.tets->col(0).data(), *T1 = in.tets->col(1).data(),
-                      *T2 = in.tets->col(2).data(), *T3 = in.tets->col(3).data();
-            for (Eigen::Index t = tBegin; t < tEnd; ++t) {
-              const raster::TetVertices v{T0[t], T1[t], T2[t], T3[t]};
-              const unsigned shared = oc[v[0]] & oc[v[1]] & oc[v[2]] & oc[v[3]];
-              hits[kept] = std::int32_t(t), hitVertices[kept] = v;
-              kept += !(shared & (growsAt(t) ? 0x0Fu : 0xF0u));
-            }
-          }
-          // Sized for all those kept and cut to those taken: filled by index, the appends had
-          // been out-of-line calls, visible in a profile of the live slice.
-          c.resize(kept);
-          std::size_t taken = 0;
-          for (std::size_t h = 0; h < kept; ++h) {
-            // The vertices of the tets a few ahead are fetched while this one is worked on.
-            constexpr std::size_t kAhead = 8;
-            if (h + kAhead < kept)
-              for (const int u : hitVertices[h + kAhead])
-                __builtin_prefetch(&in.out[std::size_t(u)]);
-            const std::int32_t t = hits[h];
-            const raster::TetVertices& v = hitVertices[h];
-            const bool grows = growsAt(t);
-            double gy = 0, gz = 0;  // box growth for the shell and the piece's rim
-            if (withShell && shell.outer[t]) gy = shell.boxGrowth[1], gz = shell.boxGrowth[2];
-            if (withRims && shell.pieceFaces[std::size_t(t)])
-              gy = std::max(gy, shell.pieceGrowth[1]), gz = std::max(gz, shell.pieceGrowth[2]);
-            const Eigen::Vector3d &p0 = in.out[v[0]], &p1 = in.out[v[1]], &p2 = in.out[v[2]],
-                                  &p3 = in.out[v[3]];
-            const double zlo = std::min(std::min(p0.z(), p1.z()), std::min(p2.z(), p3.z())) - gz;
-            const double zhi = std::max(std::max(p0.z(), p1.z()), std::max(p2.z(), p3.z())) + gz;
-            if (zhi < double(kBegin) || zlo > double(kEnd - 1)) continue;
-            const double ymin = std::min(std::min(p0.y(), p1.y()), std::min(p2.y(), p3.y()));
-            const double ymax = std::max(std::max(p0.y(), p1.y()), std::max(p2.y(), p3.y()));
-            const double ylo = ymin - gy, yhi = ymax + gy;
-            if (yhi < 0 || ylo > yLast || raster::ceilToInt(ylo) > raster::floorToInt(yhi))
-              continue;
-            // The rows of the tet itself: none when its four vertices share an exact bound
-            // (only a growing tet gets this far then).
-            double mylo = ymin, myhi = ymax;
-            const bool reaches = !(outcode[std::size_t(v[0])] & outcode[std::size_t(v[1])] &
-                                   outcode[std::size_t(v[2])] & outcode[std::size_t(v[3])] & 0xF0);
-            if (!reaches) mylo = 1, myhi = 0;
-            if (onePlane && reaches) {
-              // The section of the tet with the plane z = kBegin: its vertices on the plane and
-              // the crossings of its edges.
-              const Eigen::Vector3d* p[4] = {&p0, &p1, &p2, &p3};
-              double xlo = std::numeric_limits<double>::infinity(), xhi = -xlo;
-              mylo = xlo, myhi = -xlo;
-              for (int a = 0; a < 4; ++a) {
-                const double za = p[a]->z() - zFirst;
-                if (za == 0) {
-                  xlo = std::min(xlo, p[a]->x()), xhi = std::max(xhi, p[a]->x());
-                  mylo = std::min(mylo, p[a]->y()), myhi = std::max(myhi, p[a]->y());
-                }
-                for (int b = a + 1; b < 4; ++b) {
-                  const double zb = p[b]->z() - zFirst;
-                  if (!((za < 0 && zb > 0) || (za > 0 && zb < 0))) continue;
-                  const double u = za / (za - zb);
-                  const double x = p[a]->x() + u * (p[b]->x() - p[a]->x());
-                  const double y = p[a]->y() + u * (p[b]->y() - p[a]->y());
-                  xlo = std::min(xlo, x), xhi = std::max(xhi, x);
-                  mylo = std::min(mylo, y), myhi = std::max(myhi, y);
-                }
-              }
-              const double slack = kSectionSlack * (1 + std::max(std::abs(xlo), std::abs(xhi)));
-              xlo = std::max(xlo - slack, 0.0), xhi = std::min(xhi + slack, double(nx - 1));
-              const double ySlack = kSectionSlack * (1 + std::max(std::abs(mylo), std::abs(myhi)));
-              mylo -= ySlack, myhi += ySlack;
-              if (!(raster::ceilToInt(xlo) <= raster::floorToInt(xhi))) mylo = 1, myhi = 0;
-            }
-            const std::int64_t mj0 = std::max<std::int64_t>(0, raster::ceilToInt(mylo)),
-                               mj1 = std::min(in.dims[1] - 1, raster::floorToInt(myhi));
-            if (!grows && mj0 > mj1) continue;
-            // A tet that does not grow is handed to the work items by its own rows.
-            c[taken++] = Candidate{
-                t,
-                v,
-                std::int32_t(grows ? std::max<std::int64_t>(0, raster::ceilToInt(ylo)) : mj0),
-                std::int32_t(grows ? std::min(in.dims[1] - 1, raster::floorToInt(yhi)) : mj1),
-                std::int32_t(std::max(kBegin, raster::ceilToInt(zlo))),
-                std::int32_t(std::min(kEnd - 1, raster::floorToInt(zhi))),
-                std::int32_t(mj0),
-                std::int32_t(mj1)};
-          }
-          c.resize(taken);
-        }
+  runScanWith(
+      in, shell, options, stage, report, frameSign,
+      [&write]() -> std::unique_ptr<ScanSink> {
+        auto worker = workerOf(write);
+        return std::make_unique<ScanSinkOf<decltype(worker)>>(std::move(worker));
       },
-      1);
-  // Tets of whole pieces (bones, organs) go last, so where a fold of soft tissue overlaps a bone
-  // the bone keeps its voxels: soft tissue is what a bend squeezes.
-  std::vector<Candidate> candidates;
-  std::size_t total = 0;
-  for (const std::vector<Candidate>& c : parts) total += c.size();
-  candidates.reserve(total);
-  const bool withPieces = in.pieces && !in.pieces->empty();
-  for (const int pass : {0, 1}) {
-    if (pass == 1 && !withPieces) break;
-    for (const std::vector<Candidate>& c : parts) {
-      if (!withPieces) {
-        candidates.insert(candidates.end(), c.begin(), c.end());
-        continue;
-      }
-      for (const Candidate& n : c)
-        if (((*in.pieces)[std::size_t(n.tet)] != 0) == (pass == 1)) candidates.push_back(n);
-    }
-  }
-  // Work items: slabs of whole k-slices, or for thin grids (a live slice is one voxel thick)
-  // bands of j-rows across all slices, so every core has work either way.
-  const int threads = resolveThreads(options.threads);
-  const std::int64_t depth = kEnd - kBegin;
-  const bool bands = depth < 2 * threads;
-  const std::int64_t split = bands ? in.dims[1] : depth;
-  const std::int64_t slabs = std::max<std::int64_t>(1, std::min<std::int64_t>(split, 8 * threads));
-  // Each work item's candidates, in candidate order: a live slice's bands each meet a few
-  // hundred of the thousands of tets it keeps.
-  std::vector<std::vector<std::int32_t>> itemCandidates(static_cast<std::size_t>(slabs));
-  {
-    // The work item of each row or slice, as a table: two 64-bit divisions per candidate had
-    // cost a millisecond per slice.
-    std::vector<std::int32_t> itemOf(static_cast<std::size_t>(split));
-    for (std::int64_t item = 0; item < slabs; ++item)
-      std::fill(itemOf.begin() + split * item / slabs, itemOf.begin() + split * (item + 1) / slabs,
-                std::int32_t(item));
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
-      const Candidate& n = candidates[c];
-      const std::int64_t lo = bands ? n.jmin : n.kmin - kBegin,
-                         hi = bands ? n.jmax : n.kmax - kBegin;
-      if (lo > hi) continue;
-      for (std::int32_t item = itemOf[std::size_t(lo)], last = itemOf[std::size_t(hi)];
-           item <= last; ++item)
-        itemCandidates[std::size_t(item)].push_back(std::int32_t(c));
-    }
-  }
-  std::atomic<std::int64_t> writes{0}, shellWrites{0}, done{0}, nextSlab{0};
-  std::atomic<bool> stop{false};
-  std::mutex progressMutex;
-  // Work items are handed out one at a time: the body fills some bands of a slice and not others
-  // (a sagittal slice's trunk and head against its legs), so fixed halves would leave a core idle.
-  parallelFor(
-      std::min<std::int64_t>(slabs, threads), threads,
-      [&](std::int64_t, std::int64_t) {
-        std::int64_t localWrites = 0, localShell = 0;
-        HugePageVector<std::uint8_t> covered;  // tens of MB a slab of a full grid
-        auto sink = workerOf(write);
-        for (std::int64_t slab; !stop && (slab = nextSlab++) < slabs;) {
-          const std::int64_t s0 = split * slab / slabs, s1 = split * (slab + 1) / slabs;
-          const std::int64_t k0 = kBegin + (bands ? 0 : s0), k1 = bands ? kEnd : kBegin + s1;
-          const std::int64_t j0 = bands ? s0 : 0, j1 = bands ? s1 : in.dims[1];
-          // Voxels of this work item already written, row by row (rows j0..j1 of slices k0..k1).
-          const std::int64_t rows = j1 - j0;
-          // 1: written by soft tissue, 2: by a whole piece's tets, 3: by a rim or a ghost.
-          if (withShell || withRims)
-            covered.assign(static_cast<std::size_t>(nx * rows * (k1 - k0)), 0);
-          ScanTet s;
-          const std::vector<std::int32_t>& mine = itemCandidates[std::size_t(slab)];
-          // The vertices of the candidates a few ahead, deformed and at rest, are fetched while
-          // this one is scanned: a slice's tets lie scattered over the vertex arrays.
-          auto fetchAhead = [&](std::size_t m) {
-            constexpr std::size_t kAhead = 6;
-            if (m + kAhead >= mine.size()) return;
-            for (const int u : candidates[std::size_t(mine[m + kAhead])].v) {
-              __builtin_prefetch(&in.out[std::size_t(u)]);
-              __builtin_prefetch(&in.rest[std::size_t(u)]);
-            }
-          };
-          for (std::size_t m = 0; m < mine.size(); ++m) {
-            fetchAhead(m);
-            const Candidate& n = candidates[std::size_t(mine[m])];
-            const std::int32_t t = n.tet;
-            if (n.kmax < k0 || n.kmin >= k1 || n.mjmax < j0 || n.mjmin >= j1 || n.mjmin > n.mjmax ||
-                !raster::prepareTet(in, n.v, s))
-              continue;
-            const std::uint8_t mark = withPieces && (*in.pieces)[std::size_t(t)] != 0 ? 2 : 1;
-            raster::scanTet(s, k0, k1, std::max<std::int64_t>(j0, n.mjmin),
-                            std::min<std::int64_t>(j1, n.mjmax + 1),
-                            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
-                                const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
-                              localWrites += i1 - i0 + 1;
-                              if (!covered.empty())
-                                std::fill_n(
-                                    covered.begin() + (((k - k0) * rows + (j - j0)) * nx + i0),
-                                    i1 - i0 + 1, mark);
-                              sink(k, j, i0, i1, rest0, step, t);
-                            });
-          }
-          // Writes, over soft tissue, the voxels of the prepared region `s` whose rest label is
-          // bone of piece tet t's body part, through t's map (a rim, or a ghost hosted by t).
-          // `overPieces`: a ghost of a piece tet that held another part's bone (PieceGhosts.h)
-          // also writes over the voxels piece tets wrote (3 marks a rim's or a ghost's voxel):
-          // the piece tet that held the bone did not copy it, and may still cover its place.
-          auto scanRim = [&](std::int32_t t, bool overPieces) {
-            raster::scanTet(
-                s, k0, k1, j0, j1,
-                [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
-                    const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
-                  std::uint8_t* cv = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
-                  for (std::int64_t a = i0; a <= i1; ++a) {
-                    const Eigen::Vector3d p = rest0 + double(a - i0) * step;
-                    if (cv[a] >= (overPieces ? 3 : 2) || !shell.rimTakes(t, p, *shell.tetParts))
-                      continue;
-                    cv[a] = 3;
-                    sink(k, j, a, a, p, step, t);
-                  }
-                });
-          };
-          // The pieces' rims: the voxels of a piece's own label just beyond its tets (Mesh_3
-          // follows its surface to within a voxel) move with the piece, over the soft tissue
-          // that covered them.
-          for (std::size_t m = 0; m < mine.size() && withRims; ++m) {
-            const Candidate& n = candidates[std::size_t(mine[m])];
-            const std::int32_t t = n.tet;
-            const unsigned rim = shell.pieceFaces[std::size_t(t)];
-            if (!rim || n.kmax < k0 || n.kmin >= k1 || n.jmax < j0 || n.jmin >= j1 ||
-                !raster::prepareShell(in, n.v, rim, shell.pieceMm, shell.normalToMm,
-                                      shell.pieceGrowth, s))
-              continue;
-            scanRim(t, false);
-          }
-          // The ghosts: piece tissue in soft tets (a bone end a joint demoted), where the piece
-          // puts it.
-          for (std::size_t g = 0; g < shell.ghosts.size() && withRims; ++g) {
-            const std::int32_t t = shell.ghosts[g].host;
-            if (!raster::prepareShell(ghostIn, Eigen::Index(g), 0xF, shell.pieceMm,
-                                      shell.normalToMm, shell.pieceGrowth, s) ||
-                s.hi[2] < k0 || s.lo[2] >= k1 || s.hi[1] < j0 || s.lo[1] >= j1)
-              continue;
-            const std::int32_t soft = shell.ghosts[g].soft;
-            scanRim(t, withPieces && (*in.pieces)[std::size_t(soft)] != 0);
-          }
-          for (std::size_t m = 0; m < mine.size() && withShell; ++m) {
-            if (shell.outer[candidates[std::size_t(mine[m])].tet]) fetchAhead(m);
-            const Candidate& n = candidates[std::size_t(mine[m])];
-            const std::int32_t t = n.tet;
-            if (!shell.outer[t] || n.kmax < k0 || n.kmin >= k1 || n.jmax < j0 || n.jmin >= j1 ||
-                !raster::prepareShell(in, n.v, shell.outer[t], shell.mm, shell.normalToMm,
-                                      shell.boxGrowth, s))
-              continue;
-            raster::scanTet(s, k0, k1, j0, j1,
-                            [&](std::int64_t k, std::int64_t j, std::int64_t i0, std::int64_t i1,
-                                const Eigen::Vector3d& rest0, const Eigen::Vector3d& step) {
-                              std::uint8_t* c = covered.data() + ((k - k0) * rows + (j - j0)) * nx;
-                              auto free = [&](std::int64_t x) {
-                                return !c[x] && shell.takes(t, rest0 + double(x - i0) * step);
-                              };
-                              for (std::int64_t a = i0; a <= i1;) {
-                                if (!free(a)) {
-                                  ++a;
-                                  continue;
-                                }
-                                std::int64_t b = a;
-                                while (b + 1 <= i1 && free(b + 1)) ++b;
-                                std::fill(c + a, c + b + 1, std::uint8_t(1));
-                                localShell += b - a + 1;
-                                sink(k, j, a, b, Eigen::Vector3d(rest0 + double(a - i0) * step),
-                                     step, t);
-                                a = b + 1;
-                              }
-                            });
-          }
-          // Counted under the lock: counted before it, a thread could report 15/16 after
-          // another reported 16/16, and the last progress a user sees would not be the end.
-          std::lock_guard<std::mutex> lock(progressMutex);
-          const double fraction = double(++done) / double(slabs);
-          try {
-            reportProgress(options.progress, fraction, stage);
-          } catch (...) {
-            stop = true;
-            throw;
-          }
-        }
-        sink.flush();
-        writes += localWrites;
-        shellWrites += localShell;
-      },
-      1);
-  if (report) {
-    *report = RasterReport();
-    report->voxelWrites = writes;
-    report->shellVoxels = shellWrites;
-    countBadTets(in, frameSign, *report);
-  }
+      kBegin, kEnd);
 }
 
 // Face f of tet t (the face opposite vertex f) as its three vertex indices, sorted: the key two
