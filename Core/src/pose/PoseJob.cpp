@@ -1,6 +1,7 @@
 #include "repose/pose/PoseJob.h"
 
 #include "repose/pose/SceneFolder.h"
+#include "repose/raster/RestTissues.h"
 #include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
 
@@ -270,7 +271,14 @@ std::unique_ptr<PoseRig> PoseJob::makeRig(RigGeometry geometry, const Pose& pose
     for (const SkeletonJoint& j : skeleton_->joints) sites.push_back({j.name, j.centre});
     rig->setJointSites(std::move(sites));
   }
-  if (request_.volumeRestoration) rig->setTetTissues(tetTissues(rig->mesh(), *organs_, threads));
+  if (request_.volumeRestoration) {
+    // Counted as the label rounding's rest scan counts them, the shell beyond the outer faces
+    // included (raster/RestTissues.h), with the frame's body-part map.
+    RasterOptions ro;
+    ro.threads = threads;
+    ro.restParts = parts_;
+    rig->setTetTissues(restTetTissues(rig->mesh(), *organs_, ro));
+  }
   return rig;
 }
 

@@ -31,16 +31,18 @@
 
 namespace repose {
 
-// Which tissue each soft tet holds at rest: per tet, the labels of G whose voxel centres lie in it
-// and how many (whole pieces' tets hold none: they are rigid). What the per-tissue volumes of the
-// restoration are counted with, as the voxels' rounding counts them (the sum over a label's rest
-// voxels of their tet's volume ratio).
+// Which tissue each soft tet holds at rest: per tet, the labels of G among its voxels and how
+// many (whole pieces' tets hold none: they are rigid). What the per-tissue volumes of the
+// restoration are counted with; the voxels' rounding sums a label's rest voxels' tet volume ratios
+// over the same voxels when they come from raster/RestTissues.h (the jobs' rigs).
 struct TetTissues {
   std::vector<int> offsets;  // #tets + 1: tet t's entries are [offsets[t], offsets[t+1])
   std::vector<std::pair<int, int>> entries;  // (label, voxels)
   bool empty() const { return entries.empty(); }
 };
-// G on its own grid (any orientation), the mesh at rest in the same RAS space.
+// The voxel centres inside each tet alone (a centre on a face two tets share counts in both), from
+// G on its own grid (any orientation), the mesh at rest in the same RAS space. Misses the voxels
+// beyond the mesh's outer faces that the rasterizer's shell carries (raster/RestTissues.h).
 TetTissues tetTissues(const TransferMesh& mesh, const Volume& organs, int threads = 0);
 
 struct VolumeRestorationOptions {

@@ -196,7 +196,7 @@ class PoseRig {
   // solved from now on: made by PoseJob from G and S at rest.
   void setJointClearance(JointClearance clearance) { clearance_ = std::move(clearance); }
   const JointClearance& jointClearance() const { return clearance_; }
-  // The tissues of G each soft tet holds at rest (tetTissues): with them the restoration holds
+  // The tissues of G each soft tet holds at rest (restTetTissues): with them the restoration holds
   // each tissue's volume at the joints as well as each body part's. Without, parts only.
   void setTetTissues(TetTissues tissues) { tissues_ = std::move(tissues); }
   // The pairs of body parts (labels of S) a joint of the skeleton connects: where two groups
