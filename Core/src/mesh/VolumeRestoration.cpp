@@ -347,7 +347,8 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       // and a hair inside out. On the real adult female's grid (1.775 x 1.775 x 4.84 mm) with
       // both arms up 160 degrees, 12 such tets stayed at the shoulders, 0.1 to 13 mm^3 at rest
       // and a few thousandths of a mm^3 inside out; a weight on each tet's own volume turned
-      // every one back (docs/QUALITY.md). Kept only if it leaves fewer inside out.
+      // every one back (measured before the tissues of the shell's voxels were held too, which
+      // leaves 7 there: docs/ARCHITECTURE.md, "Creases"). Kept only if it leaves fewer inside out.
       const int left = std::min(u.invertedAfter, again.invertedAfter);
       if (left > 0 && options.crushedVolumeWeight > 0 && !cancelled()) {
         UntangleOptions crushed = relaxed;

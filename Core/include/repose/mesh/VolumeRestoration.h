@@ -70,7 +70,8 @@ struct VolumeRestorationOptions {
   // When tets are inside out after both: the weaker hold's sweeps again with this weight on each
   // tet's own volume (TetUntangle.h's volumeWeight; 0: none), which lifts tets crushed towards a
   // point. 10 turned back all 12 tets the first two left on the adult female's grid (both arms
-  // up 160 degrees); 1 left 5 and 0.1 left 8.
+  // up 160 degrees); 1 left 5 and 0.1 left 8 (before raster/RestTissues.h held the shell's
+  // tissues too: with it 7 are left there).
   double crushedVolumeWeight = 10;
   // Set by another thread to stop early (a live prediction a new drag made stale): checked
   // between rounds and sweeps; the positions are then left wherever they are and `cancelled` is
