@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 #include <utility>
 
 namespace repose {
@@ -44,12 +45,26 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
           std::max(report.worstPartBefore, std::fabs(100 * (v.second / v.first - 1)));
   report.worstPartAfter = report.worstPartBefore;
   report.invertedAfter = report.invertedBefore;
+  // Folds: the movable surface vertices inside another layer of tissue.
+  const auto deepest = [](const std::vector<SelfContact>& c) {
+    double d = 0;
+    for (const SelfContact& x : c) d = std::max(d, x.depthMm);
+    return d;
+  };
+  const bool withContacts = options.contacts && options.contactWeight > 0;
+  std::vector<SelfContact> contacts;
+  if (withContacts) {
+    contacts = options.contacts->find(deformed, &movable);
+    report.contactsBefore = report.contactsAfter = int(contacts.size());
+    report.deepestContactBeforeMm = report.deepestContactAfterMm = deepest(contacts);
+  }
 
   // Free vertices: those of tets off their volume, grown by `rings`, that may move.
   std::vector<char> free(std::size_t(nv), 0);
   for (Eigen::Index t = 0; t < nt; ++t)
     if (std::fabs(posed[std::size_t(t)] / rest[std::size_t(t)] - 1) > options.tolerance)
       for (int k = 0; k < 4; ++k) free[std::size_t(mesh.tets(t, k))] = 1;
+  for (const SelfContact& c : contacts) free[std::size_t(c.vertex)] = 1;
   for (int ring = 0; ring < options.rings; ++ring) {
     std::vector<char> grown = free;
     for (Eigen::Index t = 0; t < nt; ++t) {
@@ -175,12 +190,28 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
   };
   // One Gauss-Newton step from the positions at hand: the correction of every free vertex
   // (3 unknowns each, index order).
+  // The contacts of the free vertices at the positions at hand (SelfContact.h).
+  std::vector<char> isFree(std::size_t(nv), 0);
+  for (Eigen::Index v = 0; v < nv; ++v) isFree[std::size_t(v)] = index[std::size_t(v)] >= 0;
+  const auto findContacts = [&](const Eigen::MatrixX3d& x) {
+    return withContacts ? options.contacts->find(x, &isFree) : std::vector<SelfContact>();
+  };
+  contacts = findContacts(deformed);
+  // Every contact found in a round stays as a one-sided plane (the other layer's surface there)
+  // until the end: pushed out, a vertex the planes forgot would be pulled back in by the rest of
+  // the step, and the rounds would swing.
+  std::unordered_map<int, SelfContact> planes;
+  const auto remember = [&] {
+    for (const SelfContact& c : contacts) planes[c.vertex] = c;
+  };
+  remember();
   auto gaussNewtonStep = [&]() -> Eigen::VectorXd {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(active.size() * 78 + edges.size() * 12 + std::size_t(unknowns));
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns);
     Eigen::MatrixXd C = Eigen::MatrixXd::Zero(unknowns, constraints);  // columns: parts' gradients
     Eigen::VectorXd partResidual = residual(deformed);
+    std::vector<double> stiffness(planes.empty() ? 0 : std::size_t(n), 0.0);
     for (int c = 0; c < constraints; ++c) partResidual[c] /= amount[std::size_t(c)];
     for (const Eigen::Index t : active) {
       const auto x = corners(deformed, t);
@@ -202,6 +233,8 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       for (int a = 0; a < 4; ++a) {
         const int ia = index[std::size_t(mesh.tets(t, a))];
         if (ia < 0) continue;
+        if (!stiffness.empty())
+          stiffness[std::size_t(ia)] += w * g[std::size_t(a)].squaredNorm() / 3;
         for (int c = 0; c < 3; ++c) {
           rhs[3 * ia + c] -= w * r * g[std::size_t(a)][c];
           C(3 * ia + c, column) += g[std::size_t(a)][c] / amount[std::size_t(column)];
@@ -239,6 +272,21 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
         }
       }
     }
+    // Folds: each contact pulls its vertex along its way out to `contactMarginMm` beyond the
+    // other layer's surface, as stiff as `contactWeight` times the tets' volumes around it.
+    for (const auto& [vertex, contact] : planes) {
+      const int i = index[std::size_t(vertex)];
+      if (i < 0) continue;
+      const Eigen::Vector3d p = deformed.row(vertex).transpose();
+      const double gap = (contact.point - p).dot(contact.normal) + options.contactMarginMm;
+      if (gap <= 0) continue;  // beyond the plane by the margin: free to move
+      const double k = options.contactWeight * std::max(stiffness[std::size_t(i)], lambda);
+      for (int c = 0; c < 3; ++c) {
+        rhs[3 * i + c] += k * gap * contact.normal[c];
+        for (int e = 0; e < 3; ++e)
+          triplets.emplace_back(3 * i + c, 3 * i + e, k * contact.normal[c] * contact.normal[e]);
+      }
+    }
     for (int i = 0; i < unknowns; ++i) triplets.emplace_back(i, i, 1e-9 * lambda + 1e-12);
     Eigen::SparseMatrix<double> A(unknowns, unknowns);
     A.setFromTriplets(triplets.begin(), triplets.end());
@@ -257,10 +305,22 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     const Eigen::VectorXd mu = schur.ldlt().solve(C.transpose() * S.col(0) + partResidual);
     return S.col(0) - S.rightCols(constraints) * mu;
   };
+  // With contacts the rounds keep the positions of least misfit plus contact depth: an edge's
+  // length of depth in all weighs as much as the tolerance on a part's volume.
+  double meanEdge = 0;
+  for (const auto& [a, b] : edges) meanEdge += (mesh.vertices.row(a) - mesh.vertices.row(b)).norm();
+  meanEdge /= double(std::max<std::size_t>(1, edges.size()));
+  const auto score = [&](const Eigen::MatrixX3d& x, const std::vector<SelfContact>& c) {
+    double depth = 0;
+    for (const SelfContact& s : c) depth += s.depthMm;
+    return misfit(x) + options.tolerance * depth / std::max(1e-9, meanEdge);
+  };
   Eigen::MatrixX3d best = deformed;
-  double bestMisfit = misfit(deformed);
+  double bestMisfit = score(deformed, contacts);
   const auto cancelled = [&] { return options.cancel && options.cancel->load(); };
-  for (int round = 0; round < options.iterations; ++round) {
+  const int rounds =
+      planes.empty() ? options.iterations : std::max(options.iterations, options.contactIterations);
+  for (int round = 0; round < rounds; ++round) {
     if (cancelled()) {
       report.cancelled = true;
       return report;
@@ -280,9 +340,13 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       moved = std::max(moved, d.norm());
     }
     report.iterations = round + 1;
-    const double now = misfit(deformed);
+    contacts = findContacts(deformed);
+    remember();
+    const double now = score(deformed, contacts);
     if (now < bestMisfit) bestMisfit = now, best = deformed;
     if (moved < 1e-4) break;  // settled
+    // The volumes' rounds are done and no contact is left.
+    if (contacts.empty() && round + 1 >= options.iterations) break;
   }
   deformed = best;
 
@@ -383,6 +447,11 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     if (v.first > 0)
       report.worstPartAfter =
           std::max(report.worstPartAfter, std::fabs(100 * (v.second / v.first - 1)));
+  if (withContacts) {
+    const std::vector<SelfContact> left = options.contacts->find(deformed, &movable);
+    report.contactsAfter = int(left.size());
+    report.deepestContactAfterMm = deepest(left);
+  }
   for (Eigen::Index v = 0; v < nv; ++v)
     report.maxCorrectionMm =
         std::max(report.maxCorrectionMm, (deformed.row(v) - start.row(v)).norm());

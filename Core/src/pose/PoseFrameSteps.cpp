@@ -369,7 +369,11 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
                                   {"inverted_tets_after", vr.invertedAfter},
                                   {"untangled_tets", vr.untangled},
                                   {"untangle_relaxed", vr.relaxedUntangle},
-                                  {"untangle_crushed", vr.crushedUntangle}};
+                                  {"untangle_crushed", vr.crushedUntangle},
+                                  {"fold_contacts_before", vr.contactsBefore},
+                                  {"fold_contacts_after", vr.contactsAfter},
+                                  {"deepest_fold_before_mm", vr.deepestContactBeforeMm},
+                                  {"deepest_fold_after_mm", vr.deepestContactAfterMm}};
   report["bone_collisions"] = collisions;
   // Groups moved off a joint whose bones the turn drove together (JointClearance.h).
   nlohmann::json cleared = nlohmann::json::array();

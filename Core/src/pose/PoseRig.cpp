@@ -407,6 +407,7 @@ PoseRig::PoseRig(RigGeometry geometry, const Pose& pose, const LabelTable& partL
     for (Eigen::Index t = 0; t < m.tets.rows(); ++t)
       if (m.rigid[std::size_t(t)])
         for (int k = 0; k < 4; ++k) movable_[std::size_t(m.tets(t, k))] = 0;
+  contacts_ = std::make_unique<SelfContactFinder>(m);
 }
 
 PoseRig::~PoseRig() = default;
@@ -457,6 +458,7 @@ VolumeRestorationReport PoseRig::restoreFrameVolumes(Eigen::MatrixX3d& deformed,
   std::vector<char> held = bends_.empty() ? std::vector<char>() : bends_.reachTets(m, handles);
   VolumeRestorationOptions options;
   options.cancel = cancel;
+  options.contacts = contacts_.get();
   return restoreVolumes(m, grown, deformed, options, held, tissues_.empty() ? nullptr : &tissues_);
 }
 

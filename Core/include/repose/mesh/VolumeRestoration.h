@@ -20,6 +20,7 @@
 // sparse Cholesky factorisation and a small dense system per round).
 #pragma once
 
+#include "repose/mesh/SelfContact.h"
 #include "repose/mesh/TransferMesh.h"
 #include "repose/volume/Volume.h"
 
@@ -73,6 +74,17 @@ struct VolumeRestorationOptions {
   // up 160 degrees); 1 left 5 and 0.1 left 8 (before raster/RestTissues.h held the shell's
   // tissues too: with it 7 are left there).
   double crushedVolumeWeight = 10;
+  // Folds (SelfContact.h; optional): surface vertices that lie inside another layer of tissue
+  // are free too, and each round pulls them out to that layer's surface, `contactMarginMm`
+  // beyond it, with this weight against the tets' volumes around them (1: as stiff as those);
+  // 0: none. A contact found once stays as a one-sided plane for the later rounds. Up to
+  // `contactIterations` rounds while contacts remain. Weights 10, 20, 40, 100 and 300 were
+  // tried on three thick-slice arms-resting phantoms raising both arms (docs/ARCHITECTURE.md,
+  // "Creases"): 40 lost the least of the arms' muscle.
+  const SelfContactFinder* contacts = nullptr;
+  double contactWeight = 40;
+  double contactMarginMm = 0.5;
+  int contactIterations = 40;
   // Set by another thread to stop early (a live prediction a new drag made stale): checked
   // between rounds and sweeps; the positions are then left wherever they are and `cancelled` is
   // reported.
@@ -95,6 +107,10 @@ struct VolumeRestorationReport {
   // Tets were inside out after both, and it swept a third time with each tet's own volume
   // weighed (kept only when that left fewer inside out).
   bool crushedUntangle = false;
+  // Surface vertices inside another layer of tissue (SelfContact.h) before and after, and the
+  // deepest of them (mm); 0 without a contact finder.
+  int contactsBefore = 0, contactsAfter = 0;
+  double deepestContactBeforeMm = 0, deepestContactAfterMm = 0;
   bool cancelled = false;  // stopped by VolumeRestorationOptions::cancel: the result means nothing
 };
 

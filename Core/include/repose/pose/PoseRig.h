@@ -242,6 +242,8 @@ class PoseRig {
   JointBends bends_;
   JointClearance clearance_;
   std::vector<char> movable_;  // per TM vertex: not a whole piece's
+  // The transfer mesh's surface, for the restoration's folds (SelfContact.h).
+  std::unique_ptr<SelfContactFinder> contacts_;
   bool restoreVolumes_ = true;
   TetTissues tissues_;
   std::vector<std::pair<int, int>> jointedParts_;

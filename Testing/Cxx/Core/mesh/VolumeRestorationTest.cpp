@@ -187,3 +187,39 @@ TEST(VolumeRestoration, ASecondUntanglingUnderAWeakerHoldNeverLeavesMoreTetsInsi
   EXPECT_EQ(unpinned.invertedAfter, 0);
   EXPECT_FALSE(unpinned.relaxedUntangle);
 }
+
+TEST(VolumeRestoration, ALayerPressedIntoAnotherIsPushedOutWithItsVolumeKept) {
+  // A fold (mesh/SelfContact.h): a soft box pressed 3 mm into a fixed one (a bone's tissue,
+  // say). Without the contacts the restoration sees every tet at its volume and does nothing; with
+  // them the pressed face is pushed out of the other box and the soft box keeps its volume.
+  TransferMesh m = test::concatenate(test::tetBox({0, 0, 0}, {40, 40, 40}, {8, 8, 8}, 3),
+                                     test::tetBox({50, 0, 0}, {90, 40, 40}, {8, 8, 8}, 4));
+  const Eigen::Index half = m.vertices.rows() / 2;
+  Eigen::MatrixX3d x = m.vertices;
+  x.bottomRows(m.vertices.rows() - half).col(0).array() -= 13;
+  std::vector<char> movable(std::size_t(m.vertices.rows()), 0);
+  for (Eigen::Index v = half; v < m.vertices.rows(); ++v)
+    movable[std::size_t(v)] = m.vertices(v, 0) < 70;  // the far half stays: a bone's end
+  const Eigen::MatrixX3d pressed = x;
+  Eigen::MatrixX3d without = x;
+  EXPECT_EQ(restoreVolumes(m, movable, without).freeVertices, 0);
+  const SelfContactFinder finder(m);
+  VolumeRestorationOptions options;
+  options.contacts = &finder;
+  const VolumeRestorationReport r = restoreVolumes(m, movable, x, options);
+  EXPECT_EQ(r.contactsBefore, 7 * 7);  // the soft box's movable face vertices inside the other
+  EXPECT_NEAR(r.deepestContactBeforeMm, 3, 1e-9);
+  EXPECT_EQ(r.contactsAfter, 0);
+  EXPECT_TRUE(finder.find(x, &movable).empty());
+  EXPECT_EQ(r.invertedAfter, 0);
+  const double rest4 = partVolume(m, m.vertices, 4);
+  EXPECT_NEAR(partVolume(m, x, 4), rest4, 1e-4 * rest4);
+  for (Eigen::Index v = 0; v < half; ++v) EXPECT_EQ((x.row(v) - pressed.row(v)).norm(), 0);
+  // Every vertex of the pressed face that was inside now at or beyond the other's face x = 40.
+  for (Eigen::Index v = half; v < m.vertices.rows(); ++v) {
+    const Eigen::Vector3d p = m.vertices.row(v);
+    if (p.x() == 50 && p.y() > 0 && p.y() < 40 && p.z() > 0 && p.z() < 40) {
+      EXPECT_GE(x(v, 0), 40 - 1e-6) << v;
+    }
+  }
+}
