@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 #include <unordered_map>
 
@@ -195,7 +194,8 @@ std::vector<SelfContact> SelfContactFinder::find(const Eigen::MatrixX3d& posed,
             const Eigen::Vector3d w = inverse * (p - x[0]);
             const double w0 = 1 - w.sum();
             // Inside or on the tet: a vertex on a face shared by two tets of the other layer
-            // lies strictly inside neither. One touching at rest overlaps its own rest point.
+            // lies strictly inside neither. One merely touching the other layer (the two sides
+            // of a cut at rest) is on its surface: depth 0, no contact (below).
             constexpr double kOn = 1e-9;
             if (w.minCoeff() < -kOn || w0 < -kOn) continue;
             if (ownLayer(v, {tets_(t, 0), tets_(t, 1), tets_(t, 2), tets_(t, 3)})) continue;
@@ -208,7 +208,7 @@ std::vector<SelfContact> SelfContactFinder::find(const Eigen::MatrixX3d& posed,
     if (inside[n]) overlapping.push_back(tested[n]);
   if (overlapping.empty()) return contacts;
 
-  // The way out: the nearest surface face whose rest position is another layer too.
+  // The way out: the nearest surface face of another layer (no corner in the vertex's rings).
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> boxes;
   boxes.reserve(surfaceFaces_.size());
   for (const auto& f : surfaceFaces_) {

@@ -188,15 +188,13 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
       worst = std::max(worst, std::fabs(r[Eigen::Index(c)]) / amount[c]);
     return worst;
   };
-  // One Gauss-Newton step from the positions at hand: the correction of every free vertex
-  // (3 unknowns each, index order).
-  // The contacts of the free vertices at the positions at hand (SelfContact.h).
+  // The contacts of the free vertices at the positions at hand (SelfContact.h). Those found
+  // above among the movable vertices are all free already: they seeded the free set.
   std::vector<char> isFree(std::size_t(nv), 0);
   for (Eigen::Index v = 0; v < nv; ++v) isFree[std::size_t(v)] = index[std::size_t(v)] >= 0;
   const auto findContacts = [&](const Eigen::MatrixX3d& x) {
     return withContacts ? options.contacts->find(x, &isFree) : std::vector<SelfContact>();
   };
-  contacts = findContacts(deformed);
   // Every contact found in a round stays as a one-sided plane (the other layer's surface there)
   // until the end: pushed out, a vertex the planes forgot would be pulled back in by the rest of
   // the step, and the rounds would swing.
@@ -205,6 +203,8 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
     for (const SelfContact& c : contacts) planes[c.vertex] = c;
   };
   remember();
+  // One Gauss-Newton step from the positions at hand: the correction of every free vertex
+  // (3 unknowns each, index order).
   auto gaussNewtonStep = [&]() -> Eigen::VectorXd {
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(active.size() * 78 + edges.size() * 12 + std::size_t(unknowns));

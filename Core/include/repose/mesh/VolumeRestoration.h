@@ -79,8 +79,8 @@ struct VolumeRestorationOptions {
   // beyond it, with this weight against the tets' volumes around them (1: as stiff as those);
   // 0: none. A contact found once stays as a one-sided plane for the later rounds. Up to
   // `contactIterations` rounds while contacts remain. Weights 10, 20, 40, 100 and 300 were
-  // tried on three thick-slice arms-resting phantoms raising both arms (docs/ARCHITECTURE.md,
-  // "Creases"): 40 lost the least of the arms' muscle.
+  // tried on arms-resting phantoms on thick slices and on the adult female's grid raising both
+  // arms (docs/ARCHITECTURE.md, "Folds"): 40 lost the least of the arms' muscle.
   const SelfContactFinder* contacts = nullptr;
   double contactWeight = 40;
   double contactMarginMm = 0.5;
