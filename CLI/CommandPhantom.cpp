@@ -86,8 +86,10 @@ int runPhantom(const Args& args) {
             "shoulder girdles touch across the sternum (as on reference phantoms whose clavicles "
             "reach the midline); both arms raised pull them apart")
       .option("labels", "NAME",
-              "phantom (its own labels, named in the file) or icrp110 (ICRP 110 organ IDs on "
-              "ICRP's array order, no label table: a converted reference phantom)",
+              "phantom (its own labels, named in the file), icrp110 (ICRP 110 organ IDs on "
+              "ICRP's array order, no label table: a converted reference phantom) or coarse (a "
+              "dosimetry user's coarse map, no label table: 1 body, 2 the whole skeleton, 3 "
+              "brain, 4 lungs, 5 liver)",
               "phantom")
       .flag("image",
             "also a CT-like image <P>CT.<ext> (int16 HU per tissue, small fixed noise) to pose "
@@ -144,8 +146,10 @@ int runPhantom(const Args& args) {
   const std::string labels = parser.get("labels");
   if (labels == "icrp110")
     options.labels = PhantomLabelling::Icrp110;
+  else if (labels == "coarse")
+    options.labels = PhantomLabelling::Coarse;
   else if (labels != "phantom")
-    throw UsageError{"--labels must be phantom or icrp110, not " + labels};
+    throw UsageError{"--labels must be phantom, icrp110 or coarse, not " + labels};
   options.threads = static_cast<int>(parser.getInt("threads"));
   if (!std::isfinite(options.voxelMm) || options.voxelMm <= 0)
     throw UsageError{"--voxel must be a positive size in mm, not " + parser.get("voxel")};

@@ -36,7 +36,9 @@ int runRig(const Args& args) {
       .option("labels", "NAME",
               "G's label convention: auto, phantom, icrp110 (ICRP 110 AF/AM organ IDs), "
               "totalsegmentator (v2 class names from G's label table), or a CSV "
-              "label,bone[,side][,name][,density_kg_m3]",
+              "label,bone[,side][,name][,density_kg_m3]; auto also recognises a coarse map (the "
+              "whole skeleton as one label inside a body label, by name or by shape) and splits "
+              "its skeleton into bones (a CSV names them with the kinds skeleton and body)",
               "auto")
       .option("image", "FILE",
               "the scan G was segmented from (CT or MR, any grid over the same place): the "

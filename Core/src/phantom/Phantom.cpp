@@ -110,6 +110,7 @@ void Phantom::Impl::evaluate(const Eigen::Vector3d& p, const std::vector<int>& s
     }
   }
   if (icrp) organ = icrp->label(organ, part, p);
+  if (options.labels == PhantomLabelling::Coarse) organ = phantom::coarseLabel(organ);
 }
 
 void Phantom::Impl::fillRow(std::int64_t j, std::int64_t k, std::uint8_t* organ, std::uint8_t* part,
@@ -221,7 +222,7 @@ const Joint& Phantom::joint(const std::string& name) const {
 }
 
 LabelTable Phantom::organLabels() const {
-  if (impl_->options.labels == PhantomLabelling::Icrp110) return LabelTable();  // IDs only
+  if (impl_->options.labels != PhantomLabelling::Phantom) return LabelTable();  // IDs only
   return phantom::makeOrganLabels(impl_->options.armsResting);
 }
 LabelTable Phantom::partLabels() const {
@@ -320,7 +321,9 @@ std::string Phantom::skeletonJson() const {
                          {"forearmGapMm", o.forearmGapMm},
                          {"limbVesselMm", o.limbVesselMm},
                          {"girdlesTouching", o.girdlesTouching},
-                         {"labels", o.labels == PhantomLabelling::Icrp110 ? "icrp110" : "phantom"},
+                         {"labels", o.labels == PhantomLabelling::Icrp110  ? "icrp110"
+                                    : o.labels == PhantomLabelling::Coarse ? "coarse"
+                                                                           : "phantom"},
                          {"spacing_mm", {sp.x(), sp.y(), sp.z()}}};
   return skeletonToJson(skeleton(), made.dump());
 }

@@ -113,4 +113,38 @@ LabelTable makePartLabels() {
   return t;
 }
 
+std::uint8_t coarseLabel(std::uint8_t organ) {
+  switch (organ) {
+    case 0:
+      return 0;
+    case kSkull:
+    case kVertebrae:
+    case kRibs:
+    case kSternum:
+    case kPelvis:
+    case kHumerus:
+    case kRadiusUlna:
+    case kHandBones:
+    case kFemur:
+    case kTibiaFibula:
+    case kFootBones:
+    case kHumerusMarrow:
+    case kRadiusUlnaMarrow:
+    case kFemurMarrow:
+    case kTibiaFibulaMarrow:
+    case kClavicle:
+    case kScapula:
+      return 2;
+    case kBrain:
+      return 3;
+    case kLungLeft:
+    case kLungRight:
+      return 4;
+    case kLiver:
+      return 5;
+    default:
+      return 1;
+  }
+}
+
 }  // namespace repose::phantom

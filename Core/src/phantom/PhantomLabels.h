@@ -60,6 +60,10 @@ Region regionOf(std::uint8_t part);
 // The vessel label of a body part's region.
 std::uint8_t vesselLabel(std::uint8_t part);
 
+// PhantomLabelling::Coarse's value of an organ label: 1 body, 2 skeleton, 3 brain, 4 lungs,
+// 5 liver (0 stays 0).
+std::uint8_t coarseLabel(std::uint8_t organ);
+
 // The labels of G: the basic anatomy's 27, or with `detailed` all 36.
 LabelTable makeOrganLabels(bool detailed = false);
 LabelTable makePartLabels();

@@ -2,6 +2,8 @@
 // (by class name, from the file's label table), a user's CSV; and "auto", which tells them apart.
 #include "repose/rig/LabelConvention.h"
 
+#include "CoarseMap.h"
+
 #include "Icrp110Organs.h"
 #include "repose/util/Error.h"
 #include "repose/volume/LabelStatistics.h"
@@ -88,7 +90,7 @@ bool endsWith(const std::string& s, const std::string& tail) {
 const char* kBoneNames[] = {"none",         "skull",       "mandible", "teeth",   "spine",
                             "ribs",         "sternum",     "clavicle", "scapula", "pelvis",
                             "humerus",      "radius_ulna", "hand",     "femur",   "patella",
-                            "tibia_fibula", "foot"};
+                            "tibia_fibula", "foot",        "skeleton"};
 
 BoneKind boneFromName(const std::string& n) {
   for (int k = 0; k < int(sizeof(kBoneNames) / sizeof(*kBoneNames)); ++k)
@@ -360,14 +362,18 @@ LabelConvention fromCsv(const Volume& organs, const std::string& path,
       throw Error(where + "label must be an integer");
     }
     const std::string bone = f.size() > 1 ? lower(f[1]) : "";
-    r.bone = boneFromName(bone.empty() ? "none" : bone);
-    if (!bone.empty() && bone != "none" && r.bone == BoneKind::None)
+    // "body": the body's outline (soft tissue wherever no other label is), not a bone.
+    const bool outline = bone == "body";
+    r.bone = boneFromName(bone.empty() || outline ? "none" : bone);
+    if (!bone.empty() && bone != "none" && !outline && r.bone == BoneKind::None)
       throw Error(where + "unknown bone \"" + f[1] +
                   "\" (skull, mandible, teeth, spine, ribs, sternum, clavicle, scapula, pelvis, "
-                  "humerus, radius_ulna, hand, femur, patella, tibia_fibula, foot, none)");
+                  "humerus, radius_ulna, hand, femur, patella, tibia_fibula, foot, skeleton: "
+                  "every bone in one label; body: the body's outline; none)");
     r.rigid = r.bone != BoneKind::None;
     r.boneName = r.rigid ? bone : "";
     r.name = nameOf(organs, value);
+    if (outline && r.name.empty()) r.name = "body";
     for (std::size_t k = 2; k < f.size(); ++k) {
       if (header[k] == "side") {
         const std::string s = lower(f[k]);
@@ -449,6 +455,31 @@ const char* boneKindName(BoneKind kind) {
 
 namespace {
 
+// A coarse map: its skeleton one rigid label the rig splits into bones, its body the outline,
+// the rest soft tissue.
+LabelConvention coarseConvention(const Volume& organs, const std::vector<int>& labels,
+                                 const rig::CoarseMap& m) {
+  LabelConvention c;
+  c.name = "coarse (body and skeleton)";
+  c.detection = m.how;
+  for (const int v : labels) {
+    LabelRole r = unknownRole(organs, v);
+    if (v == m.skeleton) {
+      r.bone = BoneKind::Skeleton;
+      r.rigid = true;
+      r.boneName = "skeleton";
+      r.densityKgM3 = kCorticalBoneKgM3;
+      if (r.name.empty()) r.name = "skeleton";
+    } else if (v == m.body) {
+      if (r.name.empty()) r.name = "body";
+    } else {
+      c.unknown.push_back(v);
+    }
+    c.roles[v] = r;
+  }
+  return c;
+}
+
 // labelConvention on the labels present in G (in increasing order), counted by the caller.
 LabelConvention conventionOf(const Volume& organs, const std::vector<int>& labels,
                              const std::string& requested, const std::string& source) {
@@ -480,6 +511,8 @@ LabelConvention conventionOf(const Volume& organs, const std::vector<int>& label
       c = icrp110(organs, labels);
       c.detection =
           "auto: labels that are ICRP 110 organ IDs (1-141), with its humerus and femur IDs";
+    } else if (const auto coarse = rig::recogniseCoarseMap(organs, labels)) {
+      c = coarseConvention(organs, labels, *coarse);
     } else {
       throw Error(
           source + ": cannot tell the label convention (" + std::to_string(labels.size()) +

@@ -45,8 +45,17 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   reportProgress(options.progress, 0.0, "rig: labels");
   out.convention = labelConvention(organs, options.labels, source);
   const rig::Grid grid(organs.geometry());
+  // A skeleton in one label says nothing of the body around it: without an outline (a body,
+  // skin, fat or muscle label, or the scan) there would be bones alone to pose.
+  const bool skeletonLabel =
+      std::any_of(out.convention.roles.begin(), out.convention.roles.end(),
+                  [](const auto& r) { return r.second.bone == BoneKind::Skeleton; });
+  if (skeletonLabel && !options.image && !labelsSoftTissue(out.convention))
+    throw Error(source +
+                ": a skeleton label but no body outline (no body, skin, fat or muscle label): "
+                "give the scan it was segmented from (--image), or a map with the body");
   reportProgress(options.progress, 0.1, "rig: bones");
-  const rig::Bones bones = rig::findBones(organs, out.convention, grid);
+  const rig::Bones bones = rig::findBones(organs, out.convention, grid, source);
   if (bones.byKind.empty())
     throw Error(source + ": no bones found under the " + out.convention.name +
                 " convention (give --labels, or a CSV naming the bone labels)");
@@ -121,7 +130,8 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
     if (j.flexion) s.axes[0].second = *j.flexion;  // the condyles' own line
     s.parts = {partName(j.parts[0]), partName(j.parts[1])};
     s.radiusMm = rig::jointRadius(out.parts, j, grid);
-    s.method = j.method;
+    // Where the joint's bones came from: labelled, or split from one skeleton label.
+    s.method = bones.split > 0 ? j.method + " (bones split from the skeleton label)" : j.method;
     s.fitRmsMm = j.rms;
     out.skeleton.joints.push_back(s);
   }
@@ -176,6 +186,9 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
         {"anterior", {ant.x(), ant.y(), ant.z()}},
         {"midline_x_mm", bones.frame.midlineX}}},
       {"bones", bonesJson},
+      {"skeleton_split", bones.split > 0
+                             ? nlohmann::json{{"pieces", bones.split}, {"notes", bones.splitNotes}}
+                             : nlohmann::json()},
       {"joints", jointsJson},
       {"missing", out.missing},
       {"warnings", out.warnings},

@@ -91,7 +91,8 @@ void describe(Bone& b, const Grid& grid, const std::vector<std::int32_t>& owner,
 
 }  // namespace
 
-Bones findBones(const Volume& organs, const LabelConvention& convention, const Grid& grid) {
+Bones findBones(const Volume& organs, const LabelConvention& convention, const Grid& grid,
+                const std::string& source) {
   Bones out;
   out.voxelMm = grid.spacing.maxCoeff();
   std::vector<std::int32_t> owner(std::size_t(grid.count()), 0);
@@ -122,6 +123,17 @@ Bones findBones(const Volume& organs, const LabelConvention& convention, const G
       }
     }
   });
+  // A skeleton in one label: its bones by geometry.
+  if (const auto it = raw.find({BoneKind::Skeleton, 0}); it != raw.end()) {
+    SkeletonSplit split = splitSkeleton(it->second, grid, source);
+    raw.erase(it);
+    for (auto& [key, voxels] : split.bones) {
+      auto& dst = raw[key];
+      dst.insert(dst.end(), voxels.begin(), voxels.end());
+    }
+    out.split = split.pieces;
+    out.splitNotes = split.notes;
+  }
   // The midline: the axial skeleton's mean x, else the body's.
   double axialX = 0;
   std::int64_t axialCount = 0;

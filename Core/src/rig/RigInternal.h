@@ -58,9 +58,25 @@ struct Bones {
   // The spine's voxels whose labels name the sacrum (ICRP 110's, TotalSegmentator's): where the
   // lumbosacral joint is, when known.
   std::vector<V> sacrum;  // their centres, RAS
+  // How many pieces a skeleton given as one label was split from (0: the bones were labelled).
+  int split = 0;
+  std::vector<std::string> splitNotes;
   const Bone* find(BoneKind kind, int side) const;
 };
-Bones findBones(const Volume& organs, const LabelConvention& convention, const Grid& grid);
+Bones findBones(const Volume& organs, const LabelConvention& convention, const Grid& grid,
+                const std::string& source);
+
+// A skeleton given as one label (BoneKind::Skeleton) split into bones by geometry
+// (RigSkeletonSplit.cpp): its voxels by (kind, side). Throws repose::Error, one line naming
+// `source`, when it cannot be split (no piece across the midline, two bones joined across a
+// joint).
+struct SkeletonSplit {
+  std::map<std::pair<BoneKind, int>, std::vector<std::int64_t>> bones;
+  int pieces = 0;
+  std::vector<std::string> notes;
+};
+SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid& grid,
+                            const std::string& source);
 
 // One fitted joint: centre, how it was found, and the directions its part planes and axes use.
 struct FittedJoint {

@@ -17,8 +17,10 @@ namespace repose {
 // IDs of the ICRP 110 adult reference phantoms (bones split by region and tissue but not by side,
 // skin, muscle, adipose and vessels split by body region) on ICRP's array order (columns from
 // the body's right to its left, rows front to back, slices feet to head) and without a label
-// table, as a user's converted ICRP file arrives.
-enum class PhantomLabelling { Phantom, Icrp110 };
+// table, as a user's converted ICRP file arrives. Or a coarse map as most dosimetry users have
+// one (issue 65): 1 body (every soft tissue), 2 skeleton (every bone, marrow included), 3 brain,
+// 4 lungs, 5 liver, without a label table.
+enum class PhantomLabelling { Phantom, Icrp110, Coarse };
 
 struct PhantomOptions {
   double voxelMm = 2.0;  // isotropic voxel size; 1 mm gives ~160M voxels (1.3 m child)

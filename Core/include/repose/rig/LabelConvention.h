@@ -33,7 +33,8 @@ enum class BoneKind {
   Femur,    // thigh
   Patella,  // with the tibia: the shank (ICRP puts patellae with the tibiae)
   Shank,    // tibia and fibula
-  Foot      // tarsals, metatarsals, phalanges
+  Foot,     // tarsals, metatarsals, phalanges
+  Skeleton  // every bone in one label: the rig splits it by geometry (RigSkeletonSplit.cpp)
 };
 const char* boneKindName(BoneKind kind);
 

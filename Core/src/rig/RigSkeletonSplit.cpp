@@ -1,0 +1,843 @@
+// A skeleton given as one label (a CT's bone threshold, a coarse map's "skeleton") split into the
+// rig's bones by geometry. Bones meet at joints across a joint space, or touch over a thin
+// contact (a femoral head in its acetabulum, a scapula on the ribs); one voxel's erosion parts the
+// contacts, and each piece grows back over the voxels the erosion took. The pieces are then told
+// apart by where they are and what they touch: the piece across the midline is the axial
+// skeleton, the skull its top; the long pieces hanging from it are the humeri (from its upper
+// half) and the femora (from its lower half); the pieces at a long bone's distal end are the next
+// segment's, and those beyond are the hand's or foot's. The axial piece is cut into the pelvis
+// (below the iliac crests, beside the spine) and the spine with the ribs.
+#include "RigInternal.h"
+
+#include "repose/util/Error.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <queue>
+#include <set>
+#include <sstream>
+
+namespace repose::rig {
+namespace {
+
+// A connected piece of the skeleton mask, in the split's local box.
+struct Piece {
+  std::vector<std::int64_t> voxels;  // G's indices
+  V centroid = V::Zero(), axis = V::UnitZ();
+  double length = 0, top = -1e300, bottom = 1e300, xMin = 1e300, xMax = -1e300;
+  BoneKind kind = BoneKind::None;
+  int side = 0;
+  bool assigned = false;
+};
+
+// Two pieces within kNearMm of each other through the space between them, and where.
+struct Contact {
+  double distance = 1e300;
+  V at = V::Zero();
+};
+
+constexpr double kNearMm = 20;
+
+class Splitter {
+ public:
+  Splitter(const std::vector<std::int64_t>& voxels, const Grid& grid) : grid_(grid) {
+    const auto& d = grid.dims;
+    lo_ = {d[0], d[1], d[2]};
+    hi_ = {-1, -1, -1};
+    for (const std::int64_t v : voxels) {
+      const std::int64_t ijk[3] = {v % d[0], (v / d[0]) % d[1], v / (d[0] * d[1])};
+      for (int a = 0; a < 3; ++a)
+        lo_[a] = std::min(lo_[a], ijk[a]), hi_[a] = std::max(hi_[a], ijk[a]);
+    }
+    // The box grown by the contacts' reach, so the fronts between pieces have room.
+    for (int a = 0; a < 3; ++a) {
+      const std::int64_t grow = std::int64_t(std::ceil(kNearMm / grid.spacing[a])) + 1;
+      lo_[a] = std::max<std::int64_t>(0, lo_[a] - grow);
+      hi_[a] = std::min<std::int64_t>(d[a] - 1, hi_[a] + grow);
+      box_[a] = hi_[a] - lo_[a] + 1;
+    }
+    mask_.assign(std::size_t(box_[0] * box_[1] * box_[2]), 0);
+    for (const std::int64_t v : voxels) mask_[std::size_t(local(v))] = 1;
+  }
+
+  std::int64_t local(std::int64_t v) const {
+    const auto& d = grid_.dims;
+    return (v % d[0] - lo_[0]) +
+           box_[0] * (((v / d[0]) % d[1] - lo_[1]) + box_[1] * (v / (d[0] * d[1]) - lo_[2]));
+  }
+  std::int64_t global(std::int64_t l) const {
+    const std::int64_t i = l % box_[0] + lo_[0], j = (l / box_[0]) % box_[1] + lo_[1],
+                       k = l / (box_[0] * box_[1]) + lo_[2];
+    return i + grid_.dims[0] * (j + grid_.dims[1] * k);
+  }
+
+  // Each 26-neighbour of local voxel l inside the box.
+  template <class F>
+  void neighbours(std::int64_t l, F&& f) const {
+    const std::int64_t i = l % box_[0], j = (l / box_[0]) % box_[1], k = l / (box_[0] * box_[1]);
+    for (int dk = -1; dk <= 1; ++dk)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          if (!di && !dj && !dk) continue;
+          const std::int64_t a = i + di, b = j + dj, c = k + dk;
+          if (a < 0 || b < 0 || c < 0 || a >= box_[0] || b >= box_[1] || c >= box_[2]) continue;
+          f(a + box_[0] * (b + box_[1] * c), di, dj, dk);
+        }
+  }
+
+  // Pieces: the mask's 26-connected components. The axial one (the largest across the midline)
+  // may hold limb bones that touch it (a femoral head in its acetabulum, a humeral head on its
+  // glenoid, a scapula on the ribs): one voxel's erosion parts such contacts, and each long
+  // lateral part the erosion leaves becomes a piece of its own, grown back over the voxels the
+  // erosion took (ring by ring, against the rest of the axial piece). Only that piece is
+  // eroded: a skull or a pelvis one voxel thick on a coarse grid would fall apart.
+  void findPieces(double midX, double height) {
+    const std::int64_t n = std::int64_t(mask_.size());
+    owner_.assign(mask_.size(), -1);
+    std::vector<std::int64_t> got;
+    auto flood = [&](std::int64_t start, const std::vector<std::uint8_t>& in, int id,
+                     std::vector<int>& own) {
+      own[std::size_t(start)] = id;
+      got.assign(1, start);
+      for (std::size_t q = 0; q < got.size(); ++q)
+        neighbours(got[q], [&](std::int64_t m, int, int, int) {
+          if (in[std::size_t(m)] && own[std::size_t(m)] == -1) {
+            own[std::size_t(m)] = id;
+            got.push_back(m);
+          }
+        });
+    };
+    int next = 0, axial = -1;
+    std::size_t axialSize = 0;
+    for (std::int64_t l = 0; l < n; ++l) {
+      if (!mask_[std::size_t(l)] || owner_[std::size_t(l)] != -1) continue;
+      flood(l, mask_, next, owner_);
+      double lo = 1e300, hi = -1e300;
+      for (const std::int64_t m : got) {
+        const double x = grid_.ras(global(m)).x();
+        lo = std::min(lo, x), hi = std::max(hi, x);
+      }
+      if (lo <= midX && hi >= midX && got.size() > axialSize) axial = next, axialSize = got.size();
+      ++next;
+    }
+    if (axial >= 0) partAxial(axial, midX, height, next, flood, got);
+    pieces_.assign(std::size_t(next), Piece());
+    for (std::int64_t l = 0; l < n; ++l)
+      if (owner_[std::size_t(l)] >= 0)
+        pieces_[std::size_t(owner_[std::size_t(l)])].voxels.push_back(global(l));
+    // Ids the axial piece's parting left unused.
+    pieces_.erase(std::remove_if(pieces_.begin(), pieces_.end(),
+                                 [](const Piece& p) { return p.voxels.empty(); }),
+                  pieces_.end());
+    for (std::size_t i = 0; i < pieces_.size(); ++i) {
+      describe(pieces_[i]);
+      for (const std::int64_t v : pieces_[i].voxels) owner_[std::size_t(local(v))] = int(i);
+    }
+  }
+
+  template <class Flood>
+  void partAxial(int axial, double midX, double height, int& next, Flood& flood,
+                 std::vector<std::int64_t>& got) {
+    const std::int64_t n = std::int64_t(mask_.size());
+    const std::int64_t step[3] = {1, box_[0], box_[0] * box_[1]};
+    std::vector<std::uint8_t> eroded(mask_.size(), 0);
+    for (std::int64_t l = 0; l < n; ++l) {
+      if (owner_[std::size_t(l)] != axial) continue;
+      const std::int64_t ijk[3] = {l % box_[0], (l / box_[0]) % box_[1], l / (box_[0] * box_[1])};
+      bool inner = true;
+      for (int a = 0; a < 3 && inner; ++a)
+        for (int s : {-1, 1}) {
+          const std::int64_t m = ijk[a] + s;
+          if (m < 0 || m >= box_[a] || !mask_[std::size_t(l + s * step[a])]) inner = false;
+        }
+      eroded[std::size_t(l)] = inner;
+    }
+    std::vector<int> part(mask_.size(), -1);
+    std::vector<std::int64_t> seeds;
+    std::vector<int> limbs;
+    int id = 0;
+    for (std::int64_t l = 0; l < n; ++l) {
+      if (!eroded[std::size_t(l)] || part[std::size_t(l)] != -1) continue;
+      flood(l, eroded, id, part);
+      Piece p;
+      for (const std::int64_t m : got) p.voxels.push_back(global(m));
+      describe(p);
+      const bool lateral = p.xMax < midX || p.xMin > midX;
+      if (lateral && p.length >= 0.1 * height) limbs.push_back(id);
+      seeds.insert(seeds.end(), got.begin(), got.end());
+      ++id;
+    }
+    if (limbs.empty()) return;
+    // Seeds: each limb part its own piece, everything else the axial piece.
+    std::vector<int> as(std::size_t(id), axial);
+    for (const int c : limbs) as[std::size_t(c)] = next++;
+    for (std::int64_t l = 0; l < n; ++l)
+      if (owner_[std::size_t(l)] == axial) owner_[std::size_t(l)] = -1;
+    for (const std::int64_t l : seeds)
+      owner_[std::size_t(l)] = as[std::size_t(part[std::size_t(l)])];
+    std::vector<std::int64_t> frontier = seeds;
+    while (!frontier.empty()) {
+      std::vector<std::int64_t> ring;
+      for (const std::int64_t l : frontier)
+        neighbours(l, [&](std::int64_t m, int, int, int) {
+          if (mask_[std::size_t(m)] && owner_[std::size_t(m)] == -1) {
+            owner_[std::size_t(m)] = owner_[std::size_t(l)];
+            ring.push_back(m);
+          }
+        });
+      frontier.swap(ring);
+    }
+    // Voxels of the axial component no seed reached (none survived the erosion nearby).
+    for (std::int64_t l = 0; l < n; ++l)
+      if (mask_[std::size_t(l)] && owner_[std::size_t(l)] == -1) owner_[std::size_t(l)] = axial;
+  }
+
+  void describe(Piece& p) const {
+    p.centroid = V::Zero();
+    for (const std::int64_t v : p.voxels) p.centroid += grid_.ras(v);
+    p.centroid /= double(p.voxels.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    p.top = -1e300, p.bottom = 1e300, p.xMin = 1e300, p.xMax = -1e300;
+    for (const std::int64_t v : p.voxels) {
+      const V r = grid_.ras(v), d = r - p.centroid;
+      cov += d * d.transpose();
+      p.top = std::max(p.top, r.z()), p.bottom = std::min(p.bottom, r.z());
+      p.xMin = std::min(p.xMin, r.x()), p.xMax = std::max(p.xMax, r.x());
+    }
+    p.axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(2).normalized();
+    double a = 1e300, b = -1e300;
+    for (const std::int64_t v : p.voxels) {
+      const double t = (grid_.ras(v) - p.centroid).dot(p.axis);
+      a = std::min(a, t), b = std::max(b, t);
+    }
+    p.length = b - a + grid_.spacing.minCoeff();
+  }
+
+  // Contacts between pieces: fronts grown from every piece through the space between them
+  // (Dijkstra on the 26-neighbourhood in mm, up to kNearMm / 2 from each); where two meet, their
+  // distance and the meeting point.
+  void findContacts() {
+    contacts_.clear();
+    const std::int64_t n = std::int64_t(mask_.size());
+    std::vector<float> dist(mask_.size(), std::numeric_limits<float>::infinity());
+    using Item = std::pair<float, std::int64_t>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    for (std::int64_t l = 0; l < n; ++l)
+      if (owner_[std::size_t(l)] >= 0) dist[std::size_t(l)] = 0, queue.push({0.f, l});
+    const V sp = grid_.spacing;
+    auto meet = [&](std::int64_t a, std::int64_t b, double d) {
+      const int pa = owner_[std::size_t(a)], pb = owner_[std::size_t(b)];
+      if (pa == pb || pa < 0 || pb < 0) return;
+      const auto key = std::minmax(pa, pb);
+      Contact& c = contacts_[{key.first, key.second}];
+      if (d < c.distance)
+        c.distance = d, c.at = 0.5 * (grid_.ras(global(a)) + grid_.ras(global(b)));
+    };
+    while (!queue.empty()) {
+      const auto [d, l] = queue.top();
+      queue.pop();
+      if (d > dist[std::size_t(l)]) continue;
+      neighbours(l, [&](std::int64_t m, int di, int dj, int dk) {
+        const double edge =
+            std::sqrt(di * di * sp[0] * sp[0] + dj * dj * sp[1] * sp[1] + dk * dk * sp[2] * sp[2]);
+        if (owner_[std::size_t(m)] >= 0 && owner_[std::size_t(m)] != owner_[std::size_t(l)]) {
+          meet(l, m, double(d) + double(dist[std::size_t(m)]) + edge);
+          return;
+        }
+        const double nd = double(d) + edge;
+        if (nd > 0.5 * kNearMm || nd >= double(dist[std::size_t(m)])) return;
+        if (mask_[std::size_t(m)]) return;  // a voxel of the same piece
+        dist[std::size_t(m)] = float(nd);
+        owner_[std::size_t(m)] = owner_[std::size_t(l)];
+        queue.push({float(nd), m});
+      });
+    }
+    // The fronts' owners were written over the space between the pieces: back to the mask's.
+    for (std::int64_t l = 0; l < n; ++l)
+      if (!mask_[std::size_t(l)]) owner_[std::size_t(l)] = -1;
+  }
+
+  const Contact* contact(int a, int b) const {
+    const auto key = std::minmax(a, b);
+    const auto it = contacts_.find({key.first, key.second});
+    return it == contacts_.end() || it->second.distance > kNearMm ? nullptr : &it->second;
+  }
+
+  std::vector<Piece>& pieces() { return pieces_; }
+  const Grid& grid() const { return grid_; }
+
+  // Parts piece `from` where one voxel's erosion parts it into pieces of at least `minShare` of
+  // its voxels each (a humeral head on a glenoid the coarse grid closed); the voxels the erosion
+  // took go to the part that reaches them first. Returns the pieces it became (`from` first, the
+  // largest part).
+  std::vector<int> partPiece(int from, double minShare) {
+    const Piece& p = pieces_[std::size_t(from)];
+    const auto& d = grid_.dims;
+    std::array<std::int64_t, 3> lo{d[0], d[1], d[2]}, hi{-1, -1, -1}, box{};
+    for (const std::int64_t v : p.voxels) {
+      const std::int64_t ijk[3] = {v % d[0], (v / d[0]) % d[1], v / (d[0] * d[1])};
+      for (int a = 0; a < 3; ++a)
+        lo[a] = std::min(lo[a], ijk[a] - 1), hi[a] = std::max(hi[a], ijk[a] + 1);
+    }
+    for (int a = 0; a < 3; ++a) box[a] = hi[a] - lo[a] + 1;
+    auto at = [&](std::int64_t v) {
+      return (v % d[0] - lo[0]) +
+             box[0] * (((v / d[0]) % d[1] - lo[1]) + box[1] * (v / (d[0] * d[1]) - lo[2]));
+    };
+    const std::size_t n = std::size_t(box[0] * box[1] * box[2]);
+    std::vector<std::uint8_t> in(n, 0);
+    for (const std::int64_t v : p.voxels) in[std::size_t(at(v))] = 1;
+    const std::int64_t step[3] = {1, box[0], box[0] * box[1]};
+    std::vector<int> part(n, -1);
+    std::vector<std::int64_t> sizes;
+    for (const std::int64_t v : p.voxels) {
+      const std::int64_t l = at(v);
+      bool inner = true;
+      for (int a = 0; a < 3 && inner; ++a)
+        for (int t : {-1, 1}) inner = inner && in[std::size_t(l + t * step[a])];
+      if (inner) part[std::size_t(l)] = -2;  // eroded, not yet in a part
+    }
+    auto each26 = [&](std::int64_t l, auto&& f) {
+      for (int dk = -1; dk <= 1; ++dk)
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di) {
+            const std::int64_t m = l + di + box[0] * (dj + box[1] * dk);
+            if ((di || dj || dk) && m >= 0 && m < std::int64_t(n)) f(m);
+          }
+    };
+    // The 26-connected voxels marked `want` from l, marked as the next part.
+    auto flood = [&](std::int64_t l, int want) {
+      const int id = int(sizes.size());
+      std::vector<std::int64_t> got{l};
+      part[std::size_t(l)] = id;
+      for (std::size_t q = 0; q < got.size(); ++q)
+        each26(got[q], [&](std::int64_t m) {
+          if (in[std::size_t(m)] && part[std::size_t(m)] == want)
+            part[std::size_t(m)] = id, got.push_back(m);
+        });
+      sizes.push_back(std::int64_t(got.size()));
+      return got;
+    };
+    std::vector<std::int64_t> seeds;
+    for (const std::int64_t v : p.voxels)
+      if (part[std::size_t(at(v))] == -2) {
+        const std::vector<std::int64_t> got = flood(at(v), -2);
+        seeds.insert(seeds.end(), got.begin(), got.end());
+      }
+    const std::int64_t least = std::int64_t(minShare * double(p.voxels.size()));
+    std::vector<int> big;
+    for (int i = 0; i < int(sizes.size()); ++i)
+      if (sizes[std::size_t(i)] >= least) big.push_back(i);
+    if (big.empty()) return {from};
+    // Small eroded parts are not seeds: their voxels are grown over like the eroded ones.
+    std::vector<std::int64_t> frontier;
+    for (const std::int64_t l : seeds)
+      if (sizes[std::size_t(part[std::size_t(l)])] >= least)
+        frontier.push_back(l);
+      else
+        part[std::size_t(l)] = -1;
+    // The opening: one ring around the seeds. What it does not give back is thinner than the
+    // erosion (a scapula one voxel thick on a coarse grid, wholly eroded): its large pieces
+    // are parts of their own.
+    {
+      std::vector<std::int64_t> ring;
+      for (const std::int64_t l : frontier)
+        each26(l, [&](std::int64_t m) {
+          if (in[std::size_t(m)] && part[std::size_t(m)] < 0)
+            part[std::size_t(m)] = part[std::size_t(l)], ring.push_back(m);
+        });
+      frontier.insert(frontier.end(), ring.begin(), ring.end());
+      for (const std::int64_t v : p.voxels) {
+        if (part[std::size_t(at(v))] != -1) continue;
+        const std::vector<std::int64_t> got = flood(at(v), -1);
+        if (sizes.back() >= least) {
+          big.push_back(int(sizes.size()) - 1);
+          frontier.insert(frontier.end(), got.begin(), got.end());
+        } else {
+          for (const std::int64_t m : got) part[std::size_t(m)] = -3;  // grown over below
+        }
+      }
+      for (const std::int64_t v : p.voxels)
+        if (part[std::size_t(at(v))] == -3) part[std::size_t(at(v))] = -1;
+    }
+    if (big.size() < 2) return {from};
+    while (!frontier.empty()) {
+      std::vector<std::int64_t> ring;
+      for (const std::int64_t l : frontier)
+        each26(l, [&](std::int64_t m) {
+          if (in[std::size_t(m)] && part[std::size_t(m)] < 0)
+            part[std::size_t(m)] = part[std::size_t(l)], ring.push_back(m);
+        });
+      frontier.swap(ring);
+    }
+    std::sort(big.begin(), big.end(),
+              [&](int a, int b) { return sizes[std::size_t(a)] > sizes[std::size_t(b)]; });
+    std::vector<int> out{from};
+    for (std::size_t k = 1; k < big.size(); ++k) {
+      const int id = big[k];
+      const int made = carve(from, [&](std::int64_t v) { return part[std::size_t(at(v))] == id; });
+      if (made >= 0 && made != from) out.push_back(made);
+    }
+    return out;
+  }
+
+  // Cuts piece `from` across `u` where it has the fewest voxels between fractions lo and hi of
+  // its extent along u; the part beyond becomes a new piece (its index; -1 when none).
+  int cutAcross(int from, const V& u, double lo, double hi) {
+    const Piece& p = pieces_[std::size_t(from)];
+    double a = 1e300, b = -1e300;
+    for (const std::int64_t v : p.voxels) {
+      const double t = grid_.ras(v).dot(u);
+      a = std::min(a, t), b = std::max(b, t);
+    }
+    const double width = std::fabs(u.x()) * grid_.spacing.x() +
+                         std::fabs(u.y()) * grid_.spacing.y() +
+                         std::fabs(u.z()) * grid_.spacing.z();
+    const std::size_t bins = std::size_t(std::ceil((b - a) / width)) + 1;
+    std::vector<std::int64_t> count(bins, 0);
+    for (const std::int64_t v : p.voxels) ++count[std::size_t((grid_.ras(v).dot(u) - a) / width)];
+    std::size_t best = bins;
+    for (std::size_t k = std::size_t(lo * double(bins));
+         k < std::min(bins, std::size_t(hi * double(bins)) + 1); ++k)
+      if (best == bins || count[k] < count[best]) best = k;
+    if (best == bins) return -1;
+    const double at = a + (double(best) + 0.5) * width;
+    const int d = carve(from, [&](std::int64_t v) { return grid_.ras(v).dot(u) > at; });
+    return d == from ? -1 : d;
+  }
+
+  // Moves the voxels of piece `from` for which `take` holds into a new piece; returns its index
+  // (or -1 when none moved).
+  template <class F>
+  int carve(int from, F&& take) {
+    Piece fresh;
+    std::vector<std::int64_t> keep;
+    for (const std::int64_t v : pieces_[std::size_t(from)].voxels)
+      (take(v) ? fresh.voxels : keep).push_back(v);
+    if (fresh.voxels.empty() || keep.empty()) return fresh.voxels.empty() ? -1 : from;
+    pieces_[std::size_t(from)].voxels.swap(keep);
+    describe(pieces_[std::size_t(from)]);
+    describe(fresh);
+    for (const std::int64_t v : fresh.voxels) owner_[std::size_t(local(v))] = int(pieces_.size());
+    pieces_.push_back(std::move(fresh));
+    return int(pieces_.size()) - 1;
+  }
+
+ private:
+  const Grid& grid_;
+  std::array<std::int64_t, 3> lo_{}, hi_{}, box_{};
+  std::vector<std::uint8_t> mask_;
+  std::vector<int> owner_;
+  std::vector<Piece> pieces_;
+  std::map<std::pair<int, int>, Contact> contacts_;
+};
+
+// Voxel counts per slice band of `step` mm along z (RAS superior), from `z0`.
+std::vector<double> widthProfile(const Piece& p, const Grid& grid, double z0, double step,
+                                 std::size_t bands) {
+  std::vector<double> lo(bands, 1e300), hi(bands, -1e300);
+  for (const std::int64_t v : p.voxels) {
+    const V r = grid.ras(v);
+    const double t = (r.z() - z0) / step;
+    if (t < 0 || t >= double(bands)) continue;
+    const std::size_t b = std::size_t(t);
+    lo[b] = std::min(lo[b], r.x()), hi[b] = std::max(hi[b], r.x());
+  }
+  std::vector<double> w(bands, 0);
+  for (std::size_t b = 0; b < bands; ++b) w[b] = hi[b] >= lo[b] ? hi[b] - lo[b] : 0;
+  return w;
+}
+
+}  // namespace
+
+SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid& grid,
+                            const std::string& source) {
+  SkeletonSplit out;
+  if (voxels.empty()) return out;
+  Splitter split(voxels, grid);
+  double zMin = 1e300, zMax = -1e300;
+  std::vector<double> xs;
+  xs.reserve(voxels.size() / 16 + 1);
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    const V r = grid.ras(voxels[i]);
+    zMin = std::min(zMin, r.z()), zMax = std::max(zMax, r.z());
+    if (i % 16 == 0) xs.push_back(r.x());
+  }
+  std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
+  const double midX = xs[xs.size() / 2], H = zMax - zMin;
+  if (!(H > 0)) throw Error(source + ": the skeleton label has no height to split");
+  split.findPieces(midX, H);
+  std::vector<Piece>& P = split.pieces();
+
+  // The skull: the piece with the highest point; cut off the spine below it where it is joined
+  // to it (where the slices narrow to a quarter of the skull's widest, going down).
+  int skull = -1;
+  for (int i = 0; i < int(P.size()); ++i)
+    if (skull < 0 || P[std::size_t(i)].top > P[std::size_t(skull)].top) skull = i;
+  if (P[std::size_t(skull)].top - P[std::size_t(skull)].bottom > 0.25 * H) {
+    const double step = std::max(grid.spacing.z(), 2.0);
+    const std::size_t bands = std::size_t(std::ceil(0.3 * H / step));
+    const double z0 = P[std::size_t(skull)].top - double(bands) * step;
+    const std::vector<double> w = widthProfile(P[std::size_t(skull)], grid, z0, step, bands);
+    std::size_t widest = bands - 1;
+    for (std::size_t b = bands; b-- > bands / 2;)
+      if (w[b] > w[widest]) widest = b;
+    std::size_t cut = widest;
+    while (cut > 0 && w[cut] >= 0.4 * w[widest]) --cut;
+    const double level = z0 + (double(cut) + 1) * step;
+    const int top = split.carve(skull, [&](std::int64_t v) { return grid.ras(v).z() >= level; });
+    if (top >= 0) skull = top;
+  }
+  P[std::size_t(skull)].kind = BoneKind::Skull, P[std::size_t(skull)].assigned = true;
+
+  // The axial piece: the largest across the midline.
+  int axial = -1;
+  for (int i = 0; i < int(P.size()); ++i) {
+    const Piece& p = P[std::size_t(i)];
+    if (p.assigned || p.xMin > midX || p.xMax < midX) continue;
+    if (axial < 0 || p.voxels.size() > P[std::size_t(axial)].voxels.size()) axial = i;
+  }
+  if (axial < 0)
+    throw Error(source + ": the skeleton label has no spine (no piece of it crosses the midline)");
+  P[std::size_t(axial)].kind = BoneKind::Spine, P[std::size_t(axial)].assigned = true;
+  // A skull the grid breaks into pieces (a thin shell on thick slices): every piece whose centre
+  // lies above the spine's top.
+  for (Piece& p : P)
+    if (!p.assigned && p.centroid.z() > P[std::size_t(axial)].top)
+      p.kind = BoneKind::Skull, p.assigned = true;
+  split.findContacts();
+  const double axialMid = 0.5 * (P[std::size_t(axial)].top + P[std::size_t(axial)].bottom);
+  auto sideOf = [&](const Piece& p) { return p.centroid.x() < midX ? -1 : +1; };
+
+  // The sternum: a piece in front of the axial piece at the midline. Clavicles that reach the
+  // midline over the manubrium are one piece with it: parted by the erosion (the largest part
+  // across the midline is the sternum), and what crosses the midline of the rest cut there.
+  const double axialTop = P[std::size_t(axial)].top, axialBottom = P[std::size_t(axial)].bottom;
+  for (int i = 0; i < int(P.size()); ++i) {
+    const Piece& p = P[std::size_t(i)];
+    if (p.assigned || p.xMin > midX || p.xMax < midX ||
+        p.centroid.y() <= P[std::size_t(axial)].centroid.y() || p.centroid.z() <= axialMid)
+      continue;
+    const std::vector<int> parts = split.partPiece(i, 0.05);
+    P[std::size_t(i)].kind = BoneKind::Sternum, P[std::size_t(i)].assigned = true;
+    for (std::size_t k = 1; k < parts.size(); ++k) {
+      const Piece& q = P[std::size_t(parts[k])];
+      if (q.xMin < midX && q.xMax > midX)
+        split.carve(parts[k], [&](std::int64_t v) { return grid.ras(v).x() > midX; });
+    }
+    break;
+  }
+
+  // Per side: the femur and the humerus hanging from the axial piece, then their segments.
+  std::vector<std::string> merged;
+  std::map<int, V> heads;  // per side, the humeral head's end
+  bool recontact = false;
+  for (const int side : {-1, +1}) {
+    const std::string word = side < 0 ? "left" : "right";
+    auto candidates = [&](double minLength) {
+      std::vector<int> c;
+      for (int i = 0; i < int(P.size()); ++i)
+        if (!P[std::size_t(i)].assigned && sideOf(P[std::size_t(i)]) == side &&
+            P[std::size_t(i)].length >= minLength)
+          c.push_back(i);
+      return c;
+    };
+    auto take = [&](int i, BoneKind kind) {
+      P[std::size_t(i)].kind = kind, P[std::size_t(i)].side = side;
+      P[std::size_t(i)].assigned = true;
+    };
+    // The femur: the longest piece touching the axial piece in its lower half.
+    int femur = -1;
+    for (const int i : candidates(0.12 * H)) {
+      const Contact* c = split.contact(i, axial);
+      if (!c || c->at.z() > axialMid || P[std::size_t(i)].top > axialMid) continue;
+      if (femur < 0 || P[std::size_t(i)].length > P[std::size_t(femur)].length) femur = i;
+    }
+    if (femur >= 0) take(femur, BoneKind::Femur);
+    // The humerus: the longest near-vertical piece reaching above the axial piece's middle,
+    // touching it or a piece that touches it (the scapula).
+    int humerus = -1;
+    for (const int i : candidates(0.1 * H)) {
+      const Piece& p = P[std::size_t(i)];
+      // At the shoulders: its top in the axial piece's upper third (an arm held away from the
+      // trunk touches nothing there).
+      if (p.top < axialTop - (axialTop - axialBottom) / 3 || std::fabs(p.axis.z()) < 0.5) continue;
+      if (humerus < 0 || p.length > P[std::size_t(humerus)].length) humerus = i;
+    }
+    // A humerus the grid joined to its scapula at the glenoid: parted where the erosion parts
+    // them, the humerus then the longest near-vertical part.
+    if (humerus >= 0) {
+      const std::vector<int> parts = split.partPiece(humerus, 0.1);
+      for (const int i : parts)
+        if (std::fabs(P[std::size_t(i)].axis.z()) >= 0.5 &&
+            P[std::size_t(i)].length > P[std::size_t(humerus)].length)
+          humerus = i;
+      if (parts.size() > 1) recontact = true;
+      take(humerus, BoneKind::Humerus);
+    }
+    // A root bone far longer than its bone is two bones joined across a joint (on coarse
+    // grids the elbow's and the knee's joint spaces close): cut where it is thinnest about
+    // where the joint lies in proportion (the humerus 56 % of the arm to the wrist, the femur
+    // half the leg to the ankle; Drillis and Contini's segment lengths), else refuse.
+    auto cutAtJoint = [&](int bone, double longest, double lo, double hi, BoneKind distal,
+                          const std::string& what, const std::string& joint) {
+      if (bone < 0 || P[std::size_t(bone)].length <= longest * H) return;
+      const V u = P[std::size_t(bone)].axis.z() > 0 ? V(-P[std::size_t(bone)].axis)
+                                                    : P[std::size_t(bone)].axis;
+      const int d = split.cutAcross(bone, u, lo, hi);
+      if (d < 0 || P[std::size_t(bone)].length > longest * H) {
+        merged.push_back("the " + word + " " + what + " (no gap at the " + joint + ")");
+        return;
+      }
+      take(d, distal);
+      out.notes.push_back("the " + word + " " + what + " are one piece: cut at the " + joint +
+                          "'s narrowest");
+      recontact = true;
+    };
+    cutAtJoint(femur, 0.34, 0.4, 0.6, BoneKind::Shank, "femur and tibia", "knee");
+    cutAtJoint(humerus, 0.27, 0.45, 0.68, BoneKind::Forearm, "humerus and forearm", "elbow");
+    if (recontact) split.findContacts(), recontact = false;
+
+    // A limb's segments beyond its root bone: the pieces at its distal end, then what lies
+    // beyond them.
+    auto limb = [&](int root, BoneKind second, BoneKind third) {
+      if (root < 0) return;
+      const Piece& r = P[std::size_t(root)];
+      // Distal: away from the end the root hangs from (its higher end: arms and legs hang down
+      // in the rest postures a split map can be rigged in).
+      const V u = r.axis.z() > 0 ? V(-r.axis) : r.axis;
+      double far = -1e300;
+      for (const std::int64_t v : r.voxels) far = std::max(far, grid.ras(v).dot(u));
+      std::vector<int> seg;
+      for (int i = 0; i < int(P.size()); ++i)  // cut off the root at the joint
+        if (P[std::size_t(i)].kind == second && P[std::size_t(i)].side == side) seg.push_back(i);
+      for (int i = 0; i < int(P.size()); ++i) {
+        const Piece& p = P[std::size_t(i)];
+        const Contact* c = split.contact(i, root);
+        if (p.assigned || !c || sideOf(p) != side) continue;
+        if (c->at.dot(u) < far - 0.25 * r.length) continue;  // not at the distal end
+        take(i, second), seg.push_back(i);
+      }
+      if (seg.empty()) return;
+      // Long pieces beside the segment's (the fibula beside the tibia, the ulna beside the
+      // radius when only one touches the root).
+      int longest = seg[0];
+      for (const int i : seg)
+        if (P[std::size_t(i)].length > P[std::size_t(longest)].length) longest = i;
+      const V u2 = P[std::size_t(longest)].axis.dot(u) >= 0 ? P[std::size_t(longest)].axis
+                                                            : V(-P[std::size_t(longest)].axis);
+      const V base = P[std::size_t(longest)].centroid;
+      const double half = 0.5 * P[std::size_t(longest)].length;
+      for (int i = 0; i < int(P.size()); ++i) {
+        const Piece& p = P[std::size_t(i)];
+        if (p.assigned || sideOf(p) != side || p.length < 0.5 * half) continue;
+        bool beside = false;
+        for (const int s : seg) beside = beside || split.contact(i, s);
+        if (beside && std::fabs((p.centroid - base).dot(u2)) < 0.5 * half) take(i, second);
+      }
+      for (int i = 0; i < int(P.size()); ++i)
+        if (P[std::size_t(i)].kind == second && P[std::size_t(i)].side == side &&
+            std::find(seg.begin(), seg.end(), i) == seg.end())
+          seg.push_back(i);
+      // Beyond: every piece reached from the segment past its middle, and on from those.
+      std::vector<int> front = seg;
+      while (!front.empty()) {
+        std::vector<int> nextFront;
+        for (const int s : front)
+          for (int i = 0; i < int(P.size()); ++i) {
+            const Piece& p = P[std::size_t(i)];
+            if (p.assigned || sideOf(p) != side || !split.contact(i, s)) continue;
+            if ((p.centroid - base).dot(u2) <= 0) continue;
+            take(i, third), nextFront.push_back(i);
+          }
+        front.swap(nextFront);
+      }
+    };
+    limb(humerus, BoneKind::Forearm, BoneKind::Hand);
+    limb(femur, BoneKind::Shank, BoneKind::Foot);
+
+    // The girdle: pieces about the shoulder's height that reach out as far as the humeral
+    // head (the clavicle to the acromion, the scapula to the glenoid; the ribs stay inside),
+    // for now all as the scapula: front and back are told apart once the pieces that touch
+    // them have joined them.
+    if (humerus >= 0) {
+      const Piece& h = P[std::size_t(humerus)];
+      const V head = h.axis.z() > 0 ? V(h.centroid + 0.5 * h.length * h.axis)
+                                    : V(h.centroid - 0.5 * h.length * h.axis);
+      heads[side] = head;
+      const double headOut = double(side) * (head.x() - midX);
+      for (int i = 0; i < int(P.size()); ++i) {
+        const Piece& p = P[std::size_t(i)];
+        if (p.assigned || sideOf(p) != side) continue;
+        if (std::fabs(p.centroid.z() - head.z()) > 0.1 * H) continue;
+        const double out = side < 0 ? midX - p.xMin : p.xMax - midX;
+        if (out >= 0.75 * headOut) take(i, BoneKind::Scapula);
+      }
+      // A clavicle the grid breaks in its thin middle: the pieces on the line from the girdle's
+      // front end nearest the midline to the sternum's top.
+      V front = V::Zero();
+      double best = -1e300;
+      for (const Piece& p : P)
+        if (p.kind == BoneKind::Scapula && p.side == side)
+          for (const std::int64_t v : p.voxels) {
+            const V r = grid.ras(v);
+            if (r.y() > head.y() && -double(side) * (r.x() - midX) > best)
+              best = -double(side) * (r.x() - midX), front = r;
+          }
+      const Piece* sternum = nullptr;
+      for (const Piece& p : P)
+        if (p.kind == BoneKind::Sternum) sternum = &p;
+      if (best > -1e300 && sternum) {
+        V top = sternum->centroid;
+        for (const std::int64_t v : sternum->voxels)
+          if (grid.ras(v).z() > top.z()) top = grid.ras(v);
+        const V ab = top - front;
+        const double reach = std::max(20.0, 3 * grid.spacing.maxCoeff());
+        for (int i = 0; i < int(P.size()); ++i) {
+          const Piece& p = P[std::size_t(i)];
+          if (p.assigned || sideOf(p) != side) continue;
+          const double t = std::clamp((p.centroid - front).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+          if ((p.centroid - (front + t * ab)).norm() <= reach) take(i, BoneKind::Scapula);
+        }
+      }
+    }
+  }
+  if (!merged.empty()) {
+    std::string list;
+    for (const std::string& m : merged) list += (list.empty() ? "" : ", ") + m;
+    throw Error(source + ": the skeleton label cannot be split into bones: it joins " + list);
+  }
+
+  // The pelvis: the axial piece below the iliac crests, beside the spine. The lumbar spine is the
+  // narrowest stretch of the axial piece between its bottom and its middle; the crests are the
+  // highest level below it at least twice as wide; the spine's column there is the lumbar
+  // stretch's footprint.
+  {
+    Piece& a = P[std::size_t(axial)];
+    const double step = std::max(grid.spacing.z(), 4.0);
+    const std::size_t bands = std::size_t(std::ceil((axialMid - a.bottom) / step));
+    const std::vector<double> w = widthProfile(a, grid, a.bottom, step, bands);
+    std::size_t narrow = bands;
+    for (std::size_t b = bands / 4; b < bands; ++b)
+      if (w[b] > 0 && (narrow == bands || w[b] < w[narrow])) narrow = b;
+    std::size_t crest = bands;
+    if (narrow < bands)
+      for (std::size_t b = narrow; b-- > 0;)
+        if (w[b] >= 2 * w[narrow]) {
+          crest = b;
+          break;
+        }
+    if (crest < bands) {
+      const double zCrest = a.bottom + (double(crest) + 1) * step,
+                   zLumbar = a.bottom + (double(narrow) + 1) * step;
+      Eigen::Vector2d c = Eigen::Vector2d::Zero();
+      int count = 0;
+      for (const std::int64_t v : a.voxels) {
+        const V r = grid.ras(v);
+        if (r.z() >= zLumbar - step && r.z() < zLumbar) c += r.head<2>(), ++count;
+      }
+      if (count > 0) {
+        c /= double(count);
+        // The column's radius: the vertebral body's and arch's, not the transverse
+        // processes' (which would take in the sacroiliac region beside it).
+        std::vector<double> reach;
+        for (const std::int64_t v : a.voxels) {
+          const V r = grid.ras(v);
+          if (r.z() >= zLumbar - step && r.z() < zLumbar) reach.push_back((r.head<2>() - c).norm());
+        }
+        std::nth_element(reach.begin(), reach.begin() + std::ptrdiff_t(reach.size() / 2),
+                         reach.end());
+        const double radius = reach[reach.size() / 2] + grid.spacing.head<2>().maxCoeff();
+        // Below the crests the column is the spine only where a slice of it is a vertebra's
+        // section (at least half the lumbar slices' mean): in a disc's gap, what lies within the
+        // column's radius is the pelvis's.
+        const double dz = grid.spacing.z();
+        auto slice = [&](double z) { return std::int64_t(std::floor(z / dz)); };
+        std::map<std::int64_t, int> lumbarSlices, columnSlices;
+        for (const std::int64_t v : a.voxels) {
+          const V r = grid.ras(v);
+          if ((r.head<2>() - c).norm() > radius) continue;
+          if (r.z() >= zLumbar - step && r.z() < zLumbar) ++lumbarSlices[slice(r.z())];
+          if (r.z() < zCrest) ++columnSlices[slice(r.z())];
+        }
+        double lumbarMean = 0;
+        for (const auto& [k, n] : lumbarSlices) lumbarMean += n;
+        lumbarMean /= double(std::max<std::size_t>(1, lumbarSlices.size()));
+        const int pelvis = split.carve(axial, [&](std::int64_t v) {
+          const V r = grid.ras(v);
+          if (r.z() >= zCrest) return false;
+          return (r.head<2>() - c).norm() > radius || columnSlices[slice(r.z())] < 0.5 * lumbarMean;
+        });
+        if (pelvis >= 0 && pelvis != axial)
+          P[std::size_t(pelvis)].kind = BoneKind::Pelvis, P[std::size_t(pelvis)].assigned = true;
+      }
+    }
+  }
+
+  // The rest (ribs apart from the spine, small pieces) goes with the trunk's bones where it
+  // touches them (a first rib under the clavicle touches both), else with what it touches
+  // nearest.
+  auto axialKind = [](BoneKind k) {
+    return k == BoneKind::Spine || k == BoneKind::Sternum || k == BoneKind::Pelvis;
+  };
+  for (int round = 0; round < 4; ++round)
+    for (int i = 0; i < int(P.size()); ++i) {
+      Piece& p = P[std::size_t(i)];
+      if (p.assigned) continue;
+      const Contact* best = nullptr;
+      int with = -1;
+      bool trunk = false;
+      for (int j = 0; j < int(P.size()); ++j) {
+        const Contact* c = j == i || !P[std::size_t(j)].assigned ? nullptr : split.contact(i, j);
+        if (!c) continue;
+        const bool t = axialKind(P[std::size_t(j)].kind);
+        if (!best || (t && !trunk) || (t == trunk && c->distance < best->distance))
+          best = c, with = j, trunk = trunk || t;
+      }
+      if (with >= 0) p.kind = P[std::size_t(with)].kind, p.side = P[std::size_t(with)].side;
+      if (with >= 0) p.assigned = true;
+    }
+  // Pieces too far from any other for a contact (a toe's phalanges): with the piece nearest
+  // their centre.
+  for (Piece& p : P) {
+    if (p.assigned) continue;
+    double best = 1e300;
+    const Piece* with = nullptr;
+    for (const Piece& q : P) {
+      if (!q.assigned) continue;
+      const std::size_t stride = std::max<std::size_t>(1, q.voxels.size() / 4096);
+      for (std::size_t k = 0; k < q.voxels.size(); k += stride) {
+        const double d = (grid.ras(q.voxels[k]) - p.centroid).squaredNorm();
+        if (d < best) best = d, with = &q;
+      }
+    }
+    if (with) p.kind = with->kind, p.side = with->side, p.assigned = true;
+  }
+  for (Piece& p : P) {
+    if (!p.assigned) p.kind = BoneKind::Spine, p.side = 0;
+    if (p.kind == BoneKind::Scapula && heads.count(p.side)) {
+      // The girdle in front of the humeral head is the clavicle's (its medial end is the
+      // sternoclavicular joint's), behind it the scapula's.
+      const double y = heads[p.side].y();
+      for (const std::int64_t v : p.voxels)
+        out.bones[{grid.ras(v).y() > y ? BoneKind::Clavicle : BoneKind::Scapula, p.side}].push_back(
+            v);
+      continue;
+    }
+    auto& dst = out.bones[{p.kind, p.side}];
+    dst.insert(dst.end(), p.voxels.begin(), p.voxels.end());
+  }
+  std::ostringstream note;
+  note << "the skeleton label split into " << out.bones.size() << " bones from " << P.size()
+       << " pieces";
+  out.pieces = int(P.size());
+  out.notes.push_back(note.str());
+  return out;
+}
+
+}  // namespace repose::rig

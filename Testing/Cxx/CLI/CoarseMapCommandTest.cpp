@@ -1,0 +1,53 @@
+// A coarse map end to end as a dosimetry user brings one (issue 65): the whole skeleton as one
+// label inside a body label, a few organs, no label names, and the body touching the grid's edge
+// (hands and feet on its faces). `repose rig` takes it with no option and `repose pose` raises an
+// arm beyond the input grid: the output grid grows to hold it, no label is lost, every target
+// holds.
+#include "CliTestFiles.h"
+#include "CommandRunner.h"
+#include "TestPaths.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+
+using namespace repose::test;
+
+TEST(CoarseMapCommand, RigsWithNoOptionAndPosesAnArmBeyondTheInputGrid) {
+  ScratchDir dir;
+  const std::string d = shellQuote(dir.path().string());
+  ASSERT_EQ(runCommand("repose",
+                       "phantom --voxel 4 --arms-resting --gap-mm 4,15 --margin 0 "
+                       "--labels coarse --out " +
+                           d)
+                .exitCode,
+            0);
+  std::filesystem::remove(dir.file("S.nii.gz"));
+  std::filesystem::remove(dir.file("skeleton.json"));
+  const CommandResult rig =
+      runCommand("repose", "rig --input " + shellQuote(dir.file("G.nii.gz")) + " --out " +
+                               shellQuote(dir.file("rig")) + " --json");
+  ASSERT_EQ(rig.exitCode, 0) << rig.err;
+  const nlohmann::json rigReport = nlohmann::json::parse(rig.out);
+  EXPECT_EQ(rigReport["convention"], "coarse (body and skeleton)");
+  EXPECT_GT(rigReport["skeleton_split"]["pieces"].get<int>(), 10);
+  EXPECT_EQ(rigReport["missing"].size(), 0u) << rigReport["missing"].dump();
+  const nlohmann::json inputGrid = nlohmann::json::parse(
+      runCommand("repose", "info " + shellQuote(dir.file("G.nii.gz")) + " --json").out);
+
+  const CommandResult pose =
+      runCommand("repose", "pose --input " + shellQuote(dir.file("G.nii.gz")) + " --parts " +
+                               shellQuote(dir.file("rig/S.nii.gz")) + " --pose " +
+                               shellQuote(suitePoseFile("arm_raise90")) + " --out " +
+                               shellQuote(dir.file("raised")) + " --json");
+  ASSERT_EQ(pose.exitCode, 0) << pose.err;
+  const nlohmann::json report = nlohmann::json::parse(pose.out);
+  // The raised arm reaches beyond the input grid's side: the output grid is wider.
+  EXPECT_GT(report["grid"]["dims"][0].get<int>(), inputGrid["dimensions"][0].get<int>() + 20)
+      << report["grid"].dump() << inputGrid.dump();
+  EXPECT_EQ(report["labels_lost"], 0);
+  EXPECT_TRUE(report["quality"]["all_met"].get<bool>()) << report["quality"].dump();
+  for (const auto& l : report["labels"])
+    EXPECT_LT(std::fabs(l["change_beyond_floor_percent"].get<double>()), 1.0) << l.dump();
+}
