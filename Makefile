@@ -84,6 +84,7 @@ bench: build
 bench-large: build
 	/usr/bin/python3 bench/run_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench --large
 	/usr/bin/python3 bench/pose_large_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench-pose-large
+	/usr/bin/python3 bench/rig_large_bench.py --build $(BUILD_DIR) --out $(BUILD_DIR)/bench-rig-large
 
 # Posture-sweep throughput in one process and on 2 MPI ranks (docs/PERFORMANCE.md).
 bench-sweep: build

@@ -83,7 +83,7 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   out.warnings.insert(out.warnings.end(), out.convention.notes.begin(), out.convention.notes.end());
 
   reportProgress(options.progress, 0.3, "rig: joints");
-  const std::vector<rig::FittedJoint> joints = rig::fitJoints(bones, out.missing);
+  std::vector<rig::FittedJoint> joints = rig::fitJoints(bones, out.missing);
   reportProgress(options.progress, 0.4, "rig: body parts");
   rig::PartStats stats;
   std::vector<std::uint8_t> outline;
@@ -102,6 +102,8 @@ RigResult rigBody(const Volume& organs, const RigOptions& options) {
   }
   out.parts = rig::assignParts(organs, out.convention, bones, joints, grid, options.threads, stats,
                                options.image ? &outline : nullptr);
+  rig::fitDistalJointsFromOutline(out.parts, organs, out.convention, bones, joints, grid,
+                                  out.missing);
   if (stats.unreached > 0)
     out.warnings.push_back(std::to_string(stats.unreached) +
                            " body voxels are joined to no bone (a separate piece): put in the "

@@ -95,7 +95,6 @@ Bones findBones(const Volume& organs, const LabelConvention& convention, const G
                 const std::string& source) {
   Bones out;
   out.voxelMm = grid.spacing.maxCoeff();
-  std::vector<std::int32_t> owner(std::size_t(grid.count()), 0);
   // Voxels per (kind, side given by the label).
   std::map<std::pair<BoneKind, int>, std::vector<std::int64_t>> raw;
   std::vector<std::int64_t> body;
@@ -181,6 +180,8 @@ Bones findBones(const Volume& organs, const LabelConvention& convention, const G
     }
     for (const std::int64_t v : voxels) seen[std::size_t(v)] = 0;
   }
+  // Allocated only now: a skeleton split above needs its memory first (325M voxels: 1.3 GB).
+  std::vector<std::int32_t> owner(std::size_t(grid.count()), 0);
   std::int32_t id = 0;
   std::vector<Bone*> list;
   for (auto& [key, bone] : out.byKind) {

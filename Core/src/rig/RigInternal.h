@@ -131,6 +131,15 @@ void assignGirdlesAndPelvis(Volume& parts, const Bones& bones,
 std::vector<std::uint8_t> bodyOutline(const Volume& image, const Volume& organs, const Grid& grid,
                                       std::string& how);
 
+// The wrist and the ankle where the map has no hand or foot bones (RigOutlineJoints.cpp), from
+// the outline of the forearm's and shank's parts (after assignParts): each joint is added with
+// its method, the part beyond its plane becomes the hand or the foot (bones keep their part), and
+// its line leaves `missing`.
+void fitDistalJointsFromOutline(Volume& parts, const Volume& organs,
+                                const LabelConvention& convention, const Bones& bones,
+                                std::vector<FittedJoint>& joints, const Grid& grid,
+                                std::vector<std::string>& missing);
+
 // How far from its centre each joint's two parts meet across its plane (radius_mm).
 double jointRadius(const Volume& parts, const FittedJoint& joint, const Grid& grid);
 

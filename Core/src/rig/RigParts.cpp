@@ -90,7 +90,7 @@ Volume assignParts(const Volume& organs, const LabelConvention& convention, cons
   // The distance of every body voxel to the body's surface (mm).
   std::vector<std::uint8_t> outside(static_cast<std::size_t>(n));
   for (std::int64_t i = 0; i < n; ++i) outside[std::size_t(i)] = allowed[std::size_t(i)] == 0;
-  std::vector<float> depth = squaredDistanceToMask(outside, d, grid.spacing, threads);
+  std::vector<float> depth = squaredDistanceToMaskLean(outside, d, grid.spacing, threads);
   outside = {};
   for (float& v : depth) v = std::isfinite(v) ? std::sqrt(v) : 1e6f;
 

@@ -90,11 +90,11 @@ class Splitter {
         }
   }
 
-  // Pieces: the mask's 26-connected components. The axial one (the largest across the midline)
-  // may hold limb bones that touch it (a femoral head in its acetabulum, a humeral head on its
-  // glenoid, a scapula on the ribs): one voxel's erosion parts such contacts, and each long
+  // Pieces: the mask's 26-connected components. The axial ones (the large ones across the
+  // midline) may hold limb bones that touch them (a femoral head in its acetabulum, a humeral head
+  // on its glenoid, a scapula on the ribs): one voxel's erosion parts such contacts, and each long
   // lateral part the erosion leaves becomes a piece of its own, grown back over the voxels the
-  // erosion took (ring by ring, against the rest of the axial piece). Only that piece is
+  // erosion took (ring by ring, against the rest of the axial piece). Only those pieces are
   // eroded: a skull or a pelvis one voxel thick on a coarse grid would fall apart.
   void findPieces(double midX, double height) {
     const std::int64_t n = std::int64_t(mask_.size());
@@ -112,20 +112,24 @@ class Splitter {
           }
         });
     };
-    int next = 0, axial = -1;
-    std::size_t axialSize = 0;
+    int next = 0;
+    std::vector<std::pair<int, std::size_t>> across;  // components across the midline, sizes
+    std::size_t total = 0;
     for (std::int64_t l = 0; l < n; ++l) {
       if (!mask_[std::size_t(l)] || owner_[std::size_t(l)] != -1) continue;
       flood(l, mask_, next, owner_);
+      total += got.size();
       double lo = 1e300, hi = -1e300;
       for (const std::int64_t m : got) {
         const double x = grid_.ras(global(m)).x();
         lo = std::min(lo, x), hi = std::max(hi, x);
       }
-      if (lo <= midX && hi >= midX && got.size() > axialSize) axial = next, axialSize = got.size();
+      if (lo <= midX && hi >= midX) across.push_back({next, got.size()});
       ++next;
     }
-    if (axial >= 0) partAxial(axial, midX, height, next, flood, got);
+    // Each large one (the trunk's bones, the pelvis apart from a spine the discs part).
+    for (const auto& [id, size] : across)
+      if (size >= total / 20) partAxial(id, midX, height, next, flood, got);
     pieces_.assign(std::size_t(next), Piece());
     for (std::int64_t l = 0; l < n; ++l)
       if (owner_[std::size_t(l)] >= 0)
@@ -386,6 +390,16 @@ class Splitter {
     return out;
   }
 
+  // Moves every voxel of piece `from` into piece `into` (`from` is left empty).
+  void merge(int into, int from) {
+    Piece& a = pieces_[std::size_t(into)];
+    Piece& b = pieces_[std::size_t(from)];
+    for (const std::int64_t v : b.voxels) owner_[std::size_t(local(v))] = into;
+    a.voxels.insert(a.voxels.end(), b.voxels.begin(), b.voxels.end());
+    b.voxels.clear();
+    describe(a);
+  }
+
   // Cuts piece `from` across `u` where it has the fewest voxels between fractions lo and hi of
   // its extent along u; the part beyond becomes a new piece (its index; -1 when none).
   int cutAcross(int from, const V& u, double lo, double hi) {
@@ -474,11 +488,16 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
   split.findPieces(midX, H);
   std::vector<Piece>& P = split.pieces();
 
-  // The skull: the piece with the highest point; cut off the spine below it where it is joined
-  // to it (where the slices narrow to a quarter of the skull's widest, going down).
+  // The skull: the largest piece reaching within 30 mm of the highest point (on thick slices its
+  // shell breaks and the crown may be a piece of its own); cut off the spine below it where it is
+  // joined to it (where the slices narrow to 40 % of the skull's widest, going down).
   int skull = -1;
-  for (int i = 0; i < int(P.size()); ++i)
-    if (skull < 0 || P[std::size_t(i)].top > P[std::size_t(skull)].top) skull = i;
+  for (const Piece& p : P) {
+    const double near = std::max(30.0, 3 * grid.spacing.maxCoeff());
+    if (p.top < zMax - near) continue;
+    if (skull < 0 || p.voxels.size() > P[std::size_t(skull)].voxels.size())
+      skull = int(&p - P.data());
+  }
   if (P[std::size_t(skull)].top - P[std::size_t(skull)].bottom > 0.25 * H) {
     const double step = std::max(grid.spacing.z(), 2.0);
     const std::size_t bands = std::size_t(std::ceil(0.3 * H / step));
@@ -505,12 +524,33 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
   if (axial < 0)
     throw Error(source + ": the skeleton label has no spine (no piece of it crosses the midline)");
   P[std::size_t(axial)].kind = BoneKind::Spine, P[std::size_t(axial)].assigned = true;
-  // A skull the grid breaks into pieces (a thin shell on thick slices): every piece whose centre
-  // lies above the spine's top.
-  for (Piece& p : P)
-    if (!p.assigned && p.centroid.z() > P[std::size_t(axial)].top)
-      p.kind = BoneKind::Skull, p.assigned = true;
+  // A spine the discs part into vertebrae (1 mm grids), a pelvis apart from the sacrum: the
+  // pieces across the midline chained to the largest through their contacts are one axial
+  // skeleton, but for the sternum in front (more than 50 mm ahead of the largest's centre) and
+  // the rest of a skull broken on thick slices (centred above the skull's lowest point).
   split.findContacts();
+  {
+    std::vector<int> chain{axial};
+    bool grew = false;
+    const double front = P[std::size_t(axial)].centroid.y() + 50;
+    for (std::size_t q = 0; q < chain.size(); ++q)
+      for (int i = 0; i < int(P.size()); ++i) {
+        const Piece& p = P[std::size_t(i)];
+        if (p.assigned || p.voxels.empty() || p.xMin > midX || p.xMax < midX ||
+            p.centroid.y() > front || !split.contact(i, chain[q]) ||
+            p.centroid.z() > P[std::size_t(skull)].bottom)
+          continue;
+        P[std::size_t(i)].assigned = true;
+        chain.push_back(i);
+      }
+    for (std::size_t q = 1; q < chain.size(); ++q) split.merge(axial, chain[q]), grew = true;
+    if (grew) split.findContacts();
+  }
+  // A skull the grid breaks into pieces (a thin shell on thick slices): every piece centred above
+  // the skull's lowest point.
+  for (Piece& p : P)
+    if (!p.assigned && !p.voxels.empty() && p.centroid.z() > P[std::size_t(skull)].bottom)
+      p.kind = BoneKind::Skull, p.assigned = true;
   const double axialMid = 0.5 * (P[std::size_t(axial)].top + P[std::size_t(axial)].bottom);
   auto sideOf = [&](const Piece& p) { return p.centroid.x() < midX ? -1 : +1; };
 
@@ -779,11 +819,12 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
     }
   }
 
-  // The rest (ribs apart from the spine, small pieces) goes with the trunk's bones where it
-  // touches them (a first rib under the clavicle touches both), else with what it touches
-  // nearest.
+  // The rest (ribs apart from the spine, a mandible, small pieces) goes with the nearest of the
+  // trunk's and head's bones where it touches them (a first rib under the clavicle touches both
+  // it and the spine), else with what it touches nearest.
   auto axialKind = [](BoneKind k) {
-    return k == BoneKind::Spine || k == BoneKind::Sternum || k == BoneKind::Pelvis;
+    return k == BoneKind::Spine || k == BoneKind::Sternum || k == BoneKind::Pelvis ||
+           k == BoneKind::Skull;
   };
   for (int round = 0; round < 4; ++round)
     for (int i = 0; i < int(P.size()); ++i) {

@@ -51,12 +51,16 @@ void transformLine(std::vector<double>& f, double h, std::vector<double>& d, std
 
 }  // namespace
 
-std::vector<float> squaredDistanceToMask(const std::vector<std::uint8_t>& mask,
-                                         const std::array<std::int64_t, 3>& dims,
-                                         const Eigen::Vector3d& spacing, int threads) {
+namespace {
+
+// The three passes over a grid stored as `Store` between them (each line in doubles).
+template <class Store>
+std::vector<Store> transformGrid(const std::vector<std::uint8_t>& mask,
+                                 const std::array<std::int64_t, 3>& dims,
+                                 const Eigen::Vector3d& spacing, int threads) {
   const std::int64_t nx = dims[0], ny = dims[1], nz = dims[2];
-  std::vector<double> g(mask.size());
-  for (std::size_t i = 0; i < mask.size(); ++i) g[i] = mask[i] ? 0.0 : kInf;
+  std::vector<Store> g(mask.size());
+  for (std::size_t i = 0; i < mask.size(); ++i) g[i] = mask[i] ? Store(0) : Store(kInf);
   const std::int64_t stride[3] = {1, nx, nx * ny};
   const std::int64_t length[3] = {nx, ny, nz};
   for (int axis = 0; axis < 3; ++axis) {
@@ -74,12 +78,27 @@ std::vector<float> squaredDistanceToMask(const std::vector<std::uint8_t>& mask,
             const std::int64_t base = ia * stride[a] + ib * stride[b];
             for (std::size_t q = 0; q < n; ++q) f[q] = g[base + q * stride[axis]];
             transformLine(f, spacing[axis], d, v, z);
-            for (std::size_t q = 0; q < n; ++q) g[base + q * stride[axis]] = f[q];
+            for (std::size_t q = 0; q < n; ++q) g[base + q * stride[axis]] = Store(f[q]);
           }
         },
         16);
   }
+  return g;
+}
+
+}  // namespace
+
+std::vector<float> squaredDistanceToMask(const std::vector<std::uint8_t>& mask,
+                                         const std::array<std::int64_t, 3>& dims,
+                                         const Eigen::Vector3d& spacing, int threads) {
+  const std::vector<double> g = transformGrid<double>(mask, dims, spacing, threads);
   return std::vector<float>(g.begin(), g.end());
+}
+
+std::vector<float> squaredDistanceToMaskLean(const std::vector<std::uint8_t>& mask,
+                                             const std::array<std::int64_t, 3>& dims,
+                                             const Eigen::Vector3d& spacing, int threads) {
+  return transformGrid<float>(mask, dims, spacing, threads);
 }
 
 }  // namespace repose

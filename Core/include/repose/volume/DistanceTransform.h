@@ -16,4 +16,11 @@ std::vector<float> squaredDistanceToMask(const std::vector<std::uint8_t>& mask,
                                          const std::array<std::int64_t, 3>& dims,
                                          const Eigen::Vector3d& spacing, int threads = 0);
 
+// The same with the grid kept in floats between the three passes: a third of the memory (4 bytes
+// a voxel instead of 8 and then 4 more for the result; a 325M-voxel body's depth in `repose rig`
+// needs 1.3 GB, not 3.9), each value within a few float ulps of squaredDistanceToMask's.
+std::vector<float> squaredDistanceToMaskLean(const std::vector<std::uint8_t>& mask,
+                                             const std::array<std::int64_t, 3>& dims,
+                                             const Eigen::Vector3d& spacing, int threads = 0);
+
 }  // namespace repose

@@ -4,8 +4,8 @@
 // bones by geometry (rig/RigSkeletonSplit.cpp) and fits the same joints as the full-label rig of
 // the same body, each within 10 mm, on isotropic and thick-slice grids: the ICRP adult male's 8 mm
 // slices (where the elbows and knees join and the skull breaks into pieces), the girdles touching
-// across the sternum, and arms held away from the trunk. A CSV may name the kinds instead; a map
-// with a skeleton and no body is refused in one line.
+// across the sternum, arms held away from the trunk, and a spine the discs part into vertebrae. A
+// CSV may name the kinds instead; a map with a skeleton and no body is refused in one line.
 #include "repose/phantom/Phantom.h"
 #include "repose/rig/Rig.h"
 #include "repose/util/Error.h"
@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -28,6 +29,7 @@ struct Body {
   bool armsResting;
   double handGapMm;
   bool girdlesTouching;
+  bool discs = false;  // the spine parted into vertebrae at discs, the sacrum from the lumbar spine
 };
 
 void PrintTo(const Body& b, std::ostream* os) {
@@ -64,7 +66,25 @@ class CoarseMap : public ::testing::TestWithParam<Body> {};
 TEST_P(CoarseMap, RigsWithNoOptionAndFitsTheFullLabelRigsJoints) {
   const Body& b = GetParam();
   const auto [full, parts] = Phantom(options(b, PhantomLabelling::Phantom)).makeVolumes();
-  const auto [coarse, same] = Phantom(options(b, PhantomLabelling::Coarse)).makeVolumes();
+  auto [coarse, same] = Phantom(options(b, PhantomLabelling::Coarse)).makeVolumes();
+  if (b.discs) {
+    // 5 mm discs every 30 mm from the lumbosacral one up to the neck, across the spine's column
+    // (as a 1 mm map shows them): the spine falls into vertebrae and the pelvis comes apart.
+    std::uint8_t* g = coarse.data<std::uint8_t>();
+    const auto& d = coarse.geometry().dims;
+    std::int64_t cut = 0;
+    for (std::int64_t k = 0; k < d[2]; ++k)
+      for (std::int64_t j = 0; j < d[1]; ++j)
+        for (std::int64_t i = 0; i < d[0]; ++i) {
+          const std::int64_t v = i + d[0] * (j + d[1] * k);
+          const Eigen::Vector3d p = coarse.geometry().voxelToRas(double(i), double(j), double(k));
+          const double disc = std::fmod(p.z() - 750 + 300, 30.0);
+          if (g[v] == 2 && std::fabs(p.x()) < 35 && p.y() < -15 && p.y() > -90 && p.z() > 740 &&
+              p.z() < 1160 && (disc <= 2.5 || disc >= 27.5))
+            g[v] = 1, ++cut;
+        }
+    ASSERT_GT(cut, 300);
+  }
   ASSERT_TRUE(coarse.labels().empty());  // no names: recognised by the labels' shapes
   RigOptions ro;
   ro.source = b.name;
@@ -105,7 +125,8 @@ INSTANTIATE_TEST_SUITE_P(
                       Body{"gap_thick_girdles_touching", Eigen::Vector3d(1.8, 1.8, 4.8), true, 4,
                            true},
                       Body{"icrp_am_grid", Eigen::Vector3d(2.137, 2.137, 8), true, 3, true},
-                      Body{"free_arms_3mm", Eigen::Vector3d(3, 3, 3), false, 0, false}),
+                      Body{"free_arms_3mm", Eigen::Vector3d(3, 3, 3), false, 0, false},
+                      Body{"vertebrae_apart_3mm", Eigen::Vector3d(3, 3, 3), true, 0, false, true}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(CoarseMap, ACsvNamesTheSkeletonAndTheBody) {
