@@ -475,16 +475,29 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
   if (voxels.empty()) return out;
   Splitter split(voxels, grid);
   double zMin = 1e300, zMax = -1e300;
+  V lo = V::Constant(1e300), hi = V::Constant(-1e300);
   std::vector<double> xs;
   xs.reserve(voxels.size() / 16 + 1);
   for (std::size_t i = 0; i < voxels.size(); ++i) {
     const V r = grid.ras(voxels[i]);
-    zMin = std::min(zMin, r.z()), zMax = std::max(zMax, r.z());
+    lo = lo.cwiseMin(r), hi = hi.cwiseMax(r);
     if (i % 16 == 0) xs.push_back(r.x());
   }
+  zMin = lo.z(), zMax = hi.z();
   std::nth_element(xs.begin(), xs.begin() + std::ptrdiff_t(xs.size() / 2), xs.end());
   const double midX = xs[xs.size() / 2], H = zMax - zMin;
   if (!(H > 0)) throw Error(source + ": the skeleton label has no height to split");
+  // The split reads the file's RAS frame as the body's: head up (+S), arms below the shoulders.
+  // A skeleton that is not tallest along S (a file whose orientation is wrong, a body lying
+  // along another axis of its frame) is refused rather than split into nonsense.
+  const V extent = hi - lo;
+  if (H < 0.8 * std::max(extent.x(), extent.y()))
+    throw Error(source + ": the skeleton label is " + std::to_string(std::lround(H)) +
+                " mm tall along S but " +
+                std::to_string(std::lround(std::max(extent.x(), extent.y()))) + " mm along " +
+                (extent.x() > extent.y() ? "R-L" : "A-P") +
+                ": it can be split into bones only upright in the file's frame (check its "
+                "orientation)");
   split.findPieces(midX, H);
   std::vector<Piece>& P = split.pieces();
 

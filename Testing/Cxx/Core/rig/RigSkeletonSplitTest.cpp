@@ -183,3 +183,29 @@ TEST(CoarseMap, ASkeletonWithoutABodyIsRefusedInOneLine) {
     EXPECT_EQ(m.rfind("bones.nii.gz: a skeleton label but no body outline", 0), 0u) << m;
   }
 }
+
+TEST(CoarseMap, ASkeletonThatIsNotUprightInItsFrameIsRefusedInOneLine) {
+  // The same map with the array's slices along A instead of S (a file whose orientation says the
+  // body lies head forwards): splitting it by "up" would make nonsense, so it is refused.
+  PhantomOptions o;
+  o.voxelMm = 4;
+  o.armsResting = true;
+  o.labels = PhantomLabelling::Coarse;
+  auto [G, S] = Phantom(o).makeVolumes();
+  VolumeGeometry lying = G.geometry();
+  const Eigen::Matrix4d upright = lying.ijkToRas;
+  lying.ijkToRas.col(1) = upright.col(2);
+  lying.ijkToRas.col(2) = upright.col(1);
+  G.setGeometry(lying);
+  RigOptions ro;
+  ro.source = "lying.nii.gz";
+  try {
+    rigBody(G, ro);
+    FAIL() << "split a skeleton lying along A";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos);
+    EXPECT_EQ(m.rfind("lying.nii.gz: the skeleton label is ", 0), 0u) << m;
+    EXPECT_NE(m.find("along A-P: it can be split into bones only upright"), std::string::npos) << m;
+  }
+}
