@@ -373,6 +373,7 @@ LabelConvention fromCsv(const Volume& organs, const std::string& path,
     r.rigid = r.bone != BoneKind::None;
     r.boneName = r.rigid ? bone : "";
     r.name = nameOf(organs, value);
+    r.outline = outline;
     if (outline && r.name.empty()) r.name = "body";
     for (std::size_t k = 2; k < f.size(); ++k) {
       if (header[k] == "side") {
@@ -471,6 +472,7 @@ LabelConvention coarseConvention(const Volume& organs, const std::vector<int>& l
       r.densityKgM3 = kCorticalBoneKgM3;
       if (r.name.empty()) r.name = "skeleton";
     } else if (v == m.body) {
+      r.outline = true;
       if (r.name.empty()) r.name = "body";
     } else {
       c.unknown.push_back(v);
@@ -516,8 +518,10 @@ LabelConvention conventionOf(const Volume& organs, const std::vector<int>& label
     } else {
       throw Error(
           source + ": cannot tell the label convention (" + std::to_string(labels.size()) +
-          " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs 1-141): "
-          "give --labels phantom|icrp110|totalsegmentator|FILE.csv");
+          " labels; not the phantom's or TotalSegmentator's names, not ICRP 110 IDs 1-141, "
+          "not a body and one skeleton label): give --labels phantom|icrp110|totalsegmentator|"
+          "FILE.csv (label,bone rows; bone skeleton for a label holding every bone, body for "
+          "the body's outline)");
     }
   } else {
     c = fromCsv(organs, requested, labels);

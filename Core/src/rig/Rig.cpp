@@ -26,6 +26,7 @@ namespace {
 // a body mask): without one, an organ segmentation's bones float in unlabelled space.
 bool labelsSoftTissue(const LabelConvention& convention) {
   for (const auto& [value, role] : convention.roles) {
+    if (role.outline) return true;
     std::string name = role.name;
     std::transform(name.begin(), name.end(), name.begin(),
                    [](unsigned char c) { return char(std::tolower(c)); });

@@ -498,6 +498,14 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
                 (extent.x() > extent.y() ? "R-L" : "A-P") +
                 ": it can be split into bones only upright in the file's frame (check its "
                 "orientation)");
+  // The split tells bones apart by where they lie in a whole body: a skeleton of part of one (a
+  // chest CT's ribs and spine) would have its ribs taken for arms.
+  constexpr double kWholeBodyMm = 700;  // a two-year-old's skeleton; any adult's is over 1,400
+  if (H < kWholeBodyMm)
+    throw Error(source + ": the skeleton label spans " + std::to_string(std::lround(H)) +
+                " mm along S: it is split into bones only in a whole body (at least " +
+                std::to_string(std::lround(kWholeBodyMm)) +
+                " mm); name each bone's label instead (--labels FILE.csv)");
   split.findPieces(midX, H);
   std::vector<Piece>& P = split.pieces();
 

@@ -10,7 +10,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 using namespace repose::test;
 
@@ -50,4 +52,33 @@ TEST(CoarseMapCommand, RigsWithNoOptionAndPosesAnArmBeyondTheInputGrid) {
   EXPECT_TRUE(report["quality"]["all_met"].get<bool>()) << report["quality"].dump();
   for (const auto& l : report["labels"])
     EXPECT_LT(std::fabs(l["change_beyond_floor_percent"].get<double>()), 1.0) << l.dump();
+}
+
+TEST(CoarseMapCommand, ARealChestSegmentationsSkeletonIsNotSplitIntoLimbs) {
+  // 3D Slicer's sample chest segmentation (ribs, cervical, thoracic and lumbar columns, lungs,
+  // tissue; 340 mm along S): no convention names it, and the error says how to name a skeleton
+  // and a body. Named so, its ribs are not taken for arms: a skeleton of part of a body is
+  // refused in one line, and nothing is written.
+  ScratchDir dir;
+  const std::string seg = std::string(REPOSE_DATA_DIR) + "/slicer_seg/Segmentation.seg.nrrd";
+  const CommandResult unnamed = runCommand(
+      "repose", "rig --input " + shellQuote(seg) + " --out " + shellQuote(dir.file("a")));
+  EXPECT_NE(unnamed.exitCode, 0);
+  EXPECT_NE(unnamed.err.find("bone skeleton for a label holding every bone, body for the body's"),
+            std::string::npos)
+      << unnamed.err;
+  {
+    std::ofstream csv(dir.file("chest.csv"));
+    csv << "label,bone\n1,skeleton\n2,skeleton\n3,skeleton\n4,skeleton\n7,body\n";
+  }
+  const CommandResult named = runCommand("repose", "rig --input " + shellQuote(seg) + " --labels " +
+                                                       shellQuote(dir.file("chest.csv")) +
+                                                       " --out " + shellQuote(dir.file("b")));
+  EXPECT_NE(named.exitCode, 0);
+  EXPECT_NE(named.err.find("the skeleton label spans 330 mm along S: it is split into bones only "
+                           "in a whole body"),
+            std::string::npos)
+      << named.err;
+  EXPECT_EQ(std::count(named.err.begin(), named.err.end(), '\n'), 1) << named.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b")));
 }

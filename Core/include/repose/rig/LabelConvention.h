@@ -49,6 +49,7 @@ struct LabelRole {
   double densityKgM3 = 1050;
   std::string boneName;   // the bone this label is part of ("humerus"), for the tissue table
   bool cervical = false;  // spine labels of the neck (the neck joint is at their top)
+  bool outline = false;   // the body's outline (a CSV's `body`, a coarse map's body label)
 };
 
 struct LabelConvention {
