@@ -30,6 +30,9 @@ struct Piece {
   std::vector<std::int64_t> voxels;  // G's indices
   V centroid = V::Zero(), axis = V::UnitZ();
   double length = 0, top = -1e300, bottom = 1e300, xMin = 1e300, xMax = -1e300;
+  // Its second principal spread over its first: a long bone's is small (its shaft), a scapula's
+  // (a plate) or a rib's (an arc) is not.
+  double spread = 1;
   BoneKind kind = BoneKind::None;
   int side = 0;
   bool assigned = false;
@@ -42,6 +45,9 @@ struct Contact {
 };
 
 constexpr double kNearMm = 20;
+// A humerus or femur is a shaft: its second principal spread is under a quarter of its first
+// (0.07-0.09 on the phantom's grids; a scapula's 0.3, the ribs' 0.5).
+constexpr double kLongBoneSpread = 0.25;
 
 class Splitter {
  public:
@@ -213,7 +219,10 @@ class Splitter {
       p.top = std::max(p.top, r.z()), p.bottom = std::min(p.bottom, r.z());
       p.xMin = std::min(p.xMin, r.x()), p.xMax = std::max(p.xMax, r.x());
     }
-    p.axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(2).normalized();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    p.axis = eig.eigenvectors().col(2).normalized();
+    const Eigen::Vector3d l = eig.eigenvalues();  // ascending
+    p.spread = l[2] > 0 ? std::sqrt(std::max(0.0, l[1]) / l[2]) : 1;
     double a = 1e300, b = -1e300;
     for (const std::int64_t v : p.voxels) {
       const double t = (grid_.ras(v) - p.centroid).dot(p.axis);
@@ -616,7 +625,9 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
     int femur = -1;
     for (const int i : candidates(0.12 * H)) {
       const Contact* c = split.contact(i, axial);
-      if (!c || c->at.z() > axialMid || P[std::size_t(i)].top > axialMid) continue;
+      if (!c || c->at.z() > axialMid || P[std::size_t(i)].top > axialMid ||
+          P[std::size_t(i)].spread > kLongBoneSpread)
+        continue;
       if (femur < 0 || P[std::size_t(i)].length > P[std::size_t(femur)].length) femur = i;
     }
     if (femur >= 0) take(femur, BoneKind::Femur);
@@ -627,7 +638,9 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
       const Piece& p = P[std::size_t(i)];
       // At the shoulders: its top in the axial piece's upper third (an arm held away from the
       // trunk touches nothing there).
-      if (p.top < axialTop - (axialTop - axialBottom) / 3 || std::fabs(p.axis.z()) < 0.5) continue;
+      if (p.top < axialTop - (axialTop - axialBottom) / 3 || std::fabs(p.axis.z()) < 0.5 ||
+          p.spread > kLongBoneSpread)
+        continue;
       if (humerus < 0 || p.length > P[std::size_t(humerus)].length) humerus = i;
     }
     // A humerus the grid joined to its scapula at the glenoid: parted where the erosion parts
