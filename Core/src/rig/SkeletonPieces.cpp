@@ -178,7 +178,8 @@ void SkeletonPieces::findContacts() {
     if (d < c.distance) c.distance = d, c.at = 0.5 * (grid_.ras(global(a)) + grid_.ras(global(b)));
   };
   while (!queue.empty()) {
-    const auto [d, l] = queue.top();
+    const float d = queue.top().first;
+    const std::int64_t l = queue.top().second;
     queue.pop();
     if (d > dist[std::size_t(l)]) continue;
     neighbours(l, [&](std::int64_t m, int di, int dj, int dk) {
