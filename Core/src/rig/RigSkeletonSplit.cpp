@@ -1,25 +1,20 @@
 // A skeleton given as one label (a CT's bone threshold, a coarse map's "skeleton") split into the
-// rig's bones by geometry. Bones meet at joints across a joint space, or touch over a thin
-// contact (a femoral head in its acetabulum, a scapula on the ribs); one voxel's erosion parts the
-// contacts, and each piece grows back over the voxels the erosion took. The pieces are then told
-// apart by where they are and what they touch: the piece across the midline is the axial
-// skeleton, the skull its top; the long pieces hanging from it are the humeri (from its upper
-// half) and the femora (from its lower half); the pieces at a long bone's distal end are the next
-// segment's, and those beyond are the hand's or foot's. The axial piece is cut into the pelvis
-// (below the iliac crests, beside the spine) and the spine with the ribs.
+// rig's bones by geometry, from its pieces (SkeletonPieces.h: components, touching bones parted by
+// one voxel's erosion, contacts through the space between them). The pieces are told apart by
+// where they are and what they touch: the pieces across the midline that chain through their
+// contacts are the axial skeleton, the largest piece at the top the skull; straight long pieces
+// reaching the axial skeleton's upper third are the humeri, those touching its lower half the
+// femora; the pieces at a long bone's distal end are the next segment's, and those beyond the
+// hand's or foot's; the pieces reaching out to the humeral head are the girdle. The axial
+// skeleton is cut into the pelvis (below the iliac crests, beside the spine's column) and the
+// spine with the ribs.
 #include "SkeletonPieces.h"
 
 #include "repose/util/Error.h"
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
 #include <map>
-#include <queue>
-#include <set>
 #include <sstream>
 
 namespace repose::rig {
