@@ -45,7 +45,6 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
                             const std::string& source) {
   SkeletonSplit out;
   if (voxels.empty()) return out;
-  SkeletonPieces split(voxels, grid);
   double zMin = 1e300, zMax = -1e300;
   V lo = V::Constant(1e300), hi = V::Constant(-1e300);
   std::vector<double> xs;
@@ -78,6 +77,8 @@ SkeletonSplit splitSkeleton(const std::vector<std::int64_t>& voxels, const Grid&
                 " mm along S: it is split into bones only in a whole body (at least " +
                 std::to_string(std::lround(kWholeBodyMm)) +
                 " mm); name each bone's label instead (--labels FILE.csv)");
+  // Only now the box around the skeleton: a refused map does not pay for it.
+  SkeletonPieces split(voxels, grid);
   split.findPieces(midX, H);
   std::vector<Piece>& P = split.pieces();
 

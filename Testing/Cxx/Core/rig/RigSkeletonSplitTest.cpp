@@ -61,6 +61,15 @@ double sameParts(const Volume& a, const Volume& b) {
 
 class CoarseMap : public ::testing::TestWithParam<Body> {};
 
+// The arms-resting phantom at 4 mm as a coarse map (G only).
+Volume coarseArmsResting4mm() {
+  PhantomOptions o;
+  o.voxelMm = 4;
+  o.armsResting = true;
+  o.labels = PhantomLabelling::Coarse;
+  return Phantom(o).makeVolumes().first;
+}
+
 }  // namespace
 
 TEST_P(CoarseMap, RigsWithNoOptionAndFitsTheFullLabelRigsJoints) {
@@ -130,11 +139,7 @@ INSTANTIATE_TEST_SUITE_P(
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(CoarseMap, ACsvNamesTheSkeletonAndTheBody) {
-  PhantomOptions o;
-  o.voxelMm = 4;
-  o.armsResting = true;
-  o.labels = PhantomLabelling::Coarse;
-  const auto [G, S] = Phantom(o).makeVolumes();
+  const Volume G = coarseArmsResting4mm();
   const RigResult automatic = rigBody(G);
   test::ScratchDir dir;
   std::ofstream(dir.file("kinds.csv")) << "label,bone\n1,body\n2,skeleton\n";
@@ -160,11 +165,7 @@ TEST(CoarseMap, ACsvNamesTheSkeletonAndTheBody) {
 }
 
 TEST(CoarseMap, ASkeletonWithoutABodyIsRefusedInOneLine) {
-  PhantomOptions o;
-  o.voxelMm = 4;
-  o.armsResting = true;
-  o.labels = PhantomLabelling::Coarse;
-  auto [G, S] = Phantom(o).makeVolumes();
+  Volume G = coarseArmsResting4mm();
   std::uint8_t* g = G.data<std::uint8_t>();
   for (std::int64_t i = 0; i < G.numVoxels(); ++i)
     if (g[i] != 2) g[i] = 0;  // the skeleton alone
@@ -187,11 +188,7 @@ TEST(CoarseMap, ASkeletonWithoutABodyIsRefusedInOneLine) {
 TEST(CoarseMap, ASkeletonThatIsNotUprightInItsFrameIsRefusedInOneLine) {
   // The same map with the array's slices along A instead of S (a file whose orientation says the
   // body lies head forwards): splitting it by "up" would make nonsense, so it is refused.
-  PhantomOptions o;
-  o.voxelMm = 4;
-  o.armsResting = true;
-  o.labels = PhantomLabelling::Coarse;
-  auto [G, S] = Phantom(o).makeVolumes();
+  Volume G = coarseArmsResting4mm();
   VolumeGeometry lying = G.geometry();
   const Eigen::Matrix4d upright = lying.ijkToRas;
   lying.ijkToRas.col(1) = upright.col(2);
