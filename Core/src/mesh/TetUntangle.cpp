@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
+#include <set>
 
 namespace repose {
 namespace mesh_detail {
@@ -229,6 +231,69 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
     }
   }
   return report;
+}
+
+int resetInvertedKnots(const TransferMesh& mesh, const std::vector<char>& isFree,
+                       const std::vector<int>& tets, Eigen::MatrixX3d& deformed) {
+  const Eigen::Index nv = mesh.vertices.rows();
+  auto corners = [&](const Eigen::MatrixX3d& x, int t) {
+    std::array<Eigen::Vector3d, 4> c;
+    for (int k = 0; k < 4; ++k) c[std::size_t(k)] = x.row(mesh.tets(t, k)).transpose();
+    return c;
+  };
+  const Eigen::MatrixX3d rest = mesh.vertices;
+  auto inverted = [&](int t) { return volumeOf(corners(deformed, t)) < 0; };
+  // The tets given around each vertex.
+  std::vector<std::vector<int>> around(static_cast<std::size_t>(nv));
+  for (const int t : tets)
+    for (int k = 0; k < 4; ++k) around[std::size_t(mesh.tets(t, k))].push_back(t);
+  // Knots: inverted tets joined through shared vertices (union-find on the vertices).
+  std::vector<int> root(static_cast<std::size_t>(nv));
+  for (Eigen::Index v = 0; v < nv; ++v) root[std::size_t(v)] = int(v);
+  auto find = [&](int v) {
+    while (root[std::size_t(v)] != v)
+      v = root[std::size_t(v)] = root[std::size_t(root[std::size_t(v)])];
+    return v;
+  };
+  std::vector<int> bad;
+  for (const int t : tets)
+    if (inverted(t)) {
+      bad.push_back(t);
+      for (int k = 1; k < 4; ++k) root[std::size_t(find(mesh.tets(t, k)))] = find(mesh.tets(t, 0));
+    }
+  std::map<int, std::vector<int>> knots;
+  for (const int t : bad) knots[find(mesh.tets(t, 0))].push_back(t);
+  int reset = 0;
+  for (const auto& [id, knot] : knots) {
+    // The knot's vertices and the ring around them move (the free ones); the vertices of the
+    // tets around those border it.
+    std::set<int> inner;
+    for (const int t : knot)
+      for (int k = 0; k < 4; ++k)
+        for (const int u : around[std::size_t(mesh.tets(t, k))])
+          for (int m = 0; m < 4; ++m)
+            if (isFree[std::size_t(mesh.tets(u, m))]) inner.insert(mesh.tets(u, m));
+    std::set<int> border;
+    for (const int v : inner)
+      for (const int u : around[std::size_t(v)])
+        for (int m = 0; m < 4; ++m)
+          if (!inner.count(mesh.tets(u, m))) border.insert(mesh.tets(u, m));
+    if (border.size() < 4) continue;
+    // The affine map x -> A x + b of least squares from the border's rest to posed positions.
+    Eigen::MatrixXd M(border.size(), 4), Y(border.size(), 3);
+    Eigen::Index r = 0;
+    for (const int v : border) {
+      M.row(r) << rest.row(v), 1.0;
+      Y.row(r++) = deformed.row(v);
+    }
+    const Eigen::MatrixXd X = M.colPivHouseholderQr().solve(Y);  // 4 x 3
+    const Eigen::Matrix3d A = X.topRows<3>().transpose();
+    if (!(A.determinant() > 0)) continue;
+    for (const int v : inner)
+      deformed.row(v) = (A * rest.row(v).transpose() + X.row(3).transpose()).transpose();
+    ++reset;
+  }
+  return reset;
 }
 
 }  // namespace repose

@@ -428,6 +428,27 @@ VolumeRestorationReport restoreVolumes(const TransferMesh& mesh, const std::vect
           deformed = before;
       }
     }
+    // Knots the sweeps could not open (TetUntangle.h: resetInvertedKnots): set back on their
+    // border's affine map and swept again; kept only if fewer tets are left inside out.
+    auto insideOut = [&]() {
+      int n = 0;
+      for (const int t : activeTets) n += volumeOf(corners(deformed, t)) < 0;
+      return n;
+    };
+    if (const int left = insideOut(); left > 0 && !cancelled()) {
+      std::vector<char> isFree(std::size_t(nv), 0);
+      for (const int v : freeVertices) isFree[std::size_t(v)] = 1;
+      const Eigen::MatrixX3d before = deformed;
+      if (const int knots = resetInvertedKnots(mesh, isFree, activeTets, deformed); knots > 0) {
+        held.residual = residual(deformed);
+        untangleTets(mesh, freeVertices, activeTets, held, deformed, uo);
+        const int now = insideOut();
+        if (now < left)
+          report.untangled += left - now, report.knotsReset = knots;
+        else
+          deformed = before;
+      }
+    }
   }
 
   if (cancelled()) {

@@ -295,6 +295,7 @@ std::vector<int> rigidLabels(const TransferMesh& mesh, const PoseFrameOptions& o
     if (label > 0) labels.insert(label);
   for (const auto& [label, piece] : options.bonePieces)
     if (label > 0 && piece > 0) labels.insert(label);
+  for (const int label : options.bendingPieces) labels.erase(label);
   return {labels.begin(), labels.end()};
 }
 
@@ -370,6 +371,7 @@ std::string frameReport(FrameStart& start, const PoseRig& rig, const Volume& org
                                   {"untangled_tets", vr.untangled},
                                   {"untangle_relaxed", vr.relaxedUntangle},
                                   {"untangle_crushed", vr.crushedUntangle},
+                                  {"knots_reset", vr.knotsReset},
                                   {"fold_contacts_before", vr.contactsBefore},
                                   {"fold_contacts_after", vr.contactsAfter},
                                   {"deepest_fold_before_mm", vr.deepestContactBeforeMm},

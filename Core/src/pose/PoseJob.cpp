@@ -1,5 +1,7 @@
 #include "repose/pose/PoseJob.h"
 
+#include "repose/pose/EncasedTissue.h"
+
 #include "repose/pose/SceneFolder.h"
 #include "repose/raster/RestTissues.h"
 #include "repose/util/Error.h"
@@ -227,6 +229,8 @@ PoseJob::PoseJob(Pose pose, const Volume& organs, const Volume& parts, PoseJobRe
   for (const std::string& why : separations_.automatic.skipped)
     warnings_.push_back("not separated: " + why);
   settings_.refineJoints = jointRefinements(pose_, parts, skeleton);
+  // The rig's pieces that bend at joints (PoseRig.h: labelsMovingWhole), found as it finds them.
+  if (settings_.wholeOrgans) bendingPieces_ = labelsEncasedInBone(organs, settings_.rigidLabels);
 }
 
 std::string PoseJob::sceneKey(const std::string& partsPath) const {
@@ -288,6 +292,7 @@ PoseFrameOptions PoseJob::frameOptions() const {
   o.tissueTableName = tissues_.name;
   o.threads = settings_.threads;
   o.bonePieces = settings_.bonePieces;
+  o.bendingPieces = bendingPieces_;
   return o;
 }
 

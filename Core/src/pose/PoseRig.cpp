@@ -3,6 +3,7 @@
 #include "repose/cage/ArapDeformer.h"
 #include "repose/mesh/RigidHandles.h"
 #include "repose/mesh/VolumeRestoration.h"
+#include "repose/pose/EncasedTissue.h"
 #include "repose/util/Error.h"
 
 #include <Eigen/LU>
@@ -19,8 +20,10 @@
 
 namespace repose {
 
-std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
-                                   const RigSettings& settings) {
+namespace {
+// labelsMovingWhole, with the encased labels among them apart (`encased`, sorted).
+std::vector<int> wholeLabels(const Volume& organs, const Volume& parts, const RigSettings& settings,
+                             std::vector<int>& encased) {
   if (organs.dims() != parts.dims())
     throw Error("the label map is not on the grid of the body-part map");
   std::set<int> whole(settings.rigidLabels.begin(), settings.rigidLabels.end());
@@ -57,11 +60,22 @@ std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
           double(atBorder[label]) <= kWholeOrganBorderShare * double(total))
         whole.insert(label);
     }
+    // A soft label inside a ring of bone (the spinal cord in its canal) moves with that bone,
+    // whatever parts it spans: each part's share of it is a piece of that part, as the spine is.
+    for (const int label : labelsEncasedInBone(organs, settings.rigidLabels))
+      if (!whole.count(label)) whole.insert(label), encased.push_back(label);
   }
   std::vector<int> out;
   for (const int label : whole)
     if (label > 0 && label <= 65535) out.push_back(label);
   return out;
+}
+}  // namespace
+
+std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
+                                   const RigSettings& settings) {
+  std::vector<int> encased;
+  return wholeLabels(organs, parts, settings, encased);
 }
 
 std::map<int, int> bonePiecesOf(const TissueTable& table) {
@@ -247,7 +261,8 @@ int demotePiecesAcrossJoints(TransferMesh& mesh) {
 }
 
 Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSettings& settings) {
-  const std::vector<int> whole = labelsMovingWhole(organs, parts, settings);
+  std::vector<int> encased;
+  const std::vector<int> whole = wholeLabels(organs, parts, settings, encased);
   if (whole.empty()) return Volume();
   Volume pieces(parts.geometry(), ScalarType::UInt16);
   // Per label: the piece it is meshed in (0: none).
@@ -287,6 +302,11 @@ Volume wholePieceMap(const Volume& organs, const Volume& parts, const RigSetting
         if (near) seam.push_back(at);
       }
   for (const std::int64_t at : seam) piece[at] = 0;
+  // An encased label (the spinal cord) crosses the joints its bone is parted at (the neck, the
+  // lumbosacral disc): there it stays soft tissue and bends with the joint's band, as the disc
+  // beside it does, instead of two rigid halves meeting at a seam (sitting's pelvic tilt ran
+  // them into each other).
+  softenEncasedNearOtherParts(organs, parts, encased, kEncasedJointBandMm, piece);
   return pieces;
 }
 

@@ -107,6 +107,9 @@ struct VolumeRestorationReport {
   // Tets were inside out after both, and it swept a third time with each tet's own volume
   // weighed (kept only when that left fewer inside out).
   bool crushedUntangle = false;
+  // Knots of crushed tets set back on their border's affine map and swept again
+  // (resetInvertedKnots; 0 when none was, or when that did not leave fewer inside out).
+  int knotsReset = 0;
   // Surface vertices inside another layer of tissue (SelfContact.h) before and after, and the
   // deepest of them (mm); 0 without a contact finder.
   int contactsBefore = 0, contactsAfter = 0;

@@ -68,6 +68,10 @@ struct PoseFrameOptions {
   std::function<void(const std::string&)> warn;
   // The rig's RigSettings::bonePieces: which labels of G a bone's one piece holds.
   std::map<int, int> bonePieces;
+  // Labels the rig meshes as pieces that still bend where they cross a joint (labelsEncasedInBone:
+  // the spinal cord, soft within kEncasedJointBandMm of another body part). The mesh poses them;
+  // they are not rigid copies, so neither bones that may collide nor rigid labels for the pockets.
+  std::vector<int> bendingPieces;
   LabelMapFiles labelMapFiles = LabelMapFiles::Nifti;  // what writePosedFrame writes
 };
 

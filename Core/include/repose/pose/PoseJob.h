@@ -137,6 +137,7 @@ class PoseJob {
   PoseRhythms rhythms_;
   std::vector<std::string> rhythmNotes_;  // report.json's rhythms.applied
   RigSettings settings_;
+  std::vector<int> bendingPieces_;  // PoseFrameOptions::bendingPieces
   PoseSeparations separations_;
   TissueChoice tissues_;
   std::optional<Skeleton> skeleton_;

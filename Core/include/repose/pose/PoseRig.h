@@ -63,7 +63,8 @@ constexpr double kWholeOrganBorderShare = 0.002;
 
 // The labels of G that buildRigGeometry meshes as whole pieces: settings.rigidLabels, and with
 // settings.wholeOrgans every label with kWholeOrganShare of its voxels in one part of S and at
-// most kWholeOrganBorderShare of them facing another part.
+// most kWholeOrganBorderShare of them facing another part, and every soft label encased in the
+// rigid labels' bone (labelsEncasedInBone: the spinal cord), in whichever parts it lies.
 std::vector<int> labelsMovingWhole(const Volume& organs, const Volume& parts,
                                    const RigSettings& settings);
 

@@ -154,3 +154,67 @@ TEST(TetUntangle, TetsCrushedTowardsAPointComeBackNearerTheirVolumesWithTheirOwn
   EXPECT_EQ(a.invertedAfter, 0);
   EXPECT_LT(volumeMisfit(weighed), 0.6 * volumeMisfit(shapeOnly));
 }
+
+// A knot (resetInvertedKnots): under an affine pose (a turn and a stretch), the vertices around
+// the box's centre crushed through a point, tets inside out. Set back on the affine map its
+// border carries, every vertex is where the pose puts it again and no tet is inside out; vertices
+// not free stay where they were; a border whose map turns space over (a mirror) leaves the knot.
+TEST(TetUntangle, AKnotCrushedThroughAPointIsSetBackOnItsBordersAffineMap) {
+  const TransferMesh mesh = test::tetBox({0, 0, 0}, {60, 30, 30}, {12, 6, 6}, 1);
+  const Eigen::Vector3d centre(30, 15, 15);
+  Eigen::Matrix3d A = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).matrix();
+  A.col(0) *= 1.3;
+  const Eigen::Vector3d b(5, -2, 7);
+  auto posedBy = [&](const Eigen::Matrix3d& M) {
+    Eigen::MatrixX3d x(mesh.vertices.rows(), 3);
+    for (Eigen::Index v = 0; v < x.rows(); ++v)
+      x.row(v) = (M * mesh.vertices.row(v).transpose() + b).transpose();
+    return x;
+  };
+  const Eigen::MatrixX3d posed = posedBy(A);
+  std::vector<char> isFree(std::size_t(mesh.vertices.rows()), 0);
+  std::vector<int> tets;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) tets.push_back(int(t));
+  auto crush = [&](const Eigen::MatrixX3d& from) {
+    Eigen::MatrixX3d x = from;
+    const Eigen::Vector3d c = A * centre + b;
+    for (Eigen::Index v = 0; v < x.rows(); ++v) {
+      const Eigen::Vector3d p = mesh.vertices.row(v);
+      if ((p - centre).cwiseAbs().maxCoeff() < 6)
+        x.row(v) = (c - 0.01 * (x.row(v).transpose() - c)).transpose();
+    }
+    return x;
+  };
+  auto inverted = [&](const Eigen::MatrixX3d& x) {
+    int n = 0;
+    for (const int t : tets) n += tetVolume(x, mesh.tets.row(t)) * A.determinant() < 0;
+    return n;
+  };
+  // Free: the crushed vertices and the ring beyond them (the knot's ring), with one vertex held.
+  int held = -1;
+  for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v) {
+    const Eigen::Vector3d p = mesh.vertices.row(v);
+    if ((p - centre).cwiseAbs().maxCoeff() < 12) isFree[std::size_t(v)] = 1;
+    if ((p - centre - Eigen::Vector3d(10, 0, 0)).norm() < 1e-9) held = int(v);
+  }
+  ASSERT_GE(held, 0);
+  isFree[std::size_t(held)] = 0;
+  Eigen::MatrixX3d x = crush(posed);
+  x.row(held) += Eigen::RowVector3d(0.5, 0, 0);  // not on the pose: it must stay so
+  const Eigen::RowVector3d heldAt = x.row(held);
+  ASSERT_GT(inverted(x), 50);
+  EXPECT_EQ(resetInvertedKnots(mesh, isFree, tets, x), 1);
+  EXPECT_EQ(inverted(x), 0);
+  EXPECT_EQ(x.row(held), heldAt);
+  double off = 0;
+  for (Eigen::Index v = 0; v < x.rows(); ++v)
+    if (int(v) != held) off = std::max(off, (x.row(v) - posed.row(v)).norm());
+  EXPECT_LT(off, 0.02);  // the held vertex's 0.5 mm shifts the least-squares map a little
+  // A mirrored pose: the knot is left as it is.
+  Eigen::Matrix3d mirror = A;
+  mirror.col(2) *= -1;
+  const Eigen::MatrixX3d mirrored = crush(posedBy(mirror));
+  Eigen::MatrixX3d y = mirrored;
+  EXPECT_EQ(resetInvertedKnots(mesh, isFree, tets, y), 0);
+  EXPECT_EQ(y, mirrored);
+}
