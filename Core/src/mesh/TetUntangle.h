@@ -79,13 +79,13 @@ UntangleReport untangleTets(const TransferMesh& mesh, const std::vector<int>& fr
 
 // A knot of tiny tets the sweeps cannot open: where three parts meet, a bend can crush a few
 // dozen tets of a millimetre or less onto one point, each a hair inside out, and every one-vertex
-// move that turns one back turns another over (thick slices' arm raise 90 degrees: 27 tets, every
-// corner free, the vertices 0.001 mm apart after 7-42 mm of travel). Each knot (inverted tets
+// move that turns one back turns another over (thick slices' arm raise 90 degrees, in a
+// development build without this step: 27 tets, every corner free). Each knot (inverted tets
 // among `tets` that share a vertex) with the ring of vertices around it is set back on the one
 // affine map that best carries the rest positions of the vertices bordering it onto their posed
 // ones: the knot's own tets come back right side out, and the tets between it and its border may
 // turn over, but they are large enough for the sweeps, which start again from there (on that
-// body: 27 tets, 50 just after the reset, 0 after the sweeps). Only free vertices (`isFree`)
+// body none is left: the quality suite's thick-slice arm_raise90). Only free vertices (`isFree`)
 // move; a knot whose map turns space over (det <= 0) is left. Returns how many knots were reset;
 // the caller keeps the result only if the sweeps then leave fewer tets inside out.
 int resetInvertedKnots(const TransferMesh& mesh, const std::vector<char>& isFree,
