@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <map>
 
 namespace repose {
 
@@ -28,7 +27,8 @@ std::vector<int> labelsEncasedInBone(const Volume& organs, const std::vector<int
   const std::int64_t step[3] = {1, d[0], d[0] * d[1]};
   std::vector<std::int32_t> label(std::size_t(nu * nv));
   std::vector<std::uint8_t> sides(std::size_t(nu * nv));
-  std::map<int, std::int64_t> total, encased;
+  // Per label value (a vector: this runs per voxel of G).
+  std::vector<std::int64_t> total(65536, 0), encased(65536, 0);
   // Along one line of the slice (n cells, `at(c)` its c-th), counts for each soft cell whether
   // bone lies within `reach` cells before it and, in the second sweep, after it.
   auto sweep = [&](std::int64_t n, std::int64_t reach, auto at) {
@@ -64,13 +64,14 @@ std::vector<int> labelsEncasedInBone(const Volume& organs, const std::vector<int
     for (std::size_t c = 0; c < label.size(); ++c) {
       const std::int32_t l = label[c];
       if (l <= 0 || rigid[std::size_t(l)]) continue;
-      ++total[l];
-      if (sides[c] >= options.sides) ++encased[l];
+      ++total[std::size_t(l)];
+      if (sides[c] >= options.sides) ++encased[std::size_t(l)];
     }
   }
   std::vector<int> out;
-  for (const auto& [l, n] : total)
-    if (double(encased[l]) >= options.share * double(n)) out.push_back(l);
+  for (std::size_t l = 1; l < total.size(); ++l)
+    if (total[l] > 0 && double(encased[l]) >= options.share * double(total[l]))
+      out.push_back(int(l));
   return out;
 }
 
